@@ -1,0 +1,72 @@
+// The Q-table and what it takes to interpret it: the discretisation that numbers its rows,
+// the efforts that name its columns, and how much training produced it.
+#pragma once
+
+#include "cartpole_qlearning/discretiser.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace cartpole_qlearning
+{
+class QTable
+{
+public:
+  QTable() = default;
+  // A table of zeros with one row per discretiser state and one column per action effort.
+  QTable(const DiscretiserParams& discretiser, const std::vector<double>& actions);
+
+  std::size_t stateCount() const
+  {
+    return state_count_;
+  }
+  std::size_t actionCount() const
+  {
+    return actions_.size();
+  }
+
+  double& at(std::size_t state, std::size_t action)
+  {
+    return values_[state * actions_.size() + action];
+  }
+  double at(std::size_t state, std::size_t action) const
+  {
+    return values_[state * actions_.size() + action];
+  }
+
+  // The first action with the largest value (ties go to the lowest index, as numpy's argmax).
+  std::size_t argmax(std::size_t state) const;
+  double max(std::size_t state) const;
+
+  const DiscretiserParams& discretiser() const
+  {
+    return discretiser_;
+  }
+  const std::vector<double>& actions() const
+  {
+    return actions_;
+  }
+  // Row-major: state * actionCount() + action.
+  const std::vector<double>& values() const
+  {
+    return values_;
+  }
+  // Replaces the values; throws std::invalid_argument unless the size is stateCount() * actionCount().
+  void setValues(std::vector<double> values);
+
+  // Training that produced the table, so that a loaded table resumes its schedules.
+  std::uint64_t episodes = 0;
+  std::uint64_t steps = 0;
+
+  // Empty when the other table has the same discretisation and actions, else what differs.
+  std::string shapeMismatch(const QTable& other) const;
+
+private:
+  DiscretiserParams discretiser_;
+  std::vector<double> actions_;
+  std::size_t state_count_ = 0;
+  std::vector<double> values_;
+};
+
+}  // namespace cartpole_qlearning

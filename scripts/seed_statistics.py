@@ -1,0 +1,59 @@
+#!/usr/bin/env python3
+"""Runs train_headless over a range of seeds and reports how many episodes and wall seconds
+solving took: median, worst, and how many seeds did not solve.
+
+  scripts/seed_statistics.py [--seeds 0-9] [--config FILE] [--max-episodes N]
+
+Needs the workspace sourced (rosrun finds train_headless). Standard library only.
+"""
+import argparse
+import re
+import statistics
+import subprocess
+import sys
+
+RESULT = re.compile(r"^solved=(true|false) episodes=(\d+) steps=(\d+) wall_s=([0-9.]+)$")
+
+
+def seed_range(text):
+    first, _, last = text.partition("-")
+    return range(int(first), int(last or first) + 1)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--seeds", type=seed_range, default=seed_range("0-9"), help="e.g. 0-9 (default) or 0-99")
+    parser.add_argument("--config", help="config file (default: the package's config/cartpole.yaml)")
+    parser.add_argument("--max-episodes", type=int, help="override training/max_episodes")
+    args = parser.parse_args()
+
+    episodes, walls, unsolved = [], [], []
+    for seed in args.seeds:
+        command = ["rosrun", "cartpole_qlearning", "train_headless", "--quiet", "--seed", str(seed)]
+        if args.config:
+            command += ["--config", args.config]
+        if args.max_episodes:
+            command += ["--max-episodes", str(args.max_episodes)]
+        run = subprocess.run(command, capture_output=True, text=True)
+        lines = run.stdout.strip().splitlines()
+        match = RESULT.match(lines[-1]) if lines else None
+        if run.returncode != 0 or not match:
+            sys.exit("seed %d: train_headless failed:\n%s%s" % (seed, run.stdout, run.stderr))
+        print("seed %3d: %s" % (seed, lines[-1]))
+        if match.group(1) == "true":
+            episodes.append(int(match.group(2)))
+            walls.append(float(match.group(4)))
+        else:
+            unsolved.append(seed)
+
+    print("seeds %d-%d: solved %d of %d" % (args.seeds[0], args.seeds[-1], len(episodes), len(args.seeds)))
+    if episodes:
+        print("episodes to solve: median %g, min %d, max %d" % (statistics.median(episodes), min(episodes), max(episodes)))
+        print("wall seconds to solve: median %.4f, max %.4f" % (statistics.median(walls), max(walls)))
+    if unsolved:
+        print("not solved: seeds %s" % ", ".join(map(str, unsolved)))
+    return 1 if unsolved else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Sets everything up (scripts/setup.sh), builds and runs every test (gtest and rostest), and
+# ends with one line "N passed, N failed" counting every test case.
+set -eo pipefail
+# shellcheck disable=SC1091
+source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
+set -eo pipefail
+cd "$CARTPOLE_WS"
+rm -rf build/test_results/cartpole_qlearning
+echo "[test] catkin_make run_tests (log in $CARTPOLE_WS/test.log)"
+# run_tests keeps going past failing tests; the results files say what failed.
+catkin_make run_tests -DCMAKE_BUILD_TYPE=Release >"$CARTPOLE_WS/test.log" 2>&1 || true
+if ! ls build/test_results/cartpole_qlearning/*.xml >/dev/null 2>&1; then
+  tail -n 60 "$CARTPOLE_WS/test.log"
+  echo "[test] no test results were produced (the build of the tests failed?)"
+  echo "0 passed, 1 failed"
+  exit 1
+fi
+# Prints each failure, then the last line: "N passed, N failed, N skipped".
+exec /usr/bin/env python3 "$CARTPOLE_SRC/scripts/count_test_results.py" build/test_results/cartpole_qlearning

@@ -1,0 +1,392 @@
+#include "cartpole_qlearning/config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+std::vector<std::string> splitKey(const std::string& key)
+{
+  std::vector<std::string> parts;
+  std::stringstream in(key);
+  std::string part;
+  while (std::getline(in, part, '/'))
+    parts.push_back(part);
+  return parts;
+}
+
+class YamlParameters : public ParameterSource
+{
+public:
+  YamlParameters(YAML::Node root, std::string origin) : root_(std::move(root)), origin_(std::move(origin)) {}
+
+  bool get(const std::string& key, double& value) const override
+  {
+    return scalar(key, value, "a number");
+  }
+  bool get(const std::string& key, std::int64_t& value) const override
+  {
+    return scalar(key, value, "a whole number");
+  }
+  bool get(const std::string& key, bool& value) const override
+  {
+    return scalar(key, value, "true or false");
+  }
+  bool get(const std::string& key, std::string& value) const override
+  {
+    return scalar(key, value, "a string");
+  }
+  bool get(const std::string& key, std::vector<double>& value) const override
+  {
+    const YAML::Node node = find(key);
+    if (!node)
+      return false;
+    if (!node.IsSequence())
+      throw ConfigError(origin_ + ": " + key + " must be a list of numbers");
+    value.clear();
+    for (std::size_t i = 0; i < node.size(); ++i)
+    {
+      try
+      {
+        value.push_back(node[i].as<double>());
+      }
+      catch (const YAML::Exception&)
+      {
+        throw ConfigError(origin_ + ": " + key + "[" + std::to_string(i) + "] = '" + text(node[i]) +
+                          "' is not allowed (must be a number)");
+      }
+    }
+    return true;
+  }
+
+  std::vector<std::string> keysUnder(const std::string& section) const override
+  {
+    std::vector<std::string> keys;
+    const YAML::Node node = find(section);
+    if (node)
+      collect(node, section, keys);
+    return keys;
+  }
+
+  std::string origin() const override
+  {
+    return origin_;
+  }
+
+private:
+  YAML::Node find(const std::string& key) const
+  {
+    // reset() rebinds; plain assignment between yaml-cpp nodes would overwrite the tree itself.
+    YAML::Node node;
+    node.reset(root_);
+    for (const std::string& part : splitKey(key))
+    {
+      if (part.empty())
+        continue;
+      if (!node.IsMap())
+        return YAML::Node(YAML::NodeType::Undefined);
+      const YAML::Node& parent = node;
+      const YAML::Node child = parent[part];  // const lookup: does not insert the key
+      if (!child)
+        return child;
+      node.reset(child);
+    }
+    return node;
+  }
+
+  template <typename T>
+  bool scalar(const std::string& key, T& value, const char* expected) const
+  {
+    const YAML::Node node = find(key);
+    if (!node)
+      return false;
+    try
+    {
+      if (!node.IsScalar())
+        throw YAML::Exception(YAML::Mark::null_mark(), "not a scalar");
+      value = node.as<T>();
+    }
+    catch (const YAML::Exception&)
+    {
+      throw ConfigError(origin_ + ": " + key + " = '" + text(node) + "' is not allowed (must be " + expected + ")");
+    }
+    return true;
+  }
+
+  static std::string text(const YAML::Node& node)
+  {
+    if (node.IsScalar())
+      return node.Scalar();
+    YAML::Emitter out;
+    out << YAML::Flow << node;
+    return out.c_str();
+  }
+
+  static void collect(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& keys)
+  {
+    if (!node.IsMap())
+    {
+      keys.push_back(prefix);
+      return;
+    }
+    for (const auto& entry : node)
+      collect(entry.second, (prefix.empty() ? "" : prefix + "/") + entry.first.as<std::string>(), keys);
+  }
+
+  YAML::Node root_;
+  std::string origin_;
+};
+
+// Reads the keys of one section, remembers which keys it knows, and refuses the others, so
+// that a misspelt key stops the run instead of being silently ignored.
+class SectionReader
+{
+public:
+  SectionReader(const ParameterSource& source, std::string section) : source_(source), section_(std::move(section)) {}
+
+  template <typename T>
+  void read(const std::string& name, T& value)
+  {
+    known_.insert(key(name));
+    source_.get(key(name), value);
+  }
+
+  void read(const std::string& name, unsigned& value, std::int64_t min, std::int64_t max)
+  {
+    std::int64_t v = value;
+    read(name, v);
+    if (v < min || v > max)
+      fail(name, std::to_string(v),
+           "must be a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+    value = static_cast<unsigned>(v);
+  }
+
+  void read(const std::string& name, std::uint64_t& value, std::int64_t min)
+  {
+    std::int64_t v = static_cast<std::int64_t>(value);
+    read(name, v);
+    if (v < min)
+      fail(name, std::to_string(v), "must be a whole number >= " + std::to_string(min));
+    value = static_cast<std::uint64_t>(v);
+  }
+
+  // A list of exactly kStateDimensions values.
+  template <typename T>
+  void readDimensions(const std::string& name, std::array<T, kStateDimensions>& values, bool whole)
+  {
+    std::vector<double> list;
+    known_.insert(key(name));
+    if (!source_.get(key(name), list))
+      return;
+    if (list.size() != kStateDimensions)
+      fail(name, listText(list), "must list 4 values: x, x_dot, theta, theta_dot");
+    for (std::size_t i = 0; i < kStateDimensions; ++i)
+    {
+      if (whole && (list[i] != std::floor(list[i]) || list[i] < 1))
+        fail(name, listText(list), "must be whole numbers >= 1");
+      values[i] = static_cast<T>(list[i]);
+    }
+  }
+
+  // Refuses a key under this section that no read() asked for.
+  void refuseUnknown() const
+  {
+    for (const std::string& k : source_.keysUnder(section_))
+    {
+      if (known_.count(k) == 0)
+        throw ConfigError(source_.origin() + ": unknown key " + k + " (known keys of " + section_ + ": " + knownText() +
+                          ")");
+    }
+  }
+
+  // Turns a validate() message, which names the field relative to this section, into a ConfigError.
+  void check(const std::string& error) const
+  {
+    if (!error.empty())
+      throw ConfigError(source_.origin() + ": " + section_ + "/" + error);
+  }
+
+  [[noreturn]] void fail(const std::string& name, const std::string& value, const std::string& allowed) const
+  {
+    throw ConfigError(source_.origin() + ": " + key(name) + " = " + value + " is not allowed (" + allowed + ")");
+  }
+
+  std::string key(const std::string& name) const
+  {
+    return section_ + "/" + name;
+  }
+
+  static std::string listText(const std::vector<double>& list)
+  {
+    std::ostringstream out;
+    out << "[";
+    for (std::size_t i = 0; i < list.size(); ++i)
+      out << (i ? ", " : "") << list[i];
+    out << "]";
+    return out.str();
+  }
+
+private:
+  std::string knownText() const
+  {
+    std::string text;
+    for (const std::string& k : known_)
+      text += (text.empty() ? "" : ", ") + k.substr(section_.size() + 1);
+    return text;
+  }
+
+  const ParameterSource& source_;
+  std::string section_;
+  std::set<std::string> known_;
+};
+
+template <typename Enum, typename Parse>
+void readEnum(SectionReader& reader, const std::string& name, Enum& value, Parse parse)
+{
+  std::string text = toString(value);
+  reader.read(name, text);
+  try
+  {
+    value = parse(text);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    reader.fail(name, "'" + text + "'", e.what());
+  }
+}
+
+void readSchedule(SectionReader& reader, const std::string& name, ScheduleParams& schedule)
+{
+  readEnum(reader, name + "/schedule", schedule.type, scheduleTypeFromString);
+  reader.read(name + "/start", schedule.start);
+  reader.read(name + "/min", schedule.min);
+  reader.read(name + "/decay_episodes", schedule.decay_episodes);
+  reader.read(name + "/decay_rate", schedule.decay_rate);
+  reader.read(name + "/log_divisor", schedule.log_divisor);
+}
+
+}  // namespace
+
+std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin)
+{
+  YAML::Node root;
+  try
+  {
+    root = YAML::Load(text);
+  }
+  catch (const YAML::Exception& e)
+  {
+    throw ConfigError(origin + ": not valid YAML: " + e.what());
+  }
+  if (root.IsNull())
+    root = YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap())
+    throw ConfigError(origin + ": must be a YAML mapping of sections (physics, task, learning, training)");
+  return std::make_unique<YamlParameters>(root, origin);
+}
+
+void refuseUnknownSections(const ParameterSource& source)
+{
+  static const std::set<std::string> sections{"physics", "task", "learning", "training"};
+  for (const std::string& key : source.keysUnder(""))
+  {
+    const std::string section = key.substr(0, key.find('/'));
+    if (sections.count(section) == 0 || key == section)
+      throw ConfigError(source.origin() + ": unknown key " + key +
+                        " (the file holds the sections physics, task, learning and training)");
+  }
+}
+
+std::unique_ptr<ParameterSource> loadYamlParameters(const std::string& path)
+{
+  std::ifstream in(path);
+  if (!in)
+    throw ConfigError(path + ": cannot be read");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseYamlParameters(text.str(), path);
+}
+
+void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound)
+{
+  SectionReader reader(source, "physics");
+  reader.read("gravity", physics.gravity);
+  reader.read("mass_cart", physics.mass_cart);
+  reader.read("mass_pole", physics.mass_pole);
+  reader.read("half_length", physics.half_length);
+  reader.read("force_mag", physics.force_mag);
+  reader.read("tau", physics.tau);
+  readEnum(reader, "integrator", physics.integrator, integratorFromString);
+  reader.read("start_state_bound", start_state_bound);
+  reader.refuseUnknown();
+  reader.check(physics.validate());
+  if (!(std::isfinite(start_state_bound) && start_state_bound >= 0.0))
+    reader.fail("start_state_bound", std::to_string(start_state_bound), "must be finite and >= 0");
+}
+
+TaskParams readTask(const ParameterSource& source)
+{
+  TaskParams task;
+  SectionReader reader(source, "task");
+  reader.read("x_threshold", task.x_threshold);
+  reader.read("theta_threshold_deg", task.theta_threshold_deg);
+  reader.read("max_episode_steps", task.max_episode_steps, 1, std::numeric_limits<int>::max());
+  readEnum(reader, "reward", task.reward, rewardSchemeFromString);
+  reader.read("solved_mean_return", task.solved_mean_return);
+  reader.read("solved_window", task.solved_window, 1, 1000000);
+  reader.refuseUnknown();
+  reader.check(task.validate());
+  return task;
+}
+
+AgentParams readAgent(const ParameterSource& source)
+{
+  AgentParams agent;
+  SectionReader reader(source, "learning");
+  reader.read("gamma", agent.gamma);
+  reader.read("actions", agent.actions);
+  reader.readDimensions("bins", agent.discretiser.bins, true);
+  reader.readDimensions("lower_bounds", agent.discretiser.lower, false);
+  reader.readDimensions("upper_bounds", agent.discretiser.upper, false);
+  readSchedule(reader, "epsilon", agent.epsilon);
+  readSchedule(reader, "alpha", agent.alpha);
+  reader.refuseUnknown();
+  reader.check(agent.validate());
+  return agent;
+}
+
+TrainingLimits readLimits(const ParameterSource& source)
+{
+  TrainingLimits limits;
+  SectionReader reader(source, "training");
+  reader.read("max_episodes", limits.max_episodes, 1);
+  reader.read("stop_when_solved", limits.stop_when_solved);
+  reader.read("progress_every", limits.progress_every, 0);
+  reader.refuseUnknown();
+  return limits;
+}
+
+TrainingConfig readTrainingConfig(const ParameterSource& source)
+{
+  TrainingConfig config;
+  readPhysics(source, config.physics, config.start_state_bound);
+  config.task = readTask(source);
+  config.agent = readAgent(source);
+  config.limits = readLimits(source);
+  for (const double effort : config.agent.actions)
+  {
+    if (std::fabs(effort) > config.physics.force_mag)
+      throw ConfigError(source.origin() + ": learning/actions contains " + std::to_string(effort) +
+                        ", which is not allowed (|effort| must be <= physics/force_mag = " +
+                        std::to_string(config.physics.force_mag) + ")");
+  }
+  return config;
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,103 @@
+#include "cartpole_qlearning/q_learning_agent.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace cartpole_qlearning
+{
+ScheduleParams AgentParams::defaultEpsilon()
+{
+  ScheduleParams schedule;
+  schedule.type = ScheduleType::Log;
+  schedule.start = 1.0;
+  schedule.min = 0.01;
+  schedule.log_divisor = 25.0;
+  return schedule;
+}
+
+ScheduleParams AgentParams::defaultAlpha()
+{
+  ScheduleParams schedule;
+  schedule.type = ScheduleType::Log;
+  schedule.start = 1.0;
+  schedule.min = 0.05;
+  schedule.log_divisor = 15.0;
+  return schedule;
+}
+
+std::string AgentParams::validate() const
+{
+  std::ostringstream out;
+  std::string error = discretiser.validate();
+  if (!error.empty())
+    return error;
+  if (actions.empty())
+    return "actions = [] is not allowed (must list at least one effort)";
+  for (std::size_t i = 0; i < actions.size(); ++i)
+  {
+    if (!std::isfinite(actions[i]))
+    {
+      out << "actions[" << i << "] = " << actions[i] << " is not allowed (must be finite)";
+      return out.str();
+    }
+  }
+  if (!(gamma >= 0.0 && gamma <= 1.0))
+  {
+    out << "gamma = " << gamma << " is not allowed (must be in [0, 1])";
+    return out.str();
+  }
+  error = epsilon.validate();
+  if (!error.empty())
+    return "epsilon/" + error;
+  error = alpha.validate();
+  if (!error.empty())
+    return "alpha/" + error;
+  return "";
+}
+
+namespace
+{
+const AgentParams& checked(const AgentParams& params)
+{
+  const std::string error = params.validate();
+  if (!error.empty())
+    throw std::invalid_argument(error);
+  return params;
+}
+}  // namespace
+
+QLearningAgent::QLearningAgent(const AgentParams& params, std::uint64_t seed)
+  : params_(checked(params)),
+    discretiser_(params.discretiser),
+    epsilon_(params.epsilon),
+    alpha_(params.alpha),
+    table_(params.discretiser, params.actions),
+    rng_(seed, kAgentStream)
+{
+}
+
+std::size_t QLearningAgent::selectAction(std::size_t state, double epsilon)
+{
+  if (rng_.uniform01() < epsilon)
+    return static_cast<std::size_t>(rng_.uniformIndex(table_.actionCount()));
+  return table_.argmax(state);
+}
+
+void QLearningAgent::update(std::size_t state, std::size_t action, double reward, std::size_t next_state,
+                            bool next_is_terminal, double alpha)
+{
+  const double future = next_is_terminal ? 0.0 : params_.gamma * table_.max(next_state);
+  double& q = table_.at(state, action);
+  q += alpha * (reward + future - q);
+}
+
+std::string QLearningAgent::replaceTable(QTable table)
+{
+  const std::string mismatch = table_.shapeMismatch(table);
+  if (mismatch.empty())
+    table_ = std::move(table);
+  return mismatch;
+}
+
+}  // namespace cartpole_qlearning

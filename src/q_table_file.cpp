@@ -1,0 +1,378 @@
+#include "cartpole_qlearning/q_table_file.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <locale>
+#include <sstream>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace cartpole_qlearning
+{
+namespace fs = std::filesystem;
+
+namespace
+{
+constexpr const char* kFormatName = "cartpole_qlearning/q_table";
+
+// FNV-1a over 64-bit words: the bit patterns of every number that defines the table, so a
+// flipped digit anywhere in them is caught even when the text still parses.
+class Checksum
+{
+public:
+  void add(std::uint64_t word)
+  {
+    for (int i = 0; i < 8; ++i)
+    {
+      hash_ ^= (word >> (8 * i)) & 0xFF;
+      hash_ *= 0x100000001B3ULL;
+    }
+  }
+  void add(double value)
+  {
+    std::uint64_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    add(bits);
+  }
+  std::string text() const
+  {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "fnv1a64:%016llx", static_cast<unsigned long long>(hash_));
+    return buffer;
+  }
+
+private:
+  std::uint64_t hash_ = 0xCBF29CE484222325ULL;
+};
+
+std::string checksumOf(const QTable& table)
+{
+  Checksum sum;
+  const DiscretiserParams& d = table.discretiser();
+  for (std::size_t i = 0; i < kStateDimensions; ++i)
+  {
+    sum.add(static_cast<std::uint64_t>(d.bins[i]));
+    sum.add(d.lower[i]);
+    sum.add(d.upper[i]);
+  }
+  for (double a : table.actions())
+    sum.add(a);
+  sum.add(table.episodes);
+  sum.add(table.steps);
+  for (double v : table.values())
+    sum.add(v);
+  return sum.text();
+}
+
+// The shortest decimal (15 to 17 significant digits, classic locale) that reads back as the
+// same double: exact, and 2.4 stays "2.4" rather than "2.3999999999999999".
+std::string exact(double value)
+{
+  for (int precision = 15;; ++precision)
+  {
+    std::ostringstream out;
+    out.imbue(std::locale::classic());
+    out.precision(precision);
+    out << value;
+    std::istringstream in(out.str());
+    in.imbue(std::locale::classic());
+    double back = 0.0;
+    in >> back;
+    if (precision == 17 || (!in.fail() && std::memcmp(&back, &value, sizeof value) == 0))
+      return out.str();
+  }
+}
+
+template <typename Container>
+std::string flowList(const Container& values)
+{
+  std::string text = "[";
+  bool first = true;
+  for (const auto& v : values)
+  {
+    text += (first ? "" : ", ") + exact(static_cast<double>(v));
+    first = false;
+  }
+  return text + "]";
+}
+
+[[noreturn]] void refuse(const std::string& what)
+{
+  throw QTableFileError(what);
+}
+
+const YAML::Node required(const YAML::Node& root, const char* key)
+{
+  const YAML::Node node = root[key];
+  if (!node)
+    refuse(std::string("missing key '") + key + "' (the file is truncated or not a Q-table)");
+  return node;
+}
+
+double readNumber(const YAML::Node& node, const std::string& where)
+{
+  double value;
+  try
+  {
+    // Through the classic-locale stream, the same way it was written, so it reads back exactly.
+    if (!node.IsScalar())
+      throw YAML::Exception(YAML::Mark::null_mark(), "");
+    std::istringstream in(node.Scalar());
+    in.imbue(std::locale::classic());
+    in >> value;
+    if (!in || !(in >> std::ws).eof())
+      throw YAML::Exception(YAML::Mark::null_mark(), "");
+  }
+  catch (const YAML::Exception&)
+  {
+    refuse(where + " is not a number");
+  }
+  if (!std::isfinite(value))
+    refuse(where + " is not finite");
+  return value;
+}
+
+std::vector<double> readNumbers(const YAML::Node& node, const std::string& where, std::size_t expected_size)
+{
+  if (!node.IsSequence())
+    refuse(where + " is not a list");
+  if (expected_size != 0 && node.size() != expected_size)
+    refuse(where + " has " + std::to_string(node.size()) + " entries, expected " + std::to_string(expected_size));
+  std::vector<double> values;
+  for (std::size_t i = 0; i < node.size(); ++i)
+    values.push_back(readNumber(node[i], where + "[" + std::to_string(i) + "]"));
+  return values;
+}
+
+std::uint64_t readCount(const YAML::Node& node, const std::string& where)
+{
+  try
+  {
+    return node.as<std::uint64_t>();
+  }
+  catch (const YAML::Exception&)
+  {
+    refuse(where + " is not a whole number >= 0");
+  }
+}
+
+std::string systemError(const std::string& what, const std::string& path)
+{
+  return what + " " + path + ": " + std::strerror(errno);
+}
+}  // namespace
+
+std::string formatQTable(const QTable& table)
+{
+  const DiscretiserParams& d = table.discretiser();
+  std::ostringstream out;
+  out << "# Q-table of cartpole_qlearning. The checksum covers every number below: edit by hand and the\n"
+      << "# file will be refused.\n"
+      << "format: " << kFormatName << "\n"
+      << "version: " << kQTableFormatVersion << "\n"
+      << "# Discretisation: uniform bins per state dimension; values outside the bounds go to the end bins.\n"
+      << "dimensions: [x, x_dot, theta, theta_dot]\n"
+      << "bins: " << flowList(d.bins) << "\n"
+      << "lower_bounds: " << flowList(d.lower) << "\n"
+      << "upper_bounds: " << flowList(d.upper) << "\n"
+      << "# The effort [N] of each action: one column of values per action.\n"
+      << "actions: " << flowList(table.actions()) << "\n"
+      << "# Training that produced this table.\n"
+      << "episodes: " << table.episodes << "\n"
+      << "steps: " << table.steps << "\n"
+      << "states: " << table.stateCount() << "\n"
+      << "checksum: " << checksumOf(table) << "\n"
+      << "# One row per state: the bins combined in mixed radix, x most significant.\n"
+      << "values:\n";
+  for (std::size_t s = 0; s < table.stateCount(); ++s)
+  {
+    out << "  - [";
+    for (std::size_t a = 0; a < table.actionCount(); ++a)
+      out << (a ? ", " : "") << exact(table.at(s, a));
+    out << "]\n";
+  }
+  return out.str();
+}
+
+QTable parseQTable(const std::string& text)
+{
+  YAML::Node root;
+  try
+  {
+    root = YAML::Load(text);
+  }
+  catch (const YAML::Exception& e)
+  {
+    refuse(std::string("not valid YAML (corrupt or truncated): ") + e.what());
+  }
+  if (!root.IsMap())
+    refuse("not a Q-table file (expected a YAML mapping with 'format: " + std::string(kFormatName) + "')");
+  const YAML::Node format = required(root, "format");
+  if (!format.IsScalar() || format.Scalar() != kFormatName)
+    refuse("not a Q-table file (format is not '" + std::string(kFormatName) + "')");
+  const YAML::Node version = required(root, "version");
+  if (!version.IsScalar() || version.Scalar() != std::to_string(kQTableFormatVersion))
+    refuse("format version " + (version.IsScalar() ? version.Scalar() : std::string("?")) +
+           " is not supported (this build reads version " + std::to_string(kQTableFormatVersion) + ")");
+
+  DiscretiserParams discretiser;
+  const std::vector<double> bins = readNumbers(required(root, "bins"), "bins", kStateDimensions);
+  const std::vector<double> lower = readNumbers(required(root, "lower_bounds"), "lower_bounds", kStateDimensions);
+  const std::vector<double> upper = readNumbers(required(root, "upper_bounds"), "upper_bounds", kStateDimensions);
+  for (std::size_t i = 0; i < kStateDimensions; ++i)
+  {
+    if (bins[i] != std::floor(bins[i]) || bins[i] < 1)
+      refuse("bins[" + std::to_string(i) + "] is not a whole number >= 1");
+    discretiser.bins[i] = static_cast<unsigned>(bins[i]);
+    discretiser.lower[i] = lower[i];
+    discretiser.upper[i] = upper[i];
+  }
+  const std::string invalid = discretiser.validate();
+  if (!invalid.empty())
+    refuse("invalid discretisation: " + invalid);
+  const std::vector<double> actions = readNumbers(required(root, "actions"), "actions", 0);
+  if (actions.empty())
+    refuse("actions is empty");
+
+  QTable table(discretiser, actions);
+  table.episodes = readCount(required(root, "episodes"), "episodes");
+  table.steps = readCount(required(root, "steps"), "steps");
+  const std::uint64_t states = readCount(required(root, "states"), "states");
+  if (states != table.stateCount())
+    refuse("states is " + std::to_string(states) + " but the bins give " + std::to_string(table.stateCount()));
+
+  const YAML::Node rows = required(root, "values");
+  if (!rows.IsSequence())
+    refuse("values is not a list of rows");
+  if (rows.size() != table.stateCount())
+    refuse("values has " + std::to_string(rows.size()) + " rows, expected " + std::to_string(table.stateCount()) +
+           " (the file is truncated or its shape is wrong)");
+  std::vector<double> values;
+  values.reserve(table.stateCount() * table.actionCount());
+  for (std::size_t s = 0; s < rows.size(); ++s)
+  {
+    const std::vector<double> row = readNumbers(rows[s], "values row " + std::to_string(s), table.actionCount());
+    values.insert(values.end(), row.begin(), row.end());
+  }
+  table.setValues(std::move(values));
+
+  const YAML::Node checksum = required(root, "checksum");
+  const std::string expected = checksumOf(table);
+  if (!checksum.IsScalar() || checksum.Scalar() != expected)
+    refuse("checksum mismatch: the file says " + (checksum.IsScalar() ? checksum.Scalar() : std::string("?")) +
+           ", its contents give " + expected + " (the file is corrupt or was edited)");
+  return table;
+}
+
+void saveQTableFile(const QTable& table, const std::string& path)
+{
+  const std::string text = formatQTable(table);
+  const fs::path target(path);
+  std::error_code ec;
+  if (target.has_parent_path())
+  {
+    fs::create_directories(target.parent_path(), ec);
+    if (ec)
+      refuse("cannot create directory " + target.parent_path().string() + ": " + ec.message());
+  }
+  if (fs::is_directory(target, ec))
+    refuse("cannot save to " + path + ": it is a directory");
+
+  std::string temp = path + ".tmp.XXXXXX";
+  const int fd = ::mkstemp(&temp[0]);
+  if (fd < 0)
+    refuse(systemError("cannot create a temporary file beside", path));
+  std::size_t written = 0;
+  while (written < text.size())
+  {
+    const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
+    if (n < 0)
+    {
+      if (errno == EINTR)
+        continue;
+      const std::string error = systemError("cannot write", temp);
+      ::close(fd);
+      ::unlink(temp.c_str());
+      refuse(error);
+    }
+    written += static_cast<std::size_t>(n);
+  }
+  // The data must be on disk before the rename makes it the table; else a crash could leave an
+  // empty file under the final name.
+  if (::fsync(fd) != 0 || ::fchmod(fd, 0644) != 0)
+  {
+    const std::string error = systemError("cannot flush", temp);
+    ::close(fd);
+    ::unlink(temp.c_str());
+    refuse(error);
+  }
+  ::close(fd);
+  if (std::rename(temp.c_str(), path.c_str()) != 0)
+  {
+    const std::string error = systemError("cannot rename the temporary file to", path);
+    ::unlink(temp.c_str());
+    refuse(error);
+  }
+  // Make the rename itself durable.
+  const std::string directory = target.has_parent_path() ? target.parent_path().string() : ".";
+  const int dir_fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY);
+  if (dir_fd >= 0)
+  {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
+}
+
+QTable loadQTableFile(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    refuse(systemError("cannot open", path));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad())
+    refuse(systemError("cannot read", path));
+  try
+  {
+    return parseQTable(text.str());
+  }
+  catch (const QTableFileError& e)
+  {
+    refuse(path + ": " + e.what());
+  }
+}
+
+std::string resolvePathUnder(const std::string& directory, const std::string& path)
+{
+  if (path.empty())
+    refuse("the path is empty");
+  std::error_code ec;
+  const fs::path base = fs::weakly_canonical(fs::absolute(directory), ec);
+  if (ec)
+    refuse("cannot resolve directory " + directory + ": " + ec.message());
+  const fs::path given(path);
+  const fs::path resolved = fs::weakly_canonical(given.is_absolute() ? given : base / given, ec);
+  if (ec)
+    refuse("cannot resolve " + path + ": " + ec.message());
+  // Compare whole components: /data/qtables2 is not inside /data/qtables.
+  auto b = base.begin();
+  auto r = resolved.begin();
+  for (; b != base.end() && !b->empty(); ++b, ++r)
+  {
+    if (r == resolved.end() || *r != *b)
+      refuse(path + " is outside " + base.string() + " (refused: paths must stay inside that directory)");
+  }
+  if (r == resolved.end() || r->empty())
+    refuse(path + " names the directory " + base.string() + " itself, not a file in it");
+  return resolved.string();
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,159 @@
+// train_headless: trains with the core alone (no ROS master), prints progress and ends with
+// one line "solved=true|false episodes=N steps=M wall_s=T".
+#include "cartpole_qlearning/headless_trainer.h"
+#include "cartpole_qlearning/q_table_file.h"
+
+#include <ros/package.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+
+namespace
+{
+void usage(std::ostream& out)
+{
+  out << "usage: train_headless [--config FILE] [--seed N] [--save PATH] [--max-episodes N] [--quiet]\n"
+         "  --config FILE     physics, task, learning and training parameters (YAML);\n"
+         "                    default: the package's config/cartpole.yaml\n"
+         "  --seed N          seed of the start states and of exploration (default 0)\n"
+         "  --save PATH       write the final Q-table there (atomic)\n"
+         "  --max-episodes N  override training/max_episodes\n"
+         "  --quiet           no progress lines, only the result line\n";
+}
+
+bool parseCount(const std::string& text, std::uint64_t& value)
+{
+  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
+    return false;
+  try
+  {
+    value = std::stoull(text);
+  }
+  catch (const std::exception&)
+  {
+    return false;
+  }
+  return true;
+}
+
+std::string defaultConfigPath()
+{
+  const std::string share = ros::package::getPath("cartpole_qlearning");
+  return share.empty() ? std::string() : share + "/config/cartpole.yaml";
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  using namespace cartpole_qlearning;
+  std::string config_path;
+  std::string save_path;
+  std::uint64_t seed = 0;
+  std::uint64_t max_episodes = 0;
+  bool quiet = false;
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string arg = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (arg == "--help" || arg == "-h")
+    {
+      usage(std::cout);
+      return 0;
+    }
+    else if (arg == "--quiet")
+      quiet = true;
+    else if (arg == "--config" && has_value)
+      config_path = argv[++i];
+    else if (arg == "--save" && has_value)
+      save_path = argv[++i];
+    else if (arg == "--seed" && has_value)
+    {
+      if (!parseCount(argv[++i], seed))
+      {
+        std::cerr << "train_headless: --seed " << argv[i] << " is not allowed (must be a whole number >= 0)\n";
+        return 2;
+      }
+    }
+    else if (arg == "--max-episodes" && has_value)
+    {
+      if (!parseCount(argv[++i], max_episodes) || max_episodes == 0)
+      {
+        std::cerr << "train_headless: --max-episodes " << argv[i] << " is not allowed (must be a whole number >= 1)\n";
+        return 2;
+      }
+    }
+    else
+    {
+      std::cerr << "train_headless: unknown or incomplete argument '" << arg << "'\n";
+      usage(std::cerr);
+      return 2;
+    }
+  }
+
+  if (config_path.empty())
+  {
+    config_path = defaultConfigPath();
+    if (config_path.empty())
+    {
+      std::cerr << "train_headless: package cartpole_qlearning not found (source devel/setup.bash) "
+                   "and no --config given\n";
+      return 2;
+    }
+  }
+
+  TrainingConfig config;
+  try
+  {
+    const auto source = loadYamlParameters(config_path);
+    refuseUnknownSections(*source);
+    config = readTrainingConfig(*source);
+  }
+  catch (const ConfigError& e)
+  {
+    std::cerr << "train_headless: " << e.what() << "\n";
+    return 2;
+  }
+  if (max_episodes > 0)
+    config.limits.max_episodes = max_episodes;
+
+  HeadlessTrainer trainer(config, seed);
+  const auto start = std::chrono::steady_clock::now();
+  const std::uint64_t every = quiet ? 0 : config.limits.progress_every;
+  std::uint64_t last_steps = 0;
+  auto last_time = start;
+  const TrainingResult result = trainer.run([&](const EpisodeSummary& s) {
+    if (every == 0 || (s.episode % every != 0 && !(s.solved && config.limits.stop_when_solved)))
+      return;
+    const auto now = std::chrono::steady_clock::now();
+    const double interval = std::chrono::duration<double>(now - last_time).count();
+    const double rate = interval > 0.0 ? static_cast<double>(s.total_steps - last_steps) / interval : 0.0;
+    std::printf("episode %6llu  mean_return_%u %7.2f  epsilon %.3f  alpha %.3f  steps/s %9.0f  time %.2f s\n",
+                static_cast<unsigned long long>(s.episode), config.task.solved_window, s.mean_return_window, s.epsilon,
+                s.alpha, rate, std::chrono::duration<double>(now - start).count());
+    last_steps = s.total_steps;
+    last_time = now;
+  });
+
+  int status = 0;
+  if (!save_path.empty())
+  {
+    try
+    {
+      saveQTableFile(trainer.session().table(), save_path);
+      if (!quiet)
+        std::printf("saved the Q-table to %s\n", save_path.c_str());
+    }
+    catch (const QTableFileError& e)
+    {
+      std::cerr << "train_headless: " << e.what() << "\n";
+      status = 1;
+    }
+  }
+  std::printf("solved=%s episodes=%llu steps=%llu wall_s=%.3f\n", result.solved ? "true" : "false",
+              static_cast<unsigned long long>(result.episodes), static_cast<unsigned long long>(result.steps),
+              result.wall_s);
+  return status;
+}

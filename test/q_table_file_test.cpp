@@ -1,0 +1,290 @@
+#include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/training_session.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include <unistd.h>
+
+using namespace cartpole_qlearning;
+namespace fs = std::filesystem;
+
+namespace
+{
+class QTableFileTest : public ::testing::Test
+{
+protected:
+  void SetUp() override
+  {
+    dir_ = fs::temp_directory_path() / ("q_table_file_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override
+  {
+    fs::remove_all(dir_);
+  }
+
+  // A 72 x 2 table with values that are hard to print exactly.
+  static QTable awkwardTable()
+  {
+    QTable table(DiscretiserParams(), {-10.0, 10.0});
+    std::vector<double> values(table.values().size());
+    for (std::size_t i = 0; i < values.size(); ++i)
+      values[i] = (i % 2 ? -1.0 : 1.0) / (3.0 + static_cast<double>(i)) * std::pow(10.0, static_cast<int>(i % 7) - 3);
+    values[0] = std::numeric_limits<double>::denorm_min();
+    values[1] = std::numeric_limits<double>::max();
+    values[2] = -0.0;
+    values[3] = 0.1 + 0.2;
+    table.setValues(values);
+    table.episodes = 1234;
+    table.steps = 98765;
+    return table;
+  }
+
+  std::string path(const std::string& name) const
+  {
+    return (dir_ / name).string();
+  }
+
+  static std::string read(const std::string& file)
+  {
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+
+  static void write(const std::string& file, const std::string& text)
+  {
+    std::ofstream(file, std::ios::binary) << text;
+  }
+
+  // Loads into a training session's live table the way the controller does; returns the error.
+  static std::string loadInto(TrainingSession& session, const std::string& file)
+  {
+    try
+    {
+      return session.replaceTable(loadQTableFile(file));
+    }
+    catch (const QTableFileError& e)
+    {
+      return e.what();
+    }
+  }
+
+  fs::path dir_;
+};
+
+bool bitIdentical(const std::vector<double>& a, const std::vector<double>& b)
+{
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+}  // namespace
+
+TEST_F(QTableFileTest, RoundTripIsBitExact)
+{
+  const QTable table = awkwardTable();
+  saveQTableFile(table, path("table.yaml"));
+  const QTable loaded = loadQTableFile(path("table.yaml"));
+  EXPECT_TRUE(bitIdentical(table.values(), loaded.values()));
+  EXPECT_TRUE(std::signbit(loaded.values()[2]));
+  EXPECT_EQ("", table.shapeMismatch(loaded));
+  EXPECT_EQ(1234u, loaded.episodes);
+  EXPECT_EQ(98765u, loaded.steps);
+  // Saving what was loaded gives the same bytes.
+  saveQTableFile(loaded, path("again.yaml"));
+  EXPECT_EQ(read(path("table.yaml")), read(path("again.yaml")));
+}
+
+TEST_F(QTableFileTest, FileDescribesItself)
+{
+  saveQTableFile(awkwardTable(), path("table.yaml"));
+  const std::string text = read(path("table.yaml"));
+  for (const char* key : {"format: cartpole_qlearning/q_table", "version: 1", "bins: [1, 1, 6, 12]",
+                          "lower_bounds:", "upper_bounds:", "actions: [-10, 10]", "episodes: 1234", "steps: 98765",
+                          "states: 72", "checksum: fnv1a64:", "values:"})
+    EXPECT_NE(std::string::npos, text.find(key)) << key;
+}
+
+TEST_F(QTableFileTest, SaveIsAtomicAndLeavesNoTemporaryFile)
+{
+  saveQTableFile(QTable(DiscretiserParams(), {-10.0, 10.0}), path("t.yaml"));
+  saveQTableFile(awkwardTable(), path("t.yaml"));  // over an existing file
+  EXPECT_TRUE(bitIdentical(awkwardTable().values(), loadQTableFile(path("t.yaml")).values()));
+  std::size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(dir_))
+  {
+    ++files;
+    EXPECT_EQ("t.yaml", entry.path().filename().string());
+  }
+  EXPECT_EQ(1u, files);
+}
+
+TEST_F(QTableFileTest, SaveCreatesMissingDirectories)
+{
+  saveQTableFile(awkwardTable(), path("runs/seed0/q.yaml"));
+  EXPECT_TRUE(fs::exists(path("runs/seed0/q.yaml")));
+}
+
+TEST_F(QTableFileTest, FailedSaveKeepsTheOldFile)
+{
+  saveQTableFile(awkwardTable(), path("t.yaml"));
+  const std::string before = read(path("t.yaml"));
+  write(path("blocker"), "a file, not a directory");
+  EXPECT_THROW(saveQTableFile(awkwardTable(), path("blocker/t.yaml")), QTableFileError);
+  EXPECT_THROW(saveQTableFile(awkwardTable(), dir_.string()), QTableFileError);
+  EXPECT_EQ(before, read(path("t.yaml")));
+}
+
+TEST_F(QTableFileTest, TruncatedFilesAreRefusedAndTheLiveTableIsUntouched)
+{
+  TrainingSession session(TaskParams(), AgentParams(), 0);
+  saveQTableFile(awkwardTable(), path("good.yaml"));
+  ASSERT_EQ("", loadInto(session, path("good.yaml")));
+  const std::vector<double> live = session.table().values();
+  const std::string text = read(path("good.yaml"));
+  // Cut at many places, on and off line boundaries, including inside the last number.
+  for (std::size_t cut : {std::size_t(0), std::size_t(10), text.size() / 4, text.size() / 2, text.find("checksum"),
+                          text.find("values:") + 9, text.size() - 40, text.size() - 3})
+  {
+    write(path("cut.yaml"), text.substr(0, cut));
+    const std::string error = loadInto(session, path("cut.yaml"));
+    EXPECT_FALSE(error.empty()) << "a file cut at " << cut << " of " << text.size() << " bytes was accepted";
+    EXPECT_TRUE(bitIdentical(live, session.table().values()));
+  }
+}
+
+TEST_F(QTableFileTest, CorruptValuesAreCaughtByTheChecksum)
+{
+  TrainingSession session(TaskParams(), AgentParams(), 0);
+  const std::vector<double> live = session.table().values();
+  saveQTableFile(awkwardTable(), path("t.yaml"));
+  std::string text = read(path("t.yaml"));
+  // Change one digit of one value: still valid YAML, still a number. (Row 3 holds ordinary
+  // numbers; a digit deep in the denormal of row 0 would not change the double.)
+  std::size_t row = text.find("values:");
+  for (int i = 0; i <= 3; ++i)
+    row = text.find("  - [", row + 1);
+  const std::size_t digit = text.find_first_of("123456789", row + 8);
+  text[digit] = text[digit] == '1' ? '2' : '1';
+  write(path("t.yaml"), text);
+  const std::string error = loadInto(session, path("t.yaml"));
+  EXPECT_NE(std::string::npos, error.find("checksum")) << error;
+  EXPECT_TRUE(bitIdentical(live, session.table().values()));
+}
+
+TEST_F(QTableFileTest, GarbageAndOtherYamlAreRefused)
+{
+  write(path("garbage.yaml"), std::string("\x01\x02\xff{{[[: :", 11));
+  EXPECT_THROW(loadQTableFile(path("garbage.yaml")), QTableFileError);
+  write(path("other.yaml"), "physics:\n  gravity: 9.8\n");
+  try
+  {
+    loadQTableFile(path("other.yaml"));
+    FAIL() << "a config file was loaded as a Q-table";
+  }
+  catch (const QTableFileError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("not a Q-table")) << e.what();
+  }
+}
+
+TEST_F(QTableFileTest, WrongVersionIsRefusedWithTheVersion)
+{
+  saveQTableFile(awkwardTable(), path("t.yaml"));
+  std::string text = read(path("t.yaml"));
+  text.replace(text.find("version: 1"), 10, "version: 2");
+  write(path("t.yaml"), text);
+  try
+  {
+    loadQTableFile(path("t.yaml"));
+    FAIL() << "version 2 was accepted";
+  }
+  catch (const QTableFileError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("version 2 is not supported")) << e.what();
+  }
+}
+
+TEST_F(QTableFileTest, WrongShapeIsRefused)
+{
+  saveQTableFile(awkwardTable(), path("t.yaml"));
+  std::string text = read(path("t.yaml"));
+  std::string fewer_states = text;
+  fewer_states.replace(fewer_states.find("states: 72"), 10, "states: 71");
+  write(path("states.yaml"), fewer_states);
+  EXPECT_THROW(loadQTableFile(path("states.yaml")), QTableFileError);
+
+  std::string short_row = text;
+  const std::size_t row = short_row.find("  - [", short_row.find("values:"));
+  short_row.replace(row, short_row.find('\n', row) - row, "  - [0.5]");
+  write(path("row.yaml"), short_row);
+  try
+  {
+    loadQTableFile(path("row.yaml"));
+    FAIL() << "a row with one value was accepted";
+  }
+  catch (const QTableFileError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("values row 0 has 1 entries, expected 2")) << e.what();
+  }
+}
+
+TEST_F(QTableFileTest, ATableOfAnotherShapeIsRefusedByTheSessionAndTheLiveTableIsUntouched)
+{
+  TrainingSession session(TaskParams(), AgentParams(), 0);
+  const std::vector<double> live = session.table().values();
+  DiscretiserParams other;
+  other.bins = {{1, 1, 3, 6}};
+  saveQTableFile(QTable(other, {-10.0, 10.0}), path("other.yaml"));
+  const std::string error = loadInto(session, path("other.yaml"));
+  EXPECT_NE(std::string::npos, error.find("bins")) << error;
+  saveQTableFile(QTable(DiscretiserParams(), {-10.0, 0.0, 10.0}), path("actions.yaml"));
+  EXPECT_NE(std::string::npos, loadInto(session, path("actions.yaml")).find("actions"));
+  EXPECT_TRUE(bitIdentical(live, session.table().values()));
+}
+
+TEST_F(QTableFileTest, MissingFileIsRefusedWithItsPath)
+{
+  try
+  {
+    loadQTableFile(path("nope.yaml"));
+    FAIL();
+  }
+  catch (const QTableFileError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("nope.yaml")) << e.what();
+  }
+}
+
+TEST_F(QTableFileTest, RelativePathsResolveUnderTheDirectory)
+{
+  const std::string base = fs::weakly_canonical(dir_).string();
+  EXPECT_EQ(base + "/q.yaml", resolvePathUnder(dir_.string(), "q.yaml"));
+  EXPECT_EQ(base + "/runs/q.yaml", resolvePathUnder(dir_.string(), "runs/./x/../q.yaml"));
+  EXPECT_EQ(base + "/abs.yaml", resolvePathUnder(dir_.string(), base + "/abs.yaml"));
+}
+
+TEST_F(QTableFileTest, PathsEscapingTheDirectoryAreRefused)
+{
+  fs::create_directories(dir_ / "tables");
+  const std::string tables = (dir_ / "tables").string();
+  for (const std::string& escape : {std::string("../q.yaml"), std::string("a/../../q.yaml"), std::string("/etc/passwd"),
+                                    (dir_ / "tables2" / "q.yaml").string(), std::string(".."), std::string(".")})
+  {
+    EXPECT_THROW(resolvePathUnder(tables, escape), QTableFileError) << escape;
+  }
+  // Through a symbolic link that points outside.
+  fs::create_directory_symlink(dir_, dir_ / "tables" / "out");
+  EXPECT_THROW(resolvePathUnder(tables, "out/q.yaml"), QTableFileError);
+  EXPECT_THROW(resolvePathUnder(tables, ""), QTableFileError);
+  EXPECT_FALSE(fs::exists(dir_ / "q.yaml"));
+}
