@@ -1,5 +1,7 @@
 #include "cartpole_qlearning/random.h"
 
+#include <cmath>
+
 namespace cartpole_qlearning
 {
 namespace
@@ -28,6 +30,13 @@ double RandomStream::uniform01()
 double RandomStream::uniform(double low, double high)
 {
   return low + (high - low) * uniform01();
+}
+
+double RandomStream::normal()
+{
+  const double u1 = 1.0 - uniform01();  // in (0, 1], so the log is finite
+  const double u2 = uniform01();
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
 std::uint64_t RandomStream::uniformIndex(std::uint64_t n)

@@ -41,6 +41,14 @@ public:
   virtual std::string origin() const = 0;
 };
 
+// The value of a key, or fallback when it is absent (a wrong type still throws ConfigError).
+template <typename T>
+T valueOr(const ParameterSource& source, const std::string& key, T fallback)
+{
+  source.get(key, fallback);
+  return fallback;
+}
+
 // A YAML document as a parameter source. Throws ConfigError when the file cannot be read or parsed.
 std::unique_ptr<ParameterSource> loadYamlParameters(const std::string& path);
 std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin);

@@ -19,6 +19,8 @@ public:
   double uniform01();
   // Uniform in [low, high).
   double uniform(double low, double high);
+  // Standard normal (Box-Muller, two uniform draws per value).
+  double normal();
   // Uniform integer in [0, n), without modulo bias; n must be > 0.
   std::uint64_t uniformIndex(std::uint64_t n);
 
@@ -29,5 +31,8 @@ private:
 // The stream ids used by the simulator / headless environment and by the learning agent.
 constexpr std::uint64_t kEnvironmentStream = 0;
 constexpr std::uint64_t kAgentStream = 1;
+// Sensor and actuator noise of the simulator node: its own stream, so that adding noise does
+// not change the start states.
+constexpr std::uint64_t kNoiseStream = 2;
 
 }  // namespace cartpole_qlearning

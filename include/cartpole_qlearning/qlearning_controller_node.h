@@ -1,0 +1,110 @@
+// qlearning_controller: a tabular Q-learning controller on the ROS graph. Receives
+// joint_states, decides with the core's TrainingSession, commands cart_effort, ends episodes
+// by calling the sim's reset, publishes episode_stats, and saves or loads its Q-table.
+#pragma once
+
+#include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/LoadQTable.h"
+#include "cartpole_qlearning/SaveQTable.h"
+#include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/training_session.h"
+
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+namespace cartpole_qlearning
+{
+class QLearningControllerNode
+{
+public:
+  // nh: the instance's namespace (topics; physics, task, learning and training parameters);
+  // pnh: the node's private namespace (controller parameters and services). finished is called
+  // when training ends (solved or max_episodes); the node's main shuts ROS down there.
+  // Throws ConfigError naming a bad parameter, QTableFileError for a bad ~load_on_start file.
+  QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::function<void()> finished);
+  // Saves the table when ~save_on_shutdown (training), and stops the reset thread.
+  ~QLearningControllerNode();
+
+  QLearningControllerNode(const QLearningControllerNode&) = delete;
+  QLearningControllerNode& operator=(const QLearningControllerNode&) = delete;
+
+private:
+  void readParameters();
+  void onJointState(const sensor_msgs::JointStateConstPtr& msg);
+  bool onSave(SaveQTable::Request& request, SaveQTable::Response& response);
+  bool onLoad(LoadQTable::Request& request, LoadQTable::Response& response);
+  void onWatchdog(const ros::SteadyTimerEvent& event);
+
+  // The state in a message, or false (with a throttled warning) when it cannot be used.
+  bool extractState(const sensor_msgs::JointState& msg, CartPoleState& state) const;
+  void command(double effort);
+  void endEpisode(const ros::Time& stamp);
+  // Saves to a user path (empty: the default); returns the message for the log or service.
+  bool save(const std::string& path, std::string& message);
+  std::string resolve(const std::string& path) const;
+
+  // The reset call runs on a thread of its own: a blocking service call from this node's
+  // callback would never return if the sim's service ran on the same single thread (nodelets).
+  void requestReset();
+  void resetLoop();
+
+  ros::NodeHandle nh_;
+  ros::NodeHandle pnh_;
+  std::function<void()> finished_;
+
+  // Parameters
+  TrainingConfig config_;
+  bool learning_ = true;  // ~mode: train (true) or evaluate
+  std::uint64_t seed_ = 0;
+  std::string q_table_dir_;
+  std::string q_table_path_ = "q_table.yaml";
+  std::string load_on_start_;
+  std::uint64_t checkpoint_every_ = 100;
+  bool save_on_shutdown_ = true;
+  double sim_timeout_ = 2.0;  // [s] wall
+  std::string reset_service_ = "cartpole_sim/reset";
+
+  std::unique_ptr<TrainingSession> session_;
+
+  // Stamps: a repeated stamp is answered with the same effort and not learnt from again; after
+  // an episode ends, only a state newer than its last one (and than the reset request) starts
+  // the next.
+  ros::Time last_stamp_;
+  bool have_stamp_ = false;
+  double last_effort_ = 0.0;
+  bool awaiting_reset_ = false;
+  ros::Time reset_requested_at_;
+  bool finished_training_ = false;
+
+  // Wall-clock bookkeeping for steps/s and the sim watchdog.
+  std::chrono::steady_clock::time_point started_;
+  std::chrono::steady_clock::time_point last_episode_end_;
+  std::chrono::steady_clock::time_point last_state_at_;
+  std::uint64_t steps_at_last_progress_ = 0;
+  std::chrono::steady_clock::time_point last_progress_;
+  bool sim_silent_reported_ = false;
+
+  ros::Subscriber joint_state_sub_;
+  ros::Publisher effort_pub_;
+  ros::Publisher stats_pub_;
+  ros::ServiceServer save_srv_;
+  ros::ServiceServer load_srv_;
+  ros::ServiceClient reset_client_;
+  ros::SteadyTimer watchdog_;
+
+  std::mutex reset_mutex_;
+  std::condition_variable reset_wanted_;
+  bool reset_pending_ = false;
+  bool stopping_ = false;
+  std::thread reset_thread_;
+};
+
+}  // namespace cartpole_qlearning

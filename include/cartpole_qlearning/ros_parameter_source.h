@@ -1,0 +1,35 @@
+// The ROS parameter server as a ParameterSource, so the nodes read the physics, task and
+// learning keys with the same reader, defaults and checks as train_headless reads the YAML.
+#pragma once
+
+#include "cartpole_qlearning/config.h"
+
+#include <ros/node_handle.h>
+
+namespace cartpole_qlearning
+{
+class RosParameterSource : public ParameterSource
+{
+public:
+  // Keys are resolved relative to the node handle's namespace ("physics/tau" -> /cartpole/physics/tau).
+  explicit RosParameterSource(const ros::NodeHandle& nh) : nh_(nh)
+  {
+  }
+
+  bool get(const std::string& key, double& value) const override;
+  bool get(const std::string& key, std::int64_t& value) const override;
+  bool get(const std::string& key, bool& value) const override;
+  bool get(const std::string& key, std::string& value) const override;
+  bool get(const std::string& key, std::vector<double>& value) const override;
+  std::vector<std::string> keysUnder(const std::string& section) const override;
+  std::string origin() const override;
+
+private:
+  ros::NodeHandle nh_;
+};
+
+// Throws ConfigError "parameter /ns/node/name = value is not allowed (allowed)".
+[[noreturn]] void refuseParameter(const ros::NodeHandle& nh, const std::string& name, const std::string& value,
+                                  const std::string& allowed);
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,115 @@
+#include "cartpole_qlearning/ros_parameter_source.h"
+
+#include <xmlrpcpp/XmlRpcValue.h>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+using XmlRpc::XmlRpcValue;
+
+bool isNumber(XmlRpcValue& v)
+{
+  return v.getType() == XmlRpcValue::TypeDouble || v.getType() == XmlRpcValue::TypeInt;
+}
+
+double toDouble(XmlRpcValue& v)
+{
+  return v.getType() == XmlRpcValue::TypeInt ? static_cast<int>(v) : static_cast<double>(v);
+}
+
+void collect(XmlRpcValue& value, const std::string& prefix, std::vector<std::string>& keys)
+{
+  if (value.getType() != XmlRpcValue::TypeStruct)
+  {
+    keys.push_back(prefix);
+    return;
+  }
+  for (auto& entry : value)
+    collect(entry.second, prefix + "/" + entry.first, keys);
+}
+}  // namespace
+
+void refuseParameter(const ros::NodeHandle& nh, const std::string& name, const std::string& value,
+                     const std::string& allowed)
+{
+  throw ConfigError("parameter " + nh.resolveName(name) + " = " + value + " is not allowed (" + allowed + ")");
+}
+
+std::string RosParameterSource::origin() const
+{
+  return "parameter server (" + nh_.getNamespace() + ")";
+}
+
+bool RosParameterSource::get(const std::string& key, double& value) const
+{
+  XmlRpcValue v;
+  if (!nh_.getParam(key, v))
+    return false;
+  if (!isNumber(v))
+    throw ConfigError(origin() + ": " + key + " = '" + v.toXml() + "' is not allowed (must be a number)");
+  value = toDouble(v);
+  return true;
+}
+
+bool RosParameterSource::get(const std::string& key, std::int64_t& value) const
+{
+  XmlRpcValue v;
+  if (!nh_.getParam(key, v))
+    return false;
+  if (v.getType() != XmlRpcValue::TypeInt)
+    throw ConfigError(origin() + ": " + key + " = '" + v.toXml() + "' is not allowed (must be a whole number)");
+  value = static_cast<int>(v);
+  return true;
+}
+
+bool RosParameterSource::get(const std::string& key, bool& value) const
+{
+  XmlRpcValue v;
+  if (!nh_.getParam(key, v))
+    return false;
+  if (v.getType() != XmlRpcValue::TypeBoolean)
+    throw ConfigError(origin() + ": " + key + " = '" + v.toXml() + "' is not allowed (must be true or false)");
+  value = static_cast<bool>(v);
+  return true;
+}
+
+bool RosParameterSource::get(const std::string& key, std::string& value) const
+{
+  XmlRpcValue v;
+  if (!nh_.getParam(key, v))
+    return false;
+  if (v.getType() != XmlRpcValue::TypeString)
+    throw ConfigError(origin() + ": " + key + " = '" + v.toXml() + "' is not allowed (must be a string)");
+  value = static_cast<std::string>(v);
+  return true;
+}
+
+bool RosParameterSource::get(const std::string& key, std::vector<double>& value) const
+{
+  XmlRpcValue v;
+  if (!nh_.getParam(key, v))
+    return false;
+  if (v.getType() != XmlRpcValue::TypeArray)
+    throw ConfigError(origin() + ": " + key + " must be a list of numbers");
+  value.clear();
+  for (int i = 0; i < v.size(); ++i)
+  {
+    if (!isNumber(v[i]))
+      throw ConfigError(origin() + ": " + key + "[" + std::to_string(i) + "] = '" + v[i].toXml() +
+                        "' is not allowed (must be a number)");
+    value.push_back(toDouble(v[i]));
+  }
+  return true;
+}
+
+std::vector<std::string> RosParameterSource::keysUnder(const std::string& section) const
+{
+  std::vector<std::string> keys;
+  XmlRpcValue v;
+  if (nh_.getParam(section, v))
+    collect(v, section, keys);
+  return keys;
+}
+
+}  // namespace cartpole_qlearning
