@@ -206,8 +206,12 @@ void QLearningControllerNode::onJointState(const sensor_msgs::JointStateConstPtr
   }
   if (awaiting_reset_)
   {
-    if (stamp < reset_requested_at_)
-      return;  // realtime: a state the sim sent before it handled the reset
+    // In realtime the sim goes on stepping until it handles the reset; those states come after
+    // a fall and so are terminal themselves. (After a truncation one such state can still start
+    // the episode; in lockstep none comes, the sim waits for the reset.) The stamps cannot
+    // decide: the sim's are on its own clock, which need not be this node's.
+    if (session_->task().isTerminal(state))
+      return;
     awaiting_reset_ = false;
   }
   last_stamp_ = stamp;
@@ -352,7 +356,6 @@ void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
 void QLearningControllerNode::requestReset()
 {
   awaiting_reset_ = true;
-  reset_requested_at_ = ros::Time::now();
   {
     std::lock_guard<std::mutex> lock(reset_mutex_);
     reset_pending_ = true;

@@ -75,13 +75,11 @@ private:
   std::unique_ptr<TrainingSession> session_;
 
   // Stamps: a repeated stamp is answered with the same effort and not learnt from again; after
-  // an episode ends, only a state newer than its last one (and than the reset request) starts
-  // the next.
+  // an episode ends, only a newer state that is not terminal starts the next.
   ros::Time last_stamp_;
   bool have_stamp_ = false;
   double last_effort_ = 0.0;
   bool awaiting_reset_ = false;
-  ros::Time reset_requested_at_;
   bool finished_training_ = false;
 
   // Wall-clock bookkeeping for steps/s and the sim watchdog.

@@ -1,0 +1,244 @@
+// qlearning_controller's services and input checks: save/load round trip; missing, corrupt,
+// other-shape and escaping paths refused with the live table unchanged; bad joint_states
+// dropped; a silent sim reported.
+#include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/LoadQTable.h"
+#include "cartpole_qlearning/SaveQTable.h"
+#include "cartpole_qlearning/q_table_file.h"
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
+#include <sensor_msgs/JointState.h>
+#include <std_msgs/Float64.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using namespace cartpole_qlearning;
+
+namespace
+{
+template <typename Predicate>
+bool waitFor(Predicate predicate, double timeout_s)
+{
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
+  while (ros::ok() && ros::WallTime::now() < deadline)
+  {
+    ros::spinOnce();
+    if (predicate())
+      return true;
+    ros::WallDuration(0.005).sleep();
+  }
+  return predicate();
+}
+
+std::string root()
+{
+  std::string dir;
+  ros::param::get("~root", dir);
+  return dir;
+}
+
+std::string readFile(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+SaveQTable::Response save(const std::string& ns, const std::string& path)
+{
+  SaveQTable srv;
+  srv.request.path = path;
+  EXPECT_TRUE(ros::service::waitForService("/" + ns + "/qlearning_controller/save_q_table", ros::Duration(20)));
+  EXPECT_TRUE(ros::service::call("/" + ns + "/qlearning_controller/save_q_table", srv));
+  return srv.response;
+}
+
+LoadQTable::Response load(const std::string& ns, const std::string& path)
+{
+  LoadQTable srv;
+  srv.request.path = path;
+  EXPECT_TRUE(ros::service::waitForService("/" + ns + "/qlearning_controller/load_q_table", ros::Duration(20)));
+  EXPECT_TRUE(ros::service::call("/" + ns + "/qlearning_controller/load_q_table", srv));
+  return srv.response;
+}
+
+// Bad files in a controller's directory: missing (none), corrupt, of another shape.
+void writeBadFiles(const std::string& dir)
+{
+  fs::create_directories(dir);
+  std::ofstream(dir + "/corrupt.yaml") << "format: cartpole_qlearning/q_table\nversion: 1\nbins: [1, 1, 6, 12]\n"
+                                       << "values: {{{ not yaml";
+  DiscretiserParams other;
+  other.bins = { { 1, 1, 3, 6 } };
+  saveQTableFile(QTable(other, { -10.0, 10.0 }), dir + "/other_shape.yaml");
+  std::ofstream(fs::path(dir).parent_path() / "outside.yaml") << "placeholder";
+}
+
+void expectRefused(const LoadQTable::Response& response, const std::string& what)
+{
+  EXPECT_FALSE(response.success) << what;
+  EXPECT_NE(std::string::npos, response.message.find("unchanged")) << response.message;
+}
+}  // namespace
+
+TEST(ControllerServices, EvaluateSaveLoadRoundTripAndRefusalsKeepTheTable)
+{
+  const std::string dir = root() + "/eval";
+  writeBadFiles(dir);
+  // Greedy mode learns nothing, so the live table is observable through saves.
+  const SaveQTable::Response first = save("eval", "");
+  ASSERT_TRUE(first.success) << first.message;
+  EXPECT_NE(std::string::npos, first.message.find(dir + "/q_table.yaml")) << first.message;
+  const std::string before = readFile(dir + "/q_table.yaml");
+
+  expectRefused(load("eval", "missing.yaml"), "missing file");
+  expectRefused(load("eval", "corrupt.yaml"), "corrupt file");
+  const LoadQTable::Response shape = load("eval", "other_shape.yaml");
+  expectRefused(shape, "other shape");
+  EXPECT_NE(std::string::npos, shape.message.find("bins")) << shape.message;
+  const LoadQTable::Response escape = load("eval", "../outside.yaml");
+  expectRefused(escape, "escaping path");
+  EXPECT_NE(std::string::npos, escape.message.find("outside")) << escape.message;
+
+  ASSERT_TRUE(save("eval", "after_refusals.yaml").success);
+  EXPECT_EQ(before, readFile(dir + "/after_refusals.yaml"));
+
+  // A real table (trained offline, here: any valid table of the right shape) loads and is used.
+  QTable table(DiscretiserParams(), { -10.0, 10.0 });
+  std::vector<double> values(table.values().size());
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = std::sin(static_cast<double>(i)) / 3.0;
+  table.setValues(values);
+  table.episodes = 42;
+  saveQTableFile(table, dir + "/good.yaml");
+  const LoadQTable::Response loaded = load("eval", "good.yaml");
+  ASSERT_TRUE(loaded.success) << loaded.message;
+  EXPECT_NE(std::string::npos, loaded.message.find("42 episodes")) << loaded.message;
+  ASSERT_TRUE(save("eval", "sub/round_trip.yaml").success);
+  EXPECT_EQ(readFile(dir + "/good.yaml"), readFile(dir + "/sub/round_trip.yaml"));
+}
+
+TEST(ControllerServices, EscapingSavesAreRefusedAndWriteNothing)
+{
+  const std::string dir = root() + "/eval";
+  for (const std::string& path : { std::string("../escaped.yaml"), std::string("a/../../escaped.yaml"),
+                                   root() + "/escaped.yaml", std::string("/tmp/escaped_cartpole_q_table.yaml") })
+  {
+    const SaveQTable::Response response = save("eval", path);
+    EXPECT_FALSE(response.success) << path;
+    EXPECT_NE(std::string::npos, response.message.find("nothing written")) << response.message;
+  }
+  EXPECT_FALSE(fs::exists(root() + "/escaped.yaml"));
+  EXPECT_FALSE(fs::exists("/tmp/escaped_cartpole_q_table.yaml"));
+}
+
+TEST(ControllerServices, TrainingGoesOnThroughRefusedLoads)
+{
+  const std::string dir = root() + "/train";
+  writeBadFiles(dir);
+  ros::NodeHandle nh;
+  std::uint64_t episodes = 0;
+  ros::Subscriber sub = nh.subscribe<EpisodeStats>(
+      "/train/episode_stats", 100,
+      boost::function<void(const EpisodeStatsConstPtr&)>([&](const EpisodeStatsConstPtr& m) { episodes = m->episode; }));
+  ASSERT_TRUE(waitFor([&] { return episodes >= 5; }, 30.0)) << "training does not run";
+  ASSERT_TRUE(save("train", "before.yaml").success);
+  const QTable before = loadQTableFile(dir + "/before.yaml");
+
+  expectRefused(load("train", "missing.yaml"), "missing");
+  expectRefused(load("train", "corrupt.yaml"), "corrupt");
+  expectRefused(load("train", "other_shape.yaml"), "other shape");
+  expectRefused(load("train", "../outside.yaml"), "escape");
+
+  const std::uint64_t seen = episodes;
+  ASSERT_TRUE(waitFor([&] { return episodes >= seen + 5; }, 30.0)) << "training stopped after the refused loads";
+  ASSERT_TRUE(save("train", "after.yaml").success);
+  const QTable after = loadQTableFile(dir + "/after.yaml");
+  // Still the same table, trained further: same shape, counters grown from where they were.
+  EXPECT_EQ("", before.shapeMismatch(after));
+  EXPECT_GT(after.episodes, before.episodes);
+  EXPECT_GT(after.steps, before.steps);
+
+  // A valid load replaces the table and training goes on from its counters.
+  ASSERT_TRUE(load("train", "before.yaml").success);
+  ASSERT_TRUE(save("train", "reloaded.yaml").success);
+  const QTable reloaded = loadQTableFile(dir + "/reloaded.yaml");
+  EXPECT_GE(reloaded.episodes, before.episodes);
+  EXPECT_LT(reloaded.episodes, after.episodes + 1000);
+}
+
+TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
+{
+  ros::NodeHandle nh;
+  int commands = 0;
+  bool silent_reported = false;
+  bool back_reported = false;
+  ros::Subscriber effort = nh.subscribe<std_msgs::Float64>(
+      "/alone/cart_effort", 100,
+      boost::function<void(const std_msgs::Float64ConstPtr&)>([&](const std_msgs::Float64ConstPtr&) { ++commands; }));
+  ros::Subscriber log = nh.subscribe<rosgraph_msgs::Log>(
+      "/rosout", 1000, boost::function<void(const rosgraph_msgs::LogConstPtr&)>([&](const rosgraph_msgs::LogConstPtr& m) {
+        if (m->name != "/alone/qlearning_controller")
+          return;
+        silent_reported = silent_reported || m->msg.find("no joint_states") != std::string::npos;
+        back_reported = back_reported || m->msg.find("joint_states are back") != std::string::npos;
+      }));
+  ros::Publisher states = nh.advertise<sensor_msgs::JointState>("/alone/joint_states", 10);
+  ASSERT_TRUE(waitFor([&] { return states.getNumSubscribers() > 0 && effort.getNumPublishers() > 0; }, 20.0));
+
+  double stamp = 1.0;
+  const auto make = [&](std::vector<std::string> names, std::vector<double> position, std::vector<double> velocity) {
+    sensor_msgs::JointState msg;
+    msg.header.stamp = ros::Time(stamp += 0.02);
+    msg.name = std::move(names);
+    msg.position = std::move(position);
+    msg.velocity = std::move(velocity);
+    return msg;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<sensor_msgs::JointState> bad = {
+    make({ "cart_joint" }, { 0.0 }, { 0.0 }),                          // pole_joint missing
+    make({ "cart_joint", "other" }, { 0.0, 0.0 }, { 0.0, 0.0 }),       // pole_joint missing
+    make({ "cart_joint", "pole_joint" }, { 0.0 }, { 0.0, 0.0 }),       // lengths differ
+    make({ "cart_joint", "pole_joint" }, { 0.0, 0.0 }, {}),            // no velocities
+    make({ "cart_joint", "pole_joint" }, { nan, 0.0 }, { 0.0, 0.0 }),  // NaN
+    make({ "cart_joint", "pole_joint" }, { 0.0, 0.0 }, { 0.0, inf }),  // Inf
+  };
+  for (const auto& msg : bad)
+    states.publish(msg);
+  waitFor([] { return false; }, 1.0);
+  EXPECT_EQ(0, commands) << "a bad joint state was answered";
+  ASSERT_TRUE(save("alone", "after_bad.yaml").success);
+  const QTable table = loadQTableFile(root() + "/alone/after_bad.yaml");
+  EXPECT_EQ(0u, table.steps);
+  for (double v : table.values())
+    EXPECT_EQ(0.0, v);
+
+  // Joints found by name, in any order: a good state is answered.
+  states.publish(make({ "pole_joint", "cart_joint" }, { 0.01, 0.0 }, { 0.0, 0.0 }));
+  EXPECT_TRUE(waitFor([&] { return commands == 1; }, 10.0));
+
+  // No sim in this namespace: after sim_timeout (1 s) of silence the controller says so, once,
+  // and says so again when states come back.
+  ASSERT_TRUE(waitFor([&] { return silent_reported; }, 20.0)) << "no report of the silent sim";
+  states.publish(make({ "cart_joint", "pole_joint" }, { 0.0, 0.01 }, { 0.0, 0.0 }));
+  EXPECT_TRUE(waitFor([&] { return back_reported; }, 10.0));
+  EXPECT_TRUE(waitFor([&] { return commands == 2; }, 10.0));
+}
+
+int main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "controller_services_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,135 @@
+// train.launch's nodes, lockstep, seed 0: the controller solves CartPole-v1 over ROS topics,
+// writes the same table as train_headless, and a fresh greedy controller balances with it.
+#include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/q_table_file.h"
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using cartpole_qlearning::EpisodeStats;
+
+namespace
+{
+std::string readFile(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Spins until the predicate holds or the wall timeout passes.
+template <typename Predicate>
+bool waitFor(Predicate predicate, double timeout_s)
+{
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
+  while (ros::ok() && ros::WallTime::now() < deadline)
+  {
+    ros::spinOnce();
+    if (predicate())
+      return true;
+    ros::WallDuration(0.005).sleep();
+  }
+  return predicate();
+}
+
+std::string qTableDir()
+{
+  std::string dir;
+  ros::param::get("~q_table_dir", dir);
+  return dir;
+}
+}  // namespace
+
+class ControllerTrainTest : public ::testing::Test
+{
+protected:
+  static std::vector<EpisodeStats> stats_;
+  static ros::Subscriber sub_;
+
+  static void SetUpTestSuite()
+  {
+    ros::NodeHandle nh;
+    sub_ = nh.subscribe<EpisodeStats>(
+        "/cartpole/episode_stats", 1000,
+        boost::function<void(const cartpole_qlearning::EpisodeStatsConstPtr&)>(
+            [](const cartpole_qlearning::EpisodeStatsConstPtr& m) { stats_.push_back(*m); }));
+  }
+};
+std::vector<EpisodeStats> ControllerTrainTest::stats_;
+ros::Subscriber ControllerTrainTest::sub_;
+
+TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
+{
+  // 1. Training over ROS reaches solved (mean return of the last 100 >= 475).
+  ASSERT_TRUE(waitFor([] { return !stats_.empty() && stats_.back().solved; }, 200.0))
+      << "no solved episode; episodes seen: " << stats_.size();
+  const EpisodeStats& solved = stats_.back();
+  EXPECT_GE(solved.mean_return_100, 475.0);
+  EXPECT_GE(solved.episode, 100u);
+  // Episodes are numbered 1, 2, 3, ... and none was lost.
+  for (std::size_t i = 0; i < stats_.size(); ++i)
+    ASSERT_EQ(i + 1, stats_[i].episode);
+
+  // 2. The controller saved the table on solving, and it is train_headless's, byte for byte.
+  const std::string trained = qTableDir() + "/trained.yaml";
+  ASSERT_TRUE(waitFor([&] { return fs::exists(trained); }, 10.0)) << trained;
+  const cartpole_qlearning::QTable table = cartpole_qlearning::loadQTableFile(trained);
+  EXPECT_EQ(solved.episode, table.episodes);
+  EXPECT_EQ(solved.total_steps, table.steps);
+  const std::string headless = qTableDir() + "/headless.yaml";
+  const std::string command =
+      std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " + CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
+  ASSERT_EQ(0, std::system(command.c_str())) << command;
+  EXPECT_EQ(readFile(headless), readFile(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
+
+  // 3. A fresh controller in evaluate mode loads the table and balances a full 500-step episode.
+  const std::size_t before = stats_.size();
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0)
+  {
+    const std::string load = "_load_on_start:=trained.yaml";
+    const std::string dir = "_q_table_dir:=" + qTableDir();
+    ::execl(QLEARNING_CONTROLLER, QLEARNING_CONTROLLER, "__ns:=/cartpole", "__name:=evaluator", "_mode:=evaluate",
+            load.c_str(), dir.c_str(), "_save_on_shutdown:=false", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const bool balanced = waitFor(
+      [&] {
+        for (std::size_t i = before; i < stats_.size(); ++i)
+        {
+          if (stats_[i].steps == 500 && stats_[i].truncated && !stats_[i].terminated)
+            return true;
+        }
+        return false;
+      },
+      60.0);
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(balanced) << "the evaluator ran " << stats_.size() - before << " episodes, none of 500 steps";
+  for (std::size_t i = before; i < stats_.size(); ++i)
+    EXPECT_EQ(0.0, stats_[i].epsilon) << "evaluation must be greedy";
+}
+
+int main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "controller_train_test");
+  ros::NodeHandle nh;
+  fs::remove_all(qTableDir());
+  return RUN_ALL_TESTS();
+}
