@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Sets everything up (scripts/setup.sh) and trains: arguments go to train_headless
-# (e.g. --seed 3 --save q_table.yaml).
+# Sets everything up (scripts/setup.sh) and trains over ROS: roslaunch train.launch (sim and
+# controller in lockstep) until solved. Arguments go to roslaunch, e.g. seed:=3 or
+# stop_when_solved:=false. The table is saved to ~/.ros/cartpole_qlearning/q_table.yaml.
 set -eo pipefail
 # shellcheck disable=SC1091
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
-exec rosrun cartpole_qlearning train_headless "$@"
+exec roslaunch cartpole_qlearning train.launch "$@"

@@ -190,8 +190,11 @@ void QLearningControllerNode::onJointState(const sensor_msgs::JointStateConstPtr
   if (have_stamp_ && stamp == last_stamp_)
   {
     // The sim sent this state again (our answer or its state was lost): the same answer,
-    // learnt from once. After the episode's end there is nothing to answer.
-    if (!awaiting_reset_)
+    // learnt from once. After the episode's end it means the reset has not happened yet
+    // (lockstep repeats only after ~lockstep_timeout): ask again.
+    if (awaiting_reset_)
+      requestReset();
+    else
       command(last_effort_);
     return;
   }
@@ -373,6 +376,9 @@ void QLearningControllerNode::resetLoop()
       reset_wanted_.wait(lock, [this] { return reset_pending_ || stopping_; });
       if (stopping_)
         return;
+      // Taken before the call: a request made while the call is under way (a short episode
+      // can end before this thread sees the answer) is then served by the next call, not lost.
+      reset_pending_ = false;
     }
     Reset reset;  // empty state: a random start
     if (reset_client_.call(reset) && reset.response.success)
@@ -380,8 +386,6 @@ void QLearningControllerNode::resetLoop()
       if (failing)
         ROS_INFO("qlearning_controller: %s answers again; going on", reset_client_.getService().c_str());
       failing = false;
-      std::lock_guard<std::mutex> lock(reset_mutex_);
-      reset_pending_ = false;
       continue;
     }
     if (!failing)
@@ -390,6 +394,7 @@ void QLearningControllerNode::resetLoop()
                reset.response.message.empty() ? "" : (": " + reset.response.message).c_str());
     failing = true;
     std::unique_lock<std::mutex> lock(reset_mutex_);
+    reset_pending_ = true;
     reset_wanted_.wait_for(lock, std::chrono::milliseconds(200), [this] { return stopping_; });
     if (stopping_)
       return;
