@@ -20,8 +20,8 @@ DEBIAN_PACKAGES=(
   build-essential cmake pkg-config
   catkin ros-core-dev ros-message-generation python3-rostest librostest-dev
   rosbash python3-roslaunch python3-rostopic python3-rosservice python3-rosnode
-  libroscpp-dev libroslib-dev libsensor-msgs-dev libstd-msgs-dev libstd-srvs-dev libgeometry-msgs-dev
-  libros-rosgraph-msgs-dev libtf2-ros-dev libnodeletlib-dev libeigen3-dev libyaml-cpp-dev
+  libroscpp-dev libroslib-dev libsensor-msgs-dev libstd-msgs-dev libgeometry-msgs-dev
+  libros-rosgraph-msgs-dev libtf2-ros-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev libeigen3-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev catkin-lint
 )
 
