@@ -37,7 +37,16 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
   joint_state_.velocity.assign(2, 0.0);
   joint_state_.effort.assign(2, 0.0);
 
-  joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
+  // Lockstep: a state published before a subscriber connected never reached it. A subscriber
+  // that connects while a state waits for its answer gets that state, and only it: the others
+  // have it already, and a controller that got it twice might answer twice.
+  joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>(
+      "joint_states", 10, [this](const ros::SingleSubscriberPublisher& pub) {
+        if (mode_ != Mode::Lockstep)
+          return;
+        pub.publish(joint_state_);
+        state_heard_ = true;
+      });
   if (mode_ == Mode::Lockstep)
     clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
@@ -49,8 +58,8 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
   if (mode_ == Mode::Lockstep)
   {
     sim_time_ = ros::Time(0) + ros::Duration(physics_.tau);
-    timer_ = nh_.createSteadyTimer(ros::WallDuration(lockstep_timeout_), &CartPoleSimNode::onLockstepTimeout, this);
-    awaiting_command_ = true;
+    timer_ =
+        nh_.createSteadyTimer(ros::WallDuration(lockstep_timeout_ / 2), &CartPoleSimNode::onLockstepTimeout, this);
   }
   else
   {
@@ -138,10 +147,11 @@ void CartPoleSimNode::onEffort(const std_msgs::Float64ConstPtr& msg)
     have_command_ = true;
     return;
   }
-  if (!awaiting_command_)
+  if (!state_heard_)
   {
-    // A second answer to a state that was already answered (e.g. after a republish).
-    ROS_DEBUG_THROTTLE(1.0, "cartpole_sim: ignored a command that answers no pending state");
+    // Nobody was subscribed when the pending state went out, so this command answers an older
+    // state (e.g. from a controller that outlived a restart of this node).
+    ROS_DEBUG_THROTTLE(1.0, "cartpole_sim: ignored a command sent before anyone received the pending state");
     return;
   }
   advance(effort);
@@ -167,12 +177,20 @@ void CartPoleSimNode::onRealtimeTick(const ros::SteadyTimerEvent&)
 
 void CartPoleSimNode::onLockstepTimeout(const ros::SteadyTimerEvent&)
 {
-  if (!awaiting_command_ || std::chrono::steady_clock::now() - published_at_ < seconds(lockstep_timeout_))
+  if (std::chrono::steady_clock::now() - published_at_ < seconds(lockstep_timeout_))
     return;
+  // Late by one tick more: after this process was stalled (a loaded machine), an answer may sit
+  // in the queue behind this timer event; it gets its turn before the next tick. Repeating now
+  // would draw a second answer, which the next state would take for its own.
+  if (!repeat_armed_)
+  {
+    repeat_armed_ = true;
+    return;
+  }
   // Unanswered: the state or its answer was lost (a late or restarted controller). Send the
   // same state with the same stamp again; the controller answers it without learning twice.
   ROS_DEBUG("cartpole_sim: no command for %.3f s, publishing the state again", lockstep_timeout_);
-  publishState();
+  publishState(true);
 }
 
 bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response)
@@ -204,10 +222,7 @@ bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response
   // A reset takes one tick of sim time, so the new start state never shares a stamp with the
   // state before it and time never goes backwards.
   if (mode_ == Mode::Lockstep)
-  {
     sim_time_ += ros::Duration(physics_.tau);
-    awaiting_command_ = true;
-  }
   const CartPoleState& s = simulation_->state();
   publishState();
   std::ostringstream out;
@@ -218,7 +233,7 @@ bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response
   return true;
 }
 
-void CartPoleSimNode::publishState()
+void CartPoleSimNode::publishState(bool repeat)
 {
   const auto wall_now = std::chrono::steady_clock::now();
   const ros::Time stamp = mode_ == Mode::Lockstep ? sim_time_ : ros::Time::now();
@@ -248,9 +263,13 @@ void CartPoleSimNode::publishState()
   joint_state_.effort[0] = simulation_->appliedForce();
   joint_state_.effort[1] = 0.0;  // the pole joint is not actuated
   published_at_ = wall_now;
+  repeat_armed_ = false;
+  state_heard_ = state_heard_ && repeat;  // a new state is heard only if someone receives it
+  if (joint_state_pub_.getNumSubscribers() > 0)
+    state_heard_ = true;
   joint_state_pub_.publish(joint_state_);
 
-  if (!publish_tf_)
+  if (!publish_tf_ || repeat)  // tf2 refuses a second transform with the same stamp
     return;
   if (mode_ == Mode::Lockstep && wall_now - last_tf_ < seconds(1.0 / tf_rate_))
     return;

@@ -59,11 +59,21 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   }
 
   started_ = last_episode_end_ = last_state_at_ = last_progress_ = std::chrono::steady_clock::now();
-  effort_pub_ = nh_.advertise<std_msgs::Float64>("cart_effort", 10);
+  // A subscriber that connects while a state waits for the sim to take our answer (the sim
+  // started or restarted its subscription after we answered) gets that answer, and only it.
+  effort_pub_ = nh_.advertise<std_msgs::Float64>("cart_effort", 10, [this](const ros::SingleSubscriberPublisher& pub) {
+    if (!have_stamp_ || awaiting_reset_ || !session_->inEpisode())
+      return;
+    std_msgs::Float64 msg;
+    msg.data = last_effort_;
+    pub.publish(msg);
+    answer_unheard_ = false;
+  });
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
   save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
   load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
-  reset_client_ = nh_.serviceClient<Reset>(reset_service_);
+  // Persistent: a new connection per episode would cost a master lookup and a TCP set-up.
+  reset_client_ = nh_.serviceClient<Reset>(reset_service_, true);
   reset_thread_ = std::thread(&QLearningControllerNode::resetLoop, this);
   watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, sim_timeout_ / 2.0)),
                                     &QLearningControllerNode::onWatchdog, this);
@@ -169,6 +179,7 @@ bool QLearningControllerNode::extractState(const sensor_msgs::JointState& msg, C
 void QLearningControllerNode::command(double effort)
 {
   last_effort_ = effort;
+  answer_unheard_ = effort_pub_.getNumSubscribers() == 0;
   std_msgs::Float64 msg;
   msg.data = effort;
   effort_pub_.publish(msg);
@@ -189,12 +200,12 @@ void QLearningControllerNode::onJointState(const sensor_msgs::JointStateConstPtr
   const ros::Time stamp = msg->header.stamp;
   if (have_stamp_ && stamp == last_stamp_)
   {
-    // The sim sent this state again (our answer or its state was lost): the same answer,
-    // learnt from once. After the episode's end it means the reset has not happened yet
-    // (lockstep repeats only after ~lockstep_timeout): ask again.
-    if (awaiting_reset_)
-      requestReset();
-    else
+    // The sim sent this state again (lockstep, no answer within its timeout). Answer again, the
+    // same effort and without learning twice, only if the first answer went out with nobody
+    // subscribed to cart_effort. Otherwise it is on its way (a slow answer, a stalled sim): a
+    // second one would be taken by the sim for its next state, and every action after it would
+    // land one state late. After the episode's end there is nothing to answer.
+    if (!awaiting_reset_ && answer_unheard_)
       command(last_effort_);
     return;
   }
@@ -393,6 +404,8 @@ void QLearningControllerNode::resetLoop()
                reset_client_.getService().c_str(),
                reset.response.message.empty() ? "" : (": " + reset.response.message).c_str());
     failing = true;
+    if (!reset_client_.isValid())  // the persistent connection broke (sim restarted): reconnect
+      reset_client_ = nh_.serviceClient<Reset>(reset_service_, true);
     std::unique_lock<std::mutex> lock(reset_mutex_);
     reset_pending_ = true;
     reset_wanted_.wait_for(lock, std::chrono::milliseconds(200), [this] { return stopping_; });

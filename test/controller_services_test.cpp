@@ -240,5 +240,7 @@ int main(int argc, char** argv)
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "controller_services_test");
   ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
+  const int result = RUN_ALL_TESTS();
+  fs::remove_all(root());
+  return result;
 }

@@ -130,6 +130,7 @@ int main(int argc, char** argv)
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "controller_train_test");
   ros::NodeHandle nh;
+  const int result = RUN_ALL_TESTS();
   fs::remove_all(qTableDir());
-  return RUN_ALL_TESTS();
+  return result;
 }

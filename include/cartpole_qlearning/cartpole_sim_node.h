@@ -39,8 +39,9 @@ private:
 
   // Steps with the force (after validation), advances the clock and publishes.
   void advance(double effort);
-  // Publishes /clock (lockstep), joint_states and, at most at tf_rate in lockstep, TF.
-  void publishState();
+  // Publishes /clock (lockstep), joint_states and, at most at tf_rate in lockstep, TF. A repeat
+  // (the same state and stamp again) sends no TF.
+  void publishState(bool repeat = false);
   // A valid effort, clamped; false (with a throttled warning) for NaN or Inf.
   bool acceptEffort(double requested, double& effort) const;
 
@@ -73,9 +74,10 @@ private:
   std::chrono::steady_clock::time_point held_since_;
   bool have_command_ = false;
 
-  // Lockstep: the published state awaits its answer since this wall time.
-  bool awaiting_command_ = false;
+  // Lockstep: the last published state always awaits its answer, since this wall time.
   std::chrono::steady_clock::time_point published_at_;
+  bool repeat_armed_ = false;  // a timer tick already found the state unanswered past the timeout
+  bool state_heard_ = false;   // the pending state reached at least one subscriber
   std::chrono::steady_clock::time_point last_tf_;
   sensor_msgs::JointState joint_state_;
 

@@ -74,11 +74,12 @@ private:
 
   std::unique_ptr<TrainingSession> session_;
 
-  // Stamps: a repeated stamp is answered with the same effort and not learnt from again; after
-  // an episode ends, only a newer state that is not terminal starts the next.
+  // Stamps: a repeated stamp is not learnt from again, and answered again only when the first
+  // answer was lost; after an episode ends, only a newer state that is not terminal starts the next.
   ros::Time last_stamp_;
   bool have_stamp_ = false;
   double last_effort_ = 0.0;
+  bool answer_unheard_ = false;  // the last answer went out while nobody subscribed to cart_effort
   bool awaiting_reset_ = false;
   bool finished_training_ = false;
 
@@ -95,7 +96,7 @@ private:
   ros::Publisher stats_pub_;
   ros::ServiceServer save_srv_;
   ros::ServiceServer load_srv_;
-  ros::ServiceClient reset_client_;
+  ros::ServiceClient reset_client_;  // used by the reset thread only
   ros::SteadyTimer watchdog_;
 
   std::mutex reset_mutex_;
