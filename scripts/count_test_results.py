@@ -3,6 +3,10 @@
 prints each failure, then one line "N passed, N failed, N skipped". Exit status 1 when any
 failed or none ran.
 
+Each rostest .test file adds one case of its own (rostest-test_*.xml: its fixture nodes launched
+and its test node ran) beside the cases of its test node (rosunit-*.xml); both are counted, so
+a fixture that fails to launch counts as a failure even when no test case could run.
+
 catkin_test_results is not used for the totals: with googletest 1.12's XML (Debian 12) it
 adds the <testsuites> totals to those of each <testsuite> and so counts every test twice.
 """

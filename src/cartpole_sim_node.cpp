@@ -32,7 +32,7 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
   simulation_ = std::make_unique<CartPoleSimulation>(physics_, start_state_bound_, seed_);
   noise_ = std::make_unique<RandomStream>(seed_, kNoiseStream);
 
-  joint_state_.name = { "cart_joint", "pole_joint" };
+  joint_state_.name = {"cart_joint", "pole_joint"};
   joint_state_.position.assign(2, 0.0);
   joint_state_.velocity.assign(2, 0.0);
   joint_state_.effort.assign(2, 0.0);
@@ -40,8 +40,8 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
   // Lockstep: a state published before a subscriber connected never reached it. A subscriber
   // that connects while a state waits for its answer gets that state, and only it: the others
   // have it already, and a controller that got it twice might answer twice.
-  joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>(
-      "joint_states", 10, [this](const ros::SingleSubscriberPublisher& pub) {
+  joint_state_pub_ =
+      nh_.advertise<sensor_msgs::JointState>("joint_states", 10, [this](const ros::SingleSubscriberPublisher& pub) {
         if (mode_ != Mode::Lockstep)
           return;
         pub.publish(joint_state_);
@@ -58,8 +58,7 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
   if (mode_ == Mode::Lockstep)
   {
     sim_time_ = ros::Time(0) + ros::Duration(physics_.tau);
-    timer_ =
-        nh_.createSteadyTimer(ros::WallDuration(lockstep_timeout_ / 2), &CartPoleSimNode::onLockstepTimeout, this);
+    timer_ = nh_.createSteadyTimer(ros::WallDuration(lockstep_timeout_ / 2), &CartPoleSimNode::onLockstepTimeout, this);
   }
   else
   {
@@ -106,7 +105,8 @@ void CartPoleSimNode::readParameters()
   effort_limit_ = physics_.force_mag;
   positive("effort_limit", effort_limit_);
   if (effort_limit_ > physics_.force_mag)
-    refuseParameter(pnh_, "effort_limit", text(effort_limit_), "must be <= physics/force_mag = " + text(physics_.force_mag));
+    refuseParameter(pnh_, "effort_limit", text(effort_limit_),
+                    "must be <= physics/force_mag = " + text(physics_.force_mag));
   non_negative("position_noise_std", position_noise_std_);
   non_negative("velocity_noise_std", velocity_noise_std_);
   non_negative("effort_noise_std", effort_noise_std_);
@@ -114,7 +114,7 @@ void CartPoleSimNode::readParameters()
   world_frame_ = valueOr(priv, "world_frame", world_frame_);
   cart_frame_ = valueOr(priv, "cart_frame", cart_frame_);
   pole_frame_ = valueOr(priv, "pole_frame", pole_frame_);
-  for (const std::string* frame : { &world_frame_, &cart_frame_, &pole_frame_ })
+  for (const std::string* frame : {&world_frame_, &cart_frame_, &pole_frame_})
   {
     if (frame->empty())
       refuseParameter(pnh_, "world_frame/cart_frame/pole_frame", "''", "frame names must not be empty");
@@ -125,13 +125,13 @@ bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
 {
   if (!std::isfinite(requested))
   {
-    ROS_WARN_THROTTLE(1.0, "cartpole_sim: refused a non-finite effort (%f) on %s", requested,
-                      effort_sub_.getTopic().c_str());
+    if (nonfinite_warning_.ready())
+      ROS_WARN("cartpole_sim: refused a non-finite effort (%f) on %s", requested, effort_sub_.getTopic().c_str());
     return false;
   }
   effort = std::clamp(requested, -effort_limit_, effort_limit_);
-  if (effort != requested)
-    ROS_WARN_THROTTLE(1.0, "cartpole_sim: effort %g N clamped to the limit of %g N", requested, effort_limit_);
+  if (effort != requested && clamp_warning_.ready())
+    ROS_WARN("cartpole_sim: effort %g N clamped to the limit of %g N", requested, effort_limit_);
   return true;
 }
 
@@ -151,7 +151,7 @@ void CartPoleSimNode::onEffort(const std_msgs::Float64ConstPtr& msg)
   {
     // Nobody was subscribed when the pending state went out, so this command answers an older
     // state (e.g. from a controller that outlived a restart of this node).
-    ROS_DEBUG_THROTTLE(1.0, "cartpole_sim: ignored a command sent before anyone received the pending state");
+    ROS_DEBUG("cartpole_sim: ignored a command sent before anyone received the pending state");
     return;
   }
   advance(effort);
@@ -170,8 +170,7 @@ void CartPoleSimNode::advance(double effort)
 
 void CartPoleSimNode::onRealtimeTick(const ros::SteadyTimerEvent&)
 {
-  const bool fresh =
-      have_command_ && std::chrono::steady_clock::now() - held_since_ <= seconds(command_timeout_);
+  const bool fresh = have_command_ && std::chrono::steady_clock::now() - held_since_ <= seconds(command_timeout_);
   advance(fresh ? held_effort_ : 0.0);
 }
 
@@ -236,35 +235,38 @@ bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response
 void CartPoleSimNode::publishState(bool repeat)
 {
   const auto wall_now = std::chrono::steady_clock::now();
-  const ros::Time stamp = mode_ == Mode::Lockstep ? sim_time_ : ros::Time::now();
+  if (!repeat)
+  {
+    // A repeat sends this same message again: same stamp, same values, no new noise draws.
+    const CartPoleState& s = simulation_->state();
+    joint_state_.header.stamp = mode_ == Mode::Lockstep ? sim_time_ : ros::Time::now();
+    joint_state_.position[0] = s[0];
+    joint_state_.position[1] = s[2];
+    joint_state_.velocity[0] = s[1];
+    joint_state_.velocity[1] = s[3];
+    if (position_noise_std_ > 0.0)
+    {
+      joint_state_.position[0] += position_noise_std_ * noise_->normal();
+      joint_state_.position[1] += position_noise_std_ * noise_->normal();
+    }
+    if (velocity_noise_std_ > 0.0)
+    {
+      joint_state_.velocity[0] += velocity_noise_std_ * noise_->normal();
+      joint_state_.velocity[1] += velocity_noise_std_ * noise_->normal();
+    }
+    joint_state_.effort[0] = simulation_->appliedForce();
+    joint_state_.effort[1] = 0.0;  // the pole joint is not actuated
+    state_heard_ = false;
+  }
+  const ros::Time stamp = joint_state_.header.stamp;
   if (mode_ == Mode::Lockstep)
   {
     rosgraph_msgs::Clock clock;
     clock.clock = stamp;
     clock_pub_.publish(clock);
   }
-
-  const CartPoleState& s = simulation_->state();
-  joint_state_.header.stamp = stamp;
-  joint_state_.position[0] = s[0];
-  joint_state_.position[1] = s[2];
-  joint_state_.velocity[0] = s[1];
-  joint_state_.velocity[1] = s[3];
-  if (position_noise_std_ > 0.0)
-  {
-    joint_state_.position[0] += position_noise_std_ * noise_->normal();
-    joint_state_.position[1] += position_noise_std_ * noise_->normal();
-  }
-  if (velocity_noise_std_ > 0.0)
-  {
-    joint_state_.velocity[0] += velocity_noise_std_ * noise_->normal();
-    joint_state_.velocity[1] += velocity_noise_std_ * noise_->normal();
-  }
-  joint_state_.effort[0] = simulation_->appliedForce();
-  joint_state_.effort[1] = 0.0;  // the pole joint is not actuated
   published_at_ = wall_now;
   repeat_armed_ = false;
-  state_heard_ = state_heard_ && repeat;  // a new state is heard only if someone receives it
   if (joint_state_pub_.getNumSubscribers() > 0)
     state_heard_ = true;
   joint_state_pub_.publish(joint_state_);
@@ -274,6 +276,7 @@ void CartPoleSimNode::publishState(bool repeat)
   if (mode_ == Mode::Lockstep && wall_now - last_tf_ < seconds(1.0 / tf_rate_))
     return;
   last_tf_ = wall_now;
+  const CartPoleState& s = simulation_->state();
   geometry_msgs::TransformStamped cart;
   cart.header.stamp = stamp;
   cart.header.frame_id = world_frame_;
@@ -287,7 +290,7 @@ void CartPoleSimNode::publishState(bool repeat)
   // theta about +y: positive theta tips the pole's top toward +x.
   pole.transform.rotation.y = std::sin(s[2] / 2.0);
   pole.transform.rotation.w = std::cos(s[2] / 2.0);
-  tf_broadcaster_.sendTransform({ cart, pole });
+  tf_broadcaster_.sendTransform({cart, pole});
 }
 
 }  // namespace cartpole_qlearning

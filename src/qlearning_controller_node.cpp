@@ -45,10 +45,18 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   session_ = std::make_unique<TrainingSession>(config_.task, config_.agent, seed_, learning_);
   if (!load_on_start_.empty())
   {
-    const std::string path = resolve(load_on_start_);
-    const std::string mismatch = session_->replaceTable(loadQTableFile(path));
-    if (!mismatch.empty())
-      throw QTableFileError(path + " does not fit this controller: " + mismatch);
+    std::string path;
+    try
+    {
+      path = resolve(load_on_start_);
+      const std::string mismatch = session_->replaceTable(loadQTableFile(path));
+      if (!mismatch.empty())
+        throw QTableFileError(path + " does not fit this controller: " + mismatch);
+    }
+    catch (const QTableFileError& e)
+    {
+      refuseParameter(pnh_, "load_on_start", "'" + load_on_start_ + "'", e.what());
+    }
     ROS_INFO("qlearning_controller: loaded %s (%llu episodes, %llu steps of training)", path.c_str(),
              static_cast<unsigned long long>(session_->table().episodes),
              static_cast<unsigned long long>(session_->table().steps));
@@ -59,10 +67,12 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   }
 
   started_ = last_episode_end_ = last_state_at_ = last_progress_ = std::chrono::steady_clock::now();
-  // A subscriber that connects while a state waits for the sim to take our answer (the sim
-  // started or restarted its subscription after we answered) gets that answer, and only it.
+  // The first subscriber to connect after an answer that reached nobody (the sim subscribed
+  // after we answered) gets that answer, and only it. roscpp runs this callback some time after
+  // the connection is made, and answers published meanwhile have reached the subscriber: hence
+  // only an answer that went out with no subscriber at all is sent again, never a second copy.
   effort_pub_ = nh_.advertise<std_msgs::Float64>("cart_effort", 10, [this](const ros::SingleSubscriberPublisher& pub) {
-    if (!have_stamp_ || awaiting_reset_ || !session_->inEpisode())
+    if (!answer_unheard_ || !have_stamp_ || awaiting_reset_ || !session_->inEpisode())
       return;
     std_msgs::Float64 msg;
     msg.data = last_effort_;
@@ -157,20 +167,22 @@ bool QLearningControllerNode::extractState(const sensor_msgs::JointState& msg, C
   const int pole = jointIndex(msg, "pole_joint");
   if (cart < 0 || pole < 0)
   {
-    ROS_WARN_THROTTLE(1.0, "qlearning_controller: dropped joint_states without %s", cart < 0 ? "cart_joint" : "pole_joint");
+    if (bad_state_warning_.ready())
+      ROS_WARN("qlearning_controller: dropped joint_states without %s", cart < 0 ? "cart_joint" : "pole_joint");
     return false;
   }
   if (msg.position.size() != msg.name.size() || msg.velocity.size() != msg.name.size())
   {
-    ROS_WARN_THROTTLE(1.0,
-                      "qlearning_controller: dropped joint_states with %zu names but %zu positions and %zu velocities",
-                      msg.name.size(), msg.position.size(), msg.velocity.size());
+    if (bad_state_warning_.ready())
+      ROS_WARN("qlearning_controller: dropped joint_states with %zu names but %zu positions and %zu velocities",
+               msg.name.size(), msg.position.size(), msg.velocity.size());
     return false;
   }
   state = CartPoleState(msg.position[cart], msg.velocity[cart], msg.position[pole], msg.velocity[pole]);
   if (!state.allFinite())
   {
-    ROS_WARN_THROTTLE(1.0, "qlearning_controller: dropped joint_states with a non-finite position or velocity");
+    if (bad_state_warning_.ready())
+      ROS_WARN("qlearning_controller: dropped joint_states with a non-finite position or velocity");
     return false;
   }
   return true;
@@ -212,9 +224,10 @@ void QLearningControllerNode::onJointState(const sensor_msgs::JointStateConstPtr
   if (have_stamp_ && stamp < last_stamp_)
   {
     // Time went back: the sim was restarted. The running episode cannot be finished.
-    ROS_WARN("qlearning_controller: joint_states time went back (%.3f -> %.3f s): the sim restarted; "
-             "starting a new episode",
-             last_stamp_.toSec(), stamp.toSec());
+    ROS_WARN(
+        "qlearning_controller: joint_states time went back (%.3f -> %.3f s): the sim restarted; "
+        "starting a new episode",
+        last_stamp_.toSec(), stamp.toSec());
     session_->abortEpisode();
     awaiting_reset_ = false;
   }
@@ -251,6 +264,14 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp)
   const double episode_wall = secondsSince(last_episode_end_);
   last_episode_end_ = std::chrono::steady_clock::now();
 
+  // When training ends here, the table is saved before episode_stats says so: whoever acts on
+  // the last message finds the final file.
+  const TrainingLimits& limits = config_.limits;
+  const bool finish = learning_ && ((s.solved && limits.stop_when_solved) || s.episode >= limits.max_episodes);
+  std::string saved;
+  if (finish)
+    save("", saved);
+
   EpisodeStats stats;
   stats.header.stamp = stamp;
   stats.episode = static_cast<std::uint32_t>(s.episode);
@@ -266,7 +287,6 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp)
   stats.steps_per_second = episode_wall > 0.0 ? s.steps / episode_wall : 0.0;
   stats_pub_.publish(stats);
 
-  const TrainingLimits& limits = config_.limits;
   if (limits.progress_every > 0 && s.episode % limits.progress_every == 0)
   {
     const double interval = secondsSince(last_progress_);
@@ -280,15 +300,13 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp)
 
   if (learning_)
   {
-    const bool solved = s.solved && limits.stop_when_solved;
-    if (solved || s.episode >= limits.max_episodes)
+    if (finish)
     {
-      std::string message;
-      save("", message);
-      ROS_INFO("qlearning_controller: %s after %llu episodes, %llu steps, %.1f s (mean return of the last %u: %.2f); %s",
-               s.solved ? "SOLVED" : "NOT solved, max_episodes reached", static_cast<unsigned long long>(s.episode),
-               static_cast<unsigned long long>(s.total_steps), secondsSince(started_), config_.task.solved_window,
-               s.mean_return_window, message.c_str());
+      ROS_INFO(
+          "qlearning_controller: %s after %llu episodes, %llu steps, %.1f s (mean return of the last %u: %.2f); %s",
+          s.solved ? "SOLVED" : "NOT solved, max_episodes reached", static_cast<unsigned long long>(s.episode),
+          static_cast<unsigned long long>(s.total_steps), secondsSince(started_), config_.task.solved_window,
+          s.mean_return_window, saved.c_str());
       finished_training_ = true;
       if (finished_)
         finished_();

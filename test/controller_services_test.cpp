@@ -77,8 +77,8 @@ void writeBadFiles(const std::string& dir)
   std::ofstream(dir + "/corrupt.yaml") << "format: cartpole_qlearning/q_table\nversion: 1\nbins: [1, 1, 6, 12]\n"
                                        << "values: {{{ not yaml";
   DiscretiserParams other;
-  other.bins = { { 1, 1, 3, 6 } };
-  saveQTableFile(QTable(other, { -10.0, 10.0 }), dir + "/other_shape.yaml");
+  other.bins = {{1, 1, 3, 6}};
+  saveQTableFile(QTable(other, {-10.0, 10.0}), dir + "/other_shape.yaml");
   std::ofstream(fs::path(dir).parent_path() / "outside.yaml") << "placeholder";
 }
 
@@ -112,7 +112,7 @@ TEST(ControllerServices, EvaluateSaveLoadRoundTripAndRefusalsKeepTheTable)
   EXPECT_EQ(before, readFile(dir + "/after_refusals.yaml"));
 
   // A real table (trained offline, here: any valid table of the right shape) loads and is used.
-  QTable table(DiscretiserParams(), { -10.0, 10.0 });
+  QTable table(DiscretiserParams(), {-10.0, 10.0});
   std::vector<double> values(table.values().size());
   for (std::size_t i = 0; i < values.size(); ++i)
     values[i] = std::sin(static_cast<double>(i)) / 3.0;
@@ -129,8 +129,8 @@ TEST(ControllerServices, EvaluateSaveLoadRoundTripAndRefusalsKeepTheTable)
 TEST(ControllerServices, EscapingSavesAreRefusedAndWriteNothing)
 {
   const std::string dir = root() + "/eval";
-  for (const std::string& path : { std::string("../escaped.yaml"), std::string("a/../../escaped.yaml"),
-                                   root() + "/escaped.yaml", std::string("/tmp/escaped_cartpole_q_table.yaml") })
+  for (const std::string& path : {std::string("../escaped.yaml"), std::string("a/../../escaped.yaml"),
+                                  root() + "/escaped.yaml", std::string("/tmp/escaped_cartpole_q_table.yaml")})
   {
     const SaveQTable::Response response = save("eval", path);
     EXPECT_FALSE(response.success) << path;
@@ -146,9 +146,9 @@ TEST(ControllerServices, TrainingGoesOnThroughRefusedLoads)
   writeBadFiles(dir);
   ros::NodeHandle nh;
   std::uint64_t episodes = 0;
-  ros::Subscriber sub = nh.subscribe<EpisodeStats>(
-      "/train/episode_stats", 100,
-      boost::function<void(const EpisodeStatsConstPtr&)>([&](const EpisodeStatsConstPtr& m) { episodes = m->episode; }));
+  ros::Subscriber sub = nh.subscribe<EpisodeStats>("/train/episode_stats", 100,
+                                                   boost::function<void(const EpisodeStatsConstPtr&)>(
+                                                       [&](const EpisodeStatsConstPtr& m) { episodes = m->episode; }));
   ASSERT_TRUE(waitFor([&] { return episodes >= 5; }, 30.0)) << "training does not run";
   ASSERT_TRUE(save("train", "before.yaml").success);
   const QTable before = loadQTableFile(dir + "/before.yaml");
@@ -185,7 +185,8 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
       "/alone/cart_effort", 100,
       boost::function<void(const std_msgs::Float64ConstPtr&)>([&](const std_msgs::Float64ConstPtr&) { ++commands; }));
   ros::Subscriber log = nh.subscribe<rosgraph_msgs::Log>(
-      "/rosout", 1000, boost::function<void(const rosgraph_msgs::LogConstPtr&)>([&](const rosgraph_msgs::LogConstPtr& m) {
+      "/rosout", 1000,
+      boost::function<void(const rosgraph_msgs::LogConstPtr&)>([&](const rosgraph_msgs::LogConstPtr& m) {
         if (m->name != "/alone/qlearning_controller")
           return;
         silent_reported = silent_reported || m->msg.find("no joint_states") != std::string::npos;
@@ -206,12 +207,12 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   const std::vector<sensor_msgs::JointState> bad = {
-    make({ "cart_joint" }, { 0.0 }, { 0.0 }),                          // pole_joint missing
-    make({ "cart_joint", "other" }, { 0.0, 0.0 }, { 0.0, 0.0 }),       // pole_joint missing
-    make({ "cart_joint", "pole_joint" }, { 0.0 }, { 0.0, 0.0 }),       // lengths differ
-    make({ "cart_joint", "pole_joint" }, { 0.0, 0.0 }, {}),            // no velocities
-    make({ "cart_joint", "pole_joint" }, { nan, 0.0 }, { 0.0, 0.0 }),  // NaN
-    make({ "cart_joint", "pole_joint" }, { 0.0, 0.0 }, { 0.0, inf }),  // Inf
+      make({"cart_joint"}, {0.0}, {0.0}),                          // pole_joint missing
+      make({"cart_joint", "other"}, {0.0, 0.0}, {0.0, 0.0}),       // pole_joint missing
+      make({"cart_joint", "pole_joint"}, {0.0}, {0.0, 0.0}),       // lengths differ
+      make({"cart_joint", "pole_joint"}, {0.0, 0.0}, {}),          // no velocities
+      make({"cart_joint", "pole_joint"}, {nan, 0.0}, {0.0, 0.0}),  // NaN
+      make({"cart_joint", "pole_joint"}, {0.0, 0.0}, {0.0, inf}),  // Inf
   };
   for (const auto& msg : bad)
     states.publish(msg);
@@ -224,13 +225,13 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
     EXPECT_EQ(0.0, v);
 
   // Joints found by name, in any order: a good state is answered.
-  states.publish(make({ "pole_joint", "cart_joint" }, { 0.01, 0.0 }, { 0.0, 0.0 }));
+  states.publish(make({"pole_joint", "cart_joint"}, {0.01, 0.0}, {0.0, 0.0}));
   EXPECT_TRUE(waitFor([&] { return commands == 1; }, 10.0));
 
   // No sim in this namespace: after sim_timeout (1 s) of silence the controller says so, once,
   // and says so again when states come back.
   ASSERT_TRUE(waitFor([&] { return silent_reported; }, 20.0)) << "no report of the silent sim";
-  states.publish(make({ "cart_joint", "pole_joint" }, { 0.0, 0.01 }, { 0.0, 0.0 }));
+  states.publish(make({"cart_joint", "pole_joint"}, {0.0, 0.01}, {0.0, 0.0}));
   EXPECT_TRUE(waitFor([&] { return back_reported; }, 10.0));
   EXPECT_TRUE(waitFor([&] { return commands == 2; }, 10.0));
 }

@@ -90,8 +90,8 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
   EXPECT_EQ(solved.episode, table.episodes);
   EXPECT_EQ(solved.total_steps, table.steps);
   const std::string headless = qTableDir() + "/headless.yaml";
-  const std::string command =
-      std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " + CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
+  const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " +
+                              CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
   EXPECT_EQ(readFile(headless), readFile(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
 

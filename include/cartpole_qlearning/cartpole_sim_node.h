@@ -5,6 +5,7 @@
 #include "cartpole_qlearning/Reset.h"
 #include "cartpole_qlearning/cartpole_simulation.h"
 #include "cartpole_qlearning/random.h"
+#include "cartpole_qlearning/wall_throttle.h"
 
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
@@ -79,7 +80,9 @@ private:
   bool repeat_armed_ = false;  // a timer tick already found the state unanswered past the timeout
   bool state_heard_ = false;   // the pending state reached at least one subscriber
   std::chrono::steady_clock::time_point last_tf_;
-  sensor_msgs::JointState joint_state_;
+  sensor_msgs::JointState joint_state_;  // the last state published (repeats send it again)
+  mutable WallThrottle nonfinite_warning_{1.0};
+  mutable WallThrottle clamp_warning_{1.0};
 
   ros::Publisher joint_state_pub_;
   ros::Publisher clock_pub_;

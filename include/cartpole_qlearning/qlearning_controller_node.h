@@ -8,6 +8,7 @@
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/training_session.h"
+#include "cartpole_qlearning/wall_throttle.h"
 
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
@@ -90,6 +91,7 @@ private:
   std::uint64_t steps_at_last_progress_ = 0;
   std::chrono::steady_clock::time_point last_progress_;
   bool sim_silent_reported_ = false;
+  mutable WallThrottle bad_state_warning_{1.0};
 
   ros::Subscriber joint_state_sub_;
   ros::Publisher effort_pub_;

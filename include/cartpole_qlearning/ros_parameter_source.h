@@ -12,9 +12,7 @@ class RosParameterSource : public ParameterSource
 {
 public:
   // Keys are resolved relative to the node handle's namespace ("physics/tau" -> /cartpole/physics/tau).
-  explicit RosParameterSource(const ros::NodeHandle& nh) : nh_(nh)
-  {
-  }
+  explicit RosParameterSource(const ros::NodeHandle& nh) : nh_(nh) {}
 
   bool get(const std::string& key, double& value) const override;
   bool get(const std::string& key, std::int64_t& value) const override;

@@ -1,0 +1,161 @@
+// Speed of the ROS-free core: one physics step, one discretisation, one agent decision and
+// update, one training-session step, and a whole headless training run to solved. The same
+// code runs inside the nodes, so these are the ceilings the ROS graph can approach.
+#include "cartpole_qlearning/cartpole_dynamics.h"
+#include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/discretiser.h"
+#include "cartpole_qlearning/headless_trainer.h"
+#include "cartpole_qlearning/q_learning_agent.h"
+#include "cartpole_qlearning/random.h"
+#include "cartpole_qlearning/training_session.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+using namespace cartpole_qlearning;
+
+namespace
+{
+// Enough states that the branch predictor cannot learn the sequence, few enough to stay in L1.
+constexpr std::size_t kStatePool = 1024;
+
+// States drawn uniformly in +-scale times the termination box (x 2.4 m, theta 12 degrees), with
+// velocities in +-3 m/s and +-0.87 rad/s: scale > 1 puts some outside the bins' bounds.
+std::vector<CartPoleState> randomStates(double scale, std::uint64_t seed)
+{
+  RandomStream rng(seed, 0);
+  std::vector<CartPoleState> states(kStatePool);
+  for (CartPoleState& s : states)
+  {
+    s = CartPoleState(rng.uniform(-2.39, 2.39), rng.uniform(-3.0, 3.0), rng.uniform(-0.209, 0.209),
+                      rng.uniform(-0.87, 0.87)) *
+        scale;
+  }
+  return states;
+}
+
+// A trajectory under a bang-bang balancer (push toward the lean), restarted where the task would
+// end the episode: the states the physics really sees, and no drift to infinity.
+void dynamicsStep(benchmark::State& state, Integrator integrator)
+{
+  CartPoleParams params;
+  params.integrator = integrator;
+  const CartPoleDynamics dynamics(params);
+  const CartPoleState start(0.01, -0.02, 0.03, 0.01);
+  CartPoleState s = start;
+  for (auto _ : state)
+  {
+    const double force = s[2] + 0.1 * s[3] > 0.0 ? params.force_mag : -params.force_mag;
+    s = dynamics.step(s, force);
+    if (!(std::abs(s[0]) < 2.4 && std::abs(s[2]) < 0.2))
+      s = start;
+    benchmark::DoNotOptimize(s);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_DynamicsStepEuler(benchmark::State& state)
+{
+  dynamicsStep(state, Integrator::Euler);
+}
+BENCHMARK(BM_DynamicsStepEuler);
+
+void BM_DynamicsStepRk4(benchmark::State& state)
+{
+  dynamicsStep(state, Integrator::Rk4);
+}
+BENCHMARK(BM_DynamicsStepRk4);
+
+// The default bins (1, 1, 6, 12), over states inside and outside their bounds.
+void BM_DiscretiserIndex(benchmark::State& state)
+{
+  const Discretiser discretiser;
+  const std::vector<CartPoleState> states = randomStates(1.2, 1);
+  std::size_t i = 0;
+  for (auto _ : state)
+  {
+    std::size_t row = discretiser.index(states[i]);
+    benchmark::DoNotOptimize(row);
+    i = (i + 1) % kStatePool;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_DiscretiserIndex);
+
+// One epsilon-greedy choice and one Q-learning update, as a training step makes them.
+void BM_AgentSelectUpdate(benchmark::State& state)
+{
+  QLearningAgent agent(AgentParams(), 0);
+  const std::size_t rows = agent.table().stateCount();
+  RandomStream rng(2, 0);
+  std::vector<std::size_t> rows_visited(kStatePool);
+  for (std::size_t& row : rows_visited)
+    row = static_cast<std::size_t>(rng.uniformIndex(rows));
+  std::size_t i = 0;
+  for (auto _ : state)
+  {
+    const std::size_t s = rows_visited[i];
+    i = (i + 1) % kStatePool;
+    std::size_t action = agent.selectAction(s, 0.1);
+    agent.update(s, action, 1.0, rows_visited[i], false, 0.1);
+    benchmark::DoNotOptimize(action);
+    benchmark::ClobberMemory();  // the update's store to the table counts
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_AgentSelectUpdate);
+
+// One TrainingSession::observe (judge, discretise, learn, choose), the controller node's work per
+// joint_states message. States stay inside the termination box, so an episode ends only by
+// truncation (every 500 steps) and a new one begins there, as in training.
+void BM_TrainingSessionObserve(benchmark::State& state)
+{
+  TrainingSession session(TaskParams(), AgentParams(), 0);
+  const std::vector<CartPoleState> states = randomStates(1.0, 3);
+  std::size_t i = 0;
+  session.beginEpisode(states[i]);
+  for (auto _ : state)
+  {
+    i = (i + 1) % kStatePool;
+    Decision decision = session.observe(states[i]);
+    benchmark::DoNotOptimize(decision);
+    if (decision.episode_over)
+      session.beginEpisode(states[i]);
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["episodes"] = static_cast<double>(session.episodesEnded());
+}
+BENCHMARK(BM_TrainingSessionObserve);
+
+// train_headless's work with the shipped config/cartpole.yaml and seed 0, to the solved episode.
+void BM_HeadlessTrainingToSolved(benchmark::State& state)
+{
+  const TrainingConfig config = readTrainingConfig(*loadYamlParameters(CARTPOLE_CONFIG_FILE));
+  std::uint64_t steps = 0;
+  std::uint64_t episodes = 0;
+  for (auto _ : state)
+  {
+    HeadlessTrainer trainer(config, 0);
+    TrainingResult result = trainer.run();
+    benchmark::DoNotOptimize(result);
+    if (!result.solved)
+    {
+      state.SkipWithError("the default config did not solve with seed 0");
+      break;
+    }
+    steps += result.steps;
+    episodes = result.episodes;
+  }
+  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(steps), benchmark::Counter::kIsRate);
+  state.counters["steps"] = static_cast<double>(state.iterations() > 0 ? steps / state.iterations() : 0);
+  state.counters["episodes"] = static_cast<double>(episodes);
+}
+// Wall time, as train_headless reports it (steps_per_s is then per wall second too).
+BENCHMARK(BM_HeadlessTrainingToSolved)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,228 @@
+// Ko parameter fixtures, started by node_parameters_fail.test: each case puts one bad value on
+// the parameter server under a namespace of its own and runs the real executable there. The
+// node must exit non-zero (not crash, not hang) with a message naming the parameter and the
+// value. Ok cases, with valid values set the same way, prove the nodes read those namespaces and
+// stay up, so the ko cases cannot pass vacuously.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <regex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using XmlRpc::XmlRpcValue;
+
+namespace
+{
+constexpr int kTimedOut = 124;  // timeout(1)'s status when the command outlived it
+
+using Parameters = std::vector<std::pair<std::string, XmlRpcValue>>;  // names relative to the case's namespace
+
+struct ProcessRun
+{
+  int status = -1;  // timeout's: the node's exit status, 124 when it was stopped, 128+n on signal n
+  std::string output;
+  double seconds = 0.0;
+};
+
+// Runs the executable in the namespace, stdout and stderr together, stopped with the signal
+// after the given seconds (then killed 5 s later if it still runs).
+ProcessRun runNode(const std::string& executable, const std::string& ns, int seconds, const char* signal = "TERM")
+{
+  ProcessRun run;
+  const std::string command = "timeout -k 5 -s " + std::string(signal) + " " + std::to_string(seconds) + " " +
+                              executable + " __ns:=" + ns + " 2>&1";
+  const auto start = std::chrono::steady_clock::now();
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr)
+    return run;
+  std::array<char, 4096> buffer;
+  std::size_t n;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.output.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+void setParameters(const std::string& ns, const Parameters& parameters)
+{
+  for (const auto& [name, value] : parameters)
+    ros::param::set(ns + "/" + name, value);
+}
+
+XmlRpcValue list(const std::vector<XmlRpcValue>& values)
+{
+  XmlRpcValue array;
+  array.setSize(static_cast<int>(values.size()));
+  for (std::size_t i = 0; i < values.size(); ++i)
+    array[static_cast<int>(i)] = values[i];
+  return array;
+}
+
+// A number as a whole word: "-1" in "mass_pole = -1 is", not in "-10" or "0.-1".
+std::string number(const std::string& pattern)
+{
+  return "(^|[^0-9.])" + pattern + "([^0-9.]|$)";
+}
+
+// The node refuses: exits by itself, non-zero, without crashing, and says why on one line.
+void expectRefused(const std::string& executable, const std::string& ns, const Parameters& parameters,
+                   const std::string& says)
+{
+  setParameters(ns, parameters);
+  const ProcessRun run = runNode(executable, ns, 20);
+  EXPECT_NE(0, run.status) << "the node accepted the parameters:\n" << run.output;
+  EXPECT_NE(kTimedOut, run.status) << "the node did not exit within 20 s:\n" << run.output;
+  EXPECT_TRUE(run.status > 0 && run.status < 128) << "the node crashed (status " << run.status << "):\n" << run.output;
+  EXPECT_TRUE(std::regex_search(run.output, std::regex(says)))
+      << "the output does not name the parameter and its value (/" << says << "/):\n"
+      << run.output;
+}
+
+// The node starts with the parameters, says so, and is still running after a few seconds.
+void expectRunning(const std::string& executable, const std::string& ns, const Parameters& parameters,
+                   const std::vector<std::string>& says)
+{
+  setParameters(ns, parameters);
+  const ProcessRun run = runNode(executable, ns, 4, "INT");
+  EXPECT_EQ(kTimedOut, run.status) << "the node stopped by itself (status " << run.status << "):\n" << run.output;
+  EXPECT_EQ(std::string::npos, run.output.find("not allowed")) << run.output;
+  for (const std::string& text : says)
+    EXPECT_TRUE(std::regex_search(run.output, std::regex(text)))
+        << "the output does not show the parameters were read (/" << text << "/):\n"
+        << run.output;
+}
+
+class NodeParametersTest : public ::testing::Test
+{
+protected:
+  void SetUp() override
+  {
+    dir_ = fs::temp_directory_path() / ("node_parameters_fail_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override
+  {
+    fs::remove_all(dir_);
+  }
+  fs::path dir_;
+};
+
+const std::string kSim = CARTPOLE_SIM;
+const std::string kController = QLEARNING_CONTROLLER;
+
+// cartpole_sim
+
+TEST_F(NodeParametersTest, SimRunsWithValidParametersFromItsNamespace)
+{
+  expectRunning(kSim, "/ok_sim",
+                {{"cartpole_sim/mode", XmlRpcValue("lockstep")},
+                 {"cartpole_sim/effort_limit", XmlRpcValue(5.0)},
+                 {"physics/mass_pole", XmlRpcValue(0.2)},
+                 {"physics/tau", XmlRpcValue(0.01)},
+                 {"physics/integrator", XmlRpcValue("rk4")}},
+                {"lockstep mode, tau 0.01 s, integrator rk4"});
+}
+
+TEST_F(NodeParametersTest, SimRefusesAnUnknownMode)
+{
+  expectRefused(kSim, "/ko_sim_mode", {{"cartpole_sim/mode", XmlRpcValue("warp")}}, "[/~]mode\\b.*\\bwarp\\b");
+}
+
+TEST_F(NodeParametersTest, SimRefusesANegativePoleMass)
+{
+  expectRefused(kSim, "/ko_sim_mass_pole", {{"physics/mass_pole", XmlRpcValue(-1.0)}},
+                "physics/mass_pole\\b.*" + number("-1(\\.0*)?"));
+}
+
+TEST_F(NodeParametersTest, SimRefusesAZeroTimeStep)
+{
+  expectRefused(kSim, "/ko_sim_tau", {{"physics/tau", XmlRpcValue(0.0)}}, "physics/tau\\b.*" + number("0(\\.0*)?"));
+}
+
+TEST_F(NodeParametersTest, SimRefusesAnUnknownIntegrator)
+{
+  expectRefused(kSim, "/ko_sim_integrator", {{"physics/integrator", XmlRpcValue("verlet")}},
+                "physics/integrator\\b.*\\bverlet\\b");
+}
+
+TEST_F(NodeParametersTest, SimRefusesAnEffortLimitAboveTheForceMagnitude)
+{
+  expectRefused(kSim, "/ko_sim_effort_limit", {{"cartpole_sim/effort_limit", XmlRpcValue(50.0)}},
+                "[/~]effort_limit\\b.*" + number("50(\\.0*)?"));
+}
+
+// qlearning_controller
+
+TEST_F(NodeParametersTest, ControllerRunsWithValidParametersFromItsNamespace)
+{
+  expectRunning(kController, "/ok_controller",
+                {{"qlearning_controller/mode", XmlRpcValue("train")},
+                 {"qlearning_controller/seed", XmlRpcValue(3)},
+                 {"qlearning_controller/checkpoint_every", XmlRpcValue(0)},
+                 {"qlearning_controller/save_on_shutdown", XmlRpcValue(false)},
+                 {"qlearning_controller/q_table_dir", XmlRpcValue(dir_.string())},
+                 {"learning/gamma", XmlRpcValue(0.9)},
+                 {"learning/bins", list({1, 1, 3, 4})}},
+                {"training, seed 3, 12 states x 2 actions"});
+  EXPECT_TRUE(fs::is_empty(dir_)) << "save_on_shutdown false, yet the controller wrote into " << dir_;
+}
+
+TEST_F(NodeParametersTest, ControllerRefusesAnUnknownMode)
+{
+  expectRefused(kController, "/ko_controller_mode", {{"qlearning_controller/mode", XmlRpcValue("fly")}},
+                "[/~]mode\\b.*\\bfly\\b");
+}
+
+TEST_F(NodeParametersTest, ControllerRefusesANegativeSeed)
+{
+  expectRefused(kController, "/ko_controller_seed", {{"qlearning_controller/seed", XmlRpcValue(-1)}},
+                "[/~]seed\\b.*" + number("-1"));
+}
+
+TEST_F(NodeParametersTest, ControllerRefusesADiscountAboveOne)
+{
+  expectRefused(kController, "/ko_controller_gamma", {{"learning/gamma", XmlRpcValue(2.0)}},
+                "learning/gamma\\b.*" + number("2(\\.0*)?"));
+}
+
+TEST_F(NodeParametersTest, ControllerRefusesBinsWithThreeEntries)
+{
+  expectRefused(kController, "/ko_controller_bins", {{"learning/bins", list({1, 6, 12})}},
+                "learning/bins\\b.*\\[\\s*1(\\.0*)?\\s*,\\s*6(\\.0*)?\\s*,\\s*12(\\.0*)?\\s*\\]");
+}
+
+TEST_F(NodeParametersTest, ControllerRefusesANegativeCheckpointInterval)
+{
+  expectRefused(kController, "/ko_controller_checkpoint", {{"qlearning_controller/checkpoint_every", XmlRpcValue(-5)}},
+                "[/~]checkpoint_every\\b.*" + number("-5"));
+}
+
+TEST_F(NodeParametersTest, ControllerRefusesAMissingTableToLoadOnStart)
+{
+  expectRefused(kController, "/ko_controller_load",
+                {{"qlearning_controller/q_table_dir", XmlRpcValue(dir_.string())},
+                 {"qlearning_controller/load_on_start", XmlRpcValue("no_such_table.yaml")}},
+                "no_such_table\\.yaml");
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "node_parameters_fail_test");
+  return RUN_ALL_TESTS();
+}
