@@ -6,6 +6,9 @@
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/q_table_file.h"
 
+#include "ros_test_support.h"
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
@@ -21,35 +24,16 @@
 namespace fs = std::filesystem;
 using namespace cartpole_qlearning;
 
+using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::spinUntil;
+
 namespace
 {
-template <typename Predicate>
-bool waitFor(Predicate predicate, double timeout_s)
-{
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  while (ros::ok() && ros::WallTime::now() < deadline)
-  {
-    ros::spinOnce();
-    if (predicate())
-      return true;
-    ros::WallDuration(0.005).sleep();
-  }
-  return predicate();
-}
-
 std::string root()
 {
   std::string dir;
   ros::param::get("~root", dir);
   return dir;
-}
-
-std::string readFile(const std::string& path)
-{
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 SaveQTable::Response save(const std::string& ns, const std::string& path)
@@ -149,7 +133,7 @@ TEST(ControllerServices, TrainingGoesOnThroughRefusedLoads)
   ros::Subscriber sub = nh.subscribe<EpisodeStats>("/train/episode_stats", 100,
                                                    boost::function<void(const EpisodeStatsConstPtr&)>(
                                                        [&](const EpisodeStatsConstPtr& m) { episodes = m->episode; }));
-  ASSERT_TRUE(waitFor([&] { return episodes >= 5; }, 30.0)) << "training does not run";
+  ASSERT_TRUE(spinUntil([&] { return episodes >= 5; }, 30.0)) << "training does not run";
   ASSERT_TRUE(save("train", "before.yaml").success);
   const QTable before = loadQTableFile(dir + "/before.yaml");
 
@@ -159,7 +143,7 @@ TEST(ControllerServices, TrainingGoesOnThroughRefusedLoads)
   expectRefused(load("train", "../outside.yaml"), "escape");
 
   const std::uint64_t seen = episodes;
-  ASSERT_TRUE(waitFor([&] { return episodes >= seen + 5; }, 30.0)) << "training stopped after the refused loads";
+  ASSERT_TRUE(spinUntil([&] { return episodes >= seen + 5; }, 30.0)) << "training stopped after the refused loads";
   ASSERT_TRUE(save("train", "after.yaml").success);
   const QTable after = loadQTableFile(dir + "/after.yaml");
   // Still the same table, trained further: same shape, counters grown from where they were.
@@ -193,7 +177,7 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
         back_reported = back_reported || m->msg.find("joint_states are back") != std::string::npos;
       }));
   ros::Publisher states = nh.advertise<sensor_msgs::JointState>("/alone/joint_states", 10);
-  ASSERT_TRUE(waitFor([&] { return states.getNumSubscribers() > 0 && effort.getNumPublishers() > 0; }, 20.0));
+  ASSERT_TRUE(spinUntil([&] { return states.getNumSubscribers() > 0 && effort.getNumPublishers() > 0; }, 20.0));
 
   double stamp = 1.0;
   const auto make = [&](std::vector<std::string> names, std::vector<double> position, std::vector<double> velocity) {
@@ -216,7 +200,7 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
   };
   for (const auto& msg : bad)
     states.publish(msg);
-  waitFor([] { return false; }, 1.0);
+  spinUntil([] { return false; }, 1.0);
   EXPECT_EQ(0, commands) << "a bad joint state was answered";
   ASSERT_TRUE(save("alone", "after_bad.yaml").success);
   const QTable table = loadQTableFile(root() + "/alone/after_bad.yaml");
@@ -226,14 +210,14 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
 
   // Joints found by name, in any order: a good state is answered.
   states.publish(make({"pole_joint", "cart_joint"}, {0.01, 0.0}, {0.0, 0.0}));
-  EXPECT_TRUE(waitFor([&] { return commands == 1; }, 10.0));
+  EXPECT_TRUE(spinUntil([&] { return commands == 1; }, 10.0));
 
   // No sim in this namespace: after sim_timeout (1 s) of silence the controller says so, once,
   // and says so again when states come back.
-  ASSERT_TRUE(waitFor([&] { return silent_reported; }, 20.0)) << "no report of the silent sim";
+  ASSERT_TRUE(spinUntil([&] { return silent_reported; }, 20.0)) << "no report of the silent sim";
   states.publish(make({"cart_joint", "pole_joint"}, {0.0, 0.01}, {0.0, 0.0}));
-  EXPECT_TRUE(waitFor([&] { return back_reported; }, 10.0));
-  EXPECT_TRUE(waitFor([&] { return commands == 2; }, 10.0));
+  EXPECT_TRUE(spinUntil([&] { return back_reported; }, 10.0));
+  EXPECT_TRUE(spinUntil([&] { return commands == 2; }, 10.0));
 }
 
 int main(int argc, char** argv)

@@ -3,6 +3,9 @@
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/q_table_file.h"
 
+#include "ros_test_support.h"
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
@@ -20,31 +23,12 @@
 namespace fs = std::filesystem;
 using cartpole_qlearning::EpisodeStats;
 
+using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::spinUntil;
+
 namespace
 {
-std::string readFile(const std::string& path)
-{
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // Spins until the predicate holds or the wall timeout passes.
-template <typename Predicate>
-bool waitFor(Predicate predicate, double timeout_s)
-{
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  while (ros::ok() && ros::WallTime::now() < deadline)
-  {
-    ros::spinOnce();
-    if (predicate())
-      return true;
-    ros::WallDuration(0.005).sleep();
-  }
-  return predicate();
-}
-
 std::string qTableDir()
 {
   std::string dir;
@@ -74,7 +58,7 @@ ros::Subscriber ControllerTrainTest::sub_;
 TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
 {
   // 1. Training over ROS reaches solved (mean return of the last 100 >= 475).
-  ASSERT_TRUE(waitFor([] { return !stats_.empty() && stats_.back().solved; }, 200.0))
+  ASSERT_TRUE(spinUntil([] { return !stats_.empty() && stats_.back().solved; }, 200.0))
       << "no solved episode; episodes seen: " << stats_.size();
   const EpisodeStats& solved = stats_.back();
   EXPECT_GE(solved.mean_return_100, 475.0);
@@ -85,7 +69,7 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
 
   // 2. The controller saved the table on solving, and it is train_headless's, byte for byte.
   const std::string trained = qTableDir() + "/trained.yaml";
-  ASSERT_TRUE(waitFor([&] { return fs::exists(trained); }, 10.0)) << trained;
+  ASSERT_TRUE(spinUntil([&] { return fs::exists(trained); }, 10.0)) << trained;
   const cartpole_qlearning::QTable table = cartpole_qlearning::loadQTableFile(trained);
   EXPECT_EQ(solved.episode, table.episodes);
   EXPECT_EQ(solved.total_steps, table.steps);
@@ -107,7 +91,7 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
             load.c_str(), dir.c_str(), "_save_on_shutdown:=false", static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  const bool balanced = waitFor(
+  const bool balanced = spinUntil(
       [&] {
         for (std::size_t i = before; i < stats_.size(); ++i)
         {

@@ -3,6 +3,8 @@
 // node must exit non-zero (not crash, not hang) with a message naming the parameter and the
 // value. Ok cases, with valid values set the same way, prove the nodes read those namespaces and
 // stay up, so the ko cases cannot pass vacuously.
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <xmlrpcpp/XmlRpcValue.h>
@@ -23,38 +25,22 @@
 namespace fs = std::filesystem;
 using XmlRpc::XmlRpcValue;
 
+using cartpole_qlearning::test::CommandRun;
+using cartpole_qlearning::test::runCommand;
+
 namespace
 {
 constexpr int kTimedOut = 124;  // timeout(1)'s status when the command outlived it
 
 using Parameters = std::vector<std::pair<std::string, XmlRpcValue>>;  // names relative to the case's namespace
 
-struct ProcessRun
-{
-  int status = -1;  // timeout's: the node's exit status, 124 when it was stopped, 128+n on signal n
-  std::string output;
-  double seconds = 0.0;
-};
-
 // Runs the executable in the namespace, stdout and stderr together, stopped with the signal
 // after the given seconds (then killed 5 s later if it still runs).
-ProcessRun runNode(const std::string& executable, const std::string& ns, int seconds, const char* signal = "TERM")
+CommandRun runNode(const std::string& executable, const std::string& ns, int seconds, const char* signal = "TERM")
 {
-  ProcessRun run;
-  const std::string command = "timeout -k 5 -s " + std::string(signal) + " " + std::to_string(seconds) + " " +
-                              executable + " __ns:=" + ns + " 2>&1";
-  const auto start = std::chrono::steady_clock::now();
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr)
-    return run;
-  std::array<char, 4096> buffer;
-  std::size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    run.output.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return run;
+  // timeout(1)'s status: the node's exit status, 124 when it was stopped, 128+n on signal n.
+  return runCommand("timeout -k 5 -s " + std::string(signal) + " " + std::to_string(seconds) + " " + executable +
+                    " __ns:=" + ns);
 }
 
 void setParameters(const std::string& ns, const Parameters& parameters)
@@ -83,7 +69,7 @@ void expectRefused(const std::string& executable, const std::string& ns, const P
                    const std::string& says)
 {
   setParameters(ns, parameters);
-  const ProcessRun run = runNode(executable, ns, 20);
+  const CommandRun run = runNode(executable, ns, 20);
   EXPECT_NE(0, run.status) << "the node accepted the parameters:\n" << run.output;
   EXPECT_NE(kTimedOut, run.status) << "the node did not exit within 20 s:\n" << run.output;
   EXPECT_TRUE(run.status > 0 && run.status < 128) << "the node crashed (status " << run.status << "):\n" << run.output;
@@ -97,7 +83,7 @@ void expectRunning(const std::string& executable, const std::string& ns, const P
                    const std::vector<std::string>& says)
 {
   setParameters(ns, parameters);
-  const ProcessRun run = runNode(executable, ns, 4, "INT");
+  const CommandRun run = runNode(executable, ns, 4, "INT");
   EXPECT_EQ(kTimedOut, run.status) << "the node stopped by itself (status " << run.status << "):\n" << run.output;
   EXPECT_EQ(std::string::npos, run.output.find("not allowed")) << run.output;
   for (const std::string& text : says)

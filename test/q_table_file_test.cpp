@@ -1,6 +1,8 @@
 #include "cartpole_qlearning/q_table_file.h"
 #include "cartpole_qlearning/training_session.h"
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +16,7 @@
 
 using namespace cartpole_qlearning;
 namespace fs = std::filesystem;
+using cartpole_qlearning::test::readFile;
 
 namespace
 {
@@ -52,14 +55,6 @@ protected:
   std::string path(const std::string& name) const
   {
     return (dir_ / name).string();
-  }
-
-  static std::string read(const std::string& file)
-  {
-    std::ifstream in(file, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
   }
 
   static void write(const std::string& file, const std::string& text)
@@ -101,13 +96,13 @@ TEST_F(QTableFileTest, RoundTripIsBitExact)
   EXPECT_EQ(98765u, loaded.steps);
   // Saving what was loaded gives the same bytes.
   saveQTableFile(loaded, path("again.yaml"));
-  EXPECT_EQ(read(path("table.yaml")), read(path("again.yaml")));
+  EXPECT_EQ(readFile(path("table.yaml")), readFile(path("again.yaml")));
 }
 
 TEST_F(QTableFileTest, FileDescribesItself)
 {
   saveQTableFile(awkwardTable(), path("table.yaml"));
-  const std::string text = read(path("table.yaml"));
+  const std::string text = readFile(path("table.yaml"));
   for (const char* key : {"format: cartpole_qlearning/q_table", "version: 1", "bins: [1, 1, 6, 12]",
                           "lower_bounds:", "upper_bounds:", "actions: [-10, 10]", "episodes: 1234", "steps: 98765",
                           "states: 72", "checksum: fnv1a64:", "values:"})
@@ -137,11 +132,11 @@ TEST_F(QTableFileTest, SaveCreatesMissingDirectories)
 TEST_F(QTableFileTest, FailedSaveKeepsTheOldFile)
 {
   saveQTableFile(awkwardTable(), path("t.yaml"));
-  const std::string before = read(path("t.yaml"));
+  const std::string before = readFile(path("t.yaml"));
   write(path("blocker"), "a file, not a directory");
   EXPECT_THROW(saveQTableFile(awkwardTable(), path("blocker/t.yaml")), QTableFileError);
   EXPECT_THROW(saveQTableFile(awkwardTable(), dir_.string()), QTableFileError);
-  EXPECT_EQ(before, read(path("t.yaml")));
+  EXPECT_EQ(before, readFile(path("t.yaml")));
 }
 
 TEST_F(QTableFileTest, TruncatedFilesAreRefusedAndTheLiveTableIsUntouched)
@@ -150,7 +145,7 @@ TEST_F(QTableFileTest, TruncatedFilesAreRefusedAndTheLiveTableIsUntouched)
   saveQTableFile(awkwardTable(), path("good.yaml"));
   ASSERT_EQ("", loadInto(session, path("good.yaml")));
   const std::vector<double> live = session.table().values();
-  const std::string text = read(path("good.yaml"));
+  const std::string text = readFile(path("good.yaml"));
   // Cut at many places, on and off line boundaries, including inside the last number.
   for (std::size_t cut : {std::size_t(0), std::size_t(10), text.size() / 4, text.size() / 2, text.find("checksum"),
                           text.find("values:") + 9, text.size() - 40, text.size() - 3})
@@ -167,7 +162,7 @@ TEST_F(QTableFileTest, CorruptValuesAreCaughtByTheChecksum)
   TrainingSession session(TaskParams(), AgentParams(), 0);
   const std::vector<double> live = session.table().values();
   saveQTableFile(awkwardTable(), path("t.yaml"));
-  std::string text = read(path("t.yaml"));
+  std::string text = readFile(path("t.yaml"));
   // Change one digit of one value: still valid YAML, still a number. (Row 3 holds ordinary
   // numbers; a digit deep in the denormal of row 0 would not change the double.)
   std::size_t row = text.find("values:");
@@ -200,7 +195,7 @@ TEST_F(QTableFileTest, GarbageAndOtherYamlAreRefused)
 TEST_F(QTableFileTest, WrongVersionIsRefusedWithTheVersion)
 {
   saveQTableFile(awkwardTable(), path("t.yaml"));
-  std::string text = read(path("t.yaml"));
+  std::string text = readFile(path("t.yaml"));
   text.replace(text.find("version: 1"), 10, "version: 2");
   write(path("t.yaml"), text);
   try
@@ -217,7 +212,7 @@ TEST_F(QTableFileTest, WrongVersionIsRefusedWithTheVersion)
 TEST_F(QTableFileTest, WrongShapeIsRefused)
 {
   saveQTableFile(awkwardTable(), path("t.yaml"));
-  std::string text = read(path("t.yaml"));
+  std::string text = readFile(path("t.yaml"));
   std::string fewer_states = text;
   fewer_states.replace(fewer_states.find("states: 72"), 10, "states: 71");
   write(path("states.yaml"), fewer_states);

@@ -3,6 +3,8 @@
 // refused with a message, and the node stays up publishing finite states throughout.
 #include "cartpole_qlearning/Reset.h"
 
+#include "ros_test_support.h"
+
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
@@ -85,16 +87,7 @@ protected:
 
   bool spinUntil(const std::function<bool()>& done, double seconds = kWaitSeconds)
   {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-    while (ros::ok() && ros::WallTime::now() < deadline)
-    {
-      ros::spinOnce();
-      if (done())
-        return true;
-      ros::WallDuration(0.001).sleep();
-    }
-    ros::spinOnce();
-    return done();
+    return cartpole_qlearning::test::spinUntil(done, seconds);
   }
 
   // Publishes the efforts in turn, one every 50 ms (well within the command timeout), until done.

@@ -4,6 +4,8 @@
 #include "cartpole_qlearning/Reset.h"
 #include "cartpole_qlearning/cartpole_dynamics.h"
 
+#include "ros_test_support.h"
+
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
@@ -99,16 +101,7 @@ protected:
 
   bool spinUntil(const std::function<bool()>& done, double seconds = kWaitSeconds)
   {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-    while (ros::ok() && ros::WallTime::now() < deadline)
-    {
-      ros::spinOnce();
-      if (done())
-        return true;
-      ros::WallDuration(0.001).sleep();
-    }
-    ros::spinOnce();
-    return done();
+    return cartpole_qlearning::test::spinUntil(done, seconds);
   }
 
   void spinFor(double seconds)

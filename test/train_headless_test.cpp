@@ -1,6 +1,8 @@
 // The train_headless executable as a user runs it: its last line, its exit codes, its messages.
 #include "cartpole_qlearning/q_table_file.h"
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -16,35 +18,15 @@
 
 namespace fs = std::filesystem;
 
+using cartpole_qlearning::test::CommandRun;
+using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::runCommand;
+
 namespace
 {
-struct ProcessRun
+CommandRun trainHeadless(const std::string& args)
 {
-  int status = -1;
-  std::string output;  // stdout and stderr
-  std::string lastLine() const
-  {
-    std::string text = output;
-    while (!text.empty() && text.back() == '\n')
-      text.pop_back();
-    return text.substr(text.find_last_of('\n') + 1);
-  }
-};
-
-ProcessRun trainHeadless(const std::string& args)
-{
-  ProcessRun run;
-  const std::string command = std::string(TRAIN_HEADLESS) + " " + args + " 2>&1";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr)
-    return run;
-  std::array<char, 4096> buffer;
-  std::size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    run.output.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
+  return runCommand(std::string(TRAIN_HEADLESS) + " " + args);
 }
 
 std::string config()
@@ -77,7 +59,7 @@ protected:
 
 TEST_F(TrainHeadlessTest, SolvesAndEndsWithTheResultLine)
 {
-  const ProcessRun run = trainHeadless(config() + " --seed 0");
+  const CommandRun run = trainHeadless(config() + " --seed 0");
   EXPECT_EQ(0, run.status) << run.output;
   EXPECT_TRUE(std::regex_match(run.lastLine(), std::regex("solved=true episodes=[0-9]+ steps=[0-9]+ wall_s=[0-9.]+")))
       << run.lastLine();
@@ -93,15 +75,12 @@ TEST_F(TrainHeadlessTest, SavedTableLoadsAndTheSameSeedWritesTheSameBytes)
   ASSERT_EQ(0, trainHeadless(config() + " --seed 4 --quiet --save " + b).status);
   const cartpole_qlearning::QTable table = cartpole_qlearning::loadQTableFile(a);
   EXPECT_GT(table.episodes, 0u);
-  std::stringstream ta, tb;
-  ta << std::ifstream(a).rdbuf();
-  tb << std::ifstream(b).rdbuf();
-  EXPECT_EQ(ta.str(), tb.str());
+  EXPECT_EQ(readFile(a), readFile(b));
 }
 
 TEST_F(TrainHeadlessTest, UnsolvedRunSaysSo)
 {
-  const ProcessRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
+  const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
   EXPECT_EQ(0, run.status);
   EXPECT_TRUE(std::regex_match(run.lastLine(), std::regex("solved=false episodes=5 steps=[0-9]+ wall_s=[0-9.]+")))
       << run.lastLine();
@@ -109,17 +88,17 @@ TEST_F(TrainHeadlessTest, UnsolvedRunSaysSo)
 
 TEST_F(TrainHeadlessTest, BadConfigStopsWithTheKeyTheValueAndTheRange)
 {
-  const ProcessRun bad_value = trainHeadless("--config " + file("bad.yaml", "learning:\n  gamma: 2.0\n"));
+  const CommandRun bad_value = trainHeadless("--config " + file("bad.yaml", "learning:\n  gamma: 2.0\n"));
   EXPECT_EQ(2, bad_value.status);
   EXPECT_NE(std::string::npos, bad_value.output.find("learning/gamma = 2 is not allowed (must be in [0, 1])"))
       << bad_value.output;
   EXPECT_EQ(std::string::npos, bad_value.output.find("solved="));
 
-  const ProcessRun typo = trainHeadless("--config " + file("typo.yaml", "task:\n  max_steps: 200\n"));
+  const CommandRun typo = trainHeadless("--config " + file("typo.yaml", "task:\n  max_steps: 200\n"));
   EXPECT_EQ(2, typo.status);
   EXPECT_NE(std::string::npos, typo.output.find("unknown key task/max_steps")) << typo.output;
 
-  const ProcessRun missing = trainHeadless("--config " + file("nope.yaml"));
+  const CommandRun missing = trainHeadless("--config " + file("nope.yaml"));
   EXPECT_EQ(2, missing.status);
   EXPECT_NE(std::string::npos, missing.output.find("nope.yaml: cannot be read")) << missing.output;
 }

@@ -1,0 +1,59 @@
+// Helpers the tests share, without ROS: running a command as a user would, reading a file.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/wait.h>
+
+namespace cartpole_qlearning
+{
+namespace test
+{
+struct CommandRun
+{
+  int status = -1;     // the exit status; -1 when the command did not exit normally
+  std::string output;  // stdout and stderr together
+  double seconds = 0.0;
+
+  std::string lastLine() const
+  {
+    std::string text = output;
+    while (!text.empty() && text.back() == '\n')
+      text.pop_back();
+    return text.substr(text.find_last_of('\n') + 1);
+  }
+};
+
+// Runs a shell command, its stderr joined to its stdout, and waits for it.
+inline CommandRun runCommand(const std::string& command)
+{
+  CommandRun run;
+  const auto start = std::chrono::steady_clock::now();
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr)
+    return run;
+  std::array<char, 4096> buffer;
+  std::size_t n;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.output.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+inline std::string readFile(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace test
+}  // namespace cartpole_qlearning
