@@ -2,14 +2,23 @@
 # Sets everything up (scripts/setup.sh), builds and runs every test (gtest and rostest), and
 # ends with one line "N passed, N failed" counting every test case.
 set -eo pipefail
+# Whatever stops this script early (set-up, the build) still ends with the summary line.
+trap 'echo "0 passed, 1 failed"' EXIT
 # shellcheck disable=SC1091
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 set -eo pipefail
 cd "$CARTPOLE_WS"
 rm -rf build/test_results/cartpole_qlearning
-echo "[test] catkin_make run_tests (log in $CARTPOLE_WS/test.log)"
+echo "[test] catkin_make tests, then run_tests (log in $CARTPOLE_WS/test.log)"
+# A test that does not compile is a failure, not a test fewer.
+if ! catkin_make tests -DCMAKE_BUILD_TYPE=Release >"$CARTPOLE_WS/test.log" 2>&1; then
+  grep -E "error|Error" "$CARTPOLE_WS/test.log" | head -n 20
+  echo "[test] the tests do not build (log: $CARTPOLE_WS/test.log)"
+  exit 1
+fi
+trap - EXIT
 # run_tests keeps going past failing tests; the results files say what failed.
-catkin_make run_tests -DCMAKE_BUILD_TYPE=Release >"$CARTPOLE_WS/test.log" 2>&1 || true
+catkin_make run_tests -DCMAKE_BUILD_TYPE=Release >>"$CARTPOLE_WS/test.log" 2>&1 || true
 if ! ls build/test_results/cartpole_qlearning/*.xml >/dev/null 2>&1; then
   tail -n 60 "$CARTPOLE_WS/test.log"
   echo "[test] no test results were produced (the build of the tests failed?)"

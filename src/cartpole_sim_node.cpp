@@ -37,16 +37,11 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
   joint_state_.velocity.assign(2, 0.0);
   joint_state_.effort.assign(2, 0.0);
 
-  // Lockstep: a state published before a subscriber connected never reached it. A subscriber
-  // that connects while a state waits for its answer gets that state, and only it: the others
-  // have it already, and a controller that got it twice might answer twice.
-  joint_state_pub_ =
-      nh_.advertise<sensor_msgs::JointState>("joint_states", 10, [this](const ros::SingleSubscriberPublisher& pub) {
-        if (mode_ != Mode::Lockstep)
-          return;
-        pub.publish(joint_state_);
-        state_heard_ = true;
-      });
+  // A state that reaches no controller (one that subscribes late or restarts) is sent again
+  // after lockstep_timeout, unchanged. (Not from a subscriber-connect callback: roscpp runs it
+  // some time after the link is up, and in a nodelet manager its copy can overtake or trail the
+  // normal one, so a controller would see old states arrive late.)
+  joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
   if (mode_ == Mode::Lockstep)
     clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
@@ -117,7 +112,11 @@ void CartPoleSimNode::readParameters()
   for (const std::string* frame : {&world_frame_, &cart_frame_, &pole_frame_})
   {
     if (frame->empty())
-      refuseParameter(pnh_, "world_frame/cart_frame/pole_frame", "''", "frame names must not be empty");
+      refuseParameter(pnh_,
+                      frame == &world_frame_  ? "world_frame"
+                      : frame == &cart_frame_ ? "cart_frame"
+                                              : "pole_frame",
+                      "''", "frame names must not be empty");
   }
 }
 
@@ -145,13 +144,6 @@ void CartPoleSimNode::onEffort(const std_msgs::Float64ConstPtr& msg)
     held_effort_ = effort;
     held_since_ = std::chrono::steady_clock::now();
     have_command_ = true;
-    return;
-  }
-  if (!state_heard_)
-  {
-    // Nobody was subscribed when the pending state went out, so this command answers an older
-    // state (e.g. from a controller that outlived a restart of this node).
-    ROS_DEBUG("cartpole_sim: ignored a command sent before anyone received the pending state");
     return;
   }
   advance(effort);
@@ -256,7 +248,6 @@ void CartPoleSimNode::publishState(bool repeat)
     }
     joint_state_.effort[0] = simulation_->appliedForce();
     joint_state_.effort[1] = 0.0;  // the pole joint is not actuated
-    state_heard_ = false;
   }
   const ros::Time stamp = joint_state_.header.stamp;
   if (mode_ == Mode::Lockstep)
@@ -267,8 +258,6 @@ void CartPoleSimNode::publishState(bool repeat)
   }
   published_at_ = wall_now;
   repeat_armed_ = false;
-  if (joint_state_pub_.getNumSubscribers() > 0)
-    state_heard_ = true;
   joint_state_pub_.publish(joint_state_);
 
   if (!publish_tf_ || repeat)  // tf2 refuses a second transform with the same stamp

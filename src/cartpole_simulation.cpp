@@ -33,7 +33,6 @@ const CartPoleState& CartPoleSimulation::step(double force)
 {
   applied_force_ = dynamics_.clampForce(force);
   state_ = dynamics_.step(state_, applied_force_);
-  ++step_count_;
   return state_;
 }
 

@@ -67,18 +67,9 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   }
 
   started_ = last_episode_end_ = last_state_at_ = last_progress_ = std::chrono::steady_clock::now();
-  // The first subscriber to connect after an answer that reached nobody (the sim subscribed
-  // after we answered) gets that answer, and only it. roscpp runs this callback some time after
-  // the connection is made, and answers published meanwhile have reached the subscriber: hence
-  // only an answer that went out with no subscriber at all is sent again, never a second copy.
-  effort_pub_ = nh_.advertise<std_msgs::Float64>("cart_effort", 10, [this](const ros::SingleSubscriberPublisher& pub) {
-    if (!answer_unheard_ || !have_stamp_ || awaiting_reset_ || !session_->inEpisode())
-      return;
-    std_msgs::Float64 msg;
-    msg.data = last_effort_;
-    pub.publish(msg);
-    answer_unheard_ = false;
-  });
+  // An answer that went out while the sim was not yet subscribed is sent again when the sim
+  // repeats the state (see onJointState).
+  effort_pub_ = nh_.advertise<std_msgs::Float64>("cart_effort", 10);
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
   save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
   load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
@@ -119,6 +110,15 @@ void QLearningControllerNode::readParameters()
   config_ = readTrainingConfig(shared);
 
   const RosParameterSource priv(pnh_);
+  // The launch files' stop_when_solved and max_episodes arrive as private parameters; they
+  // override the shared training/ keys for this controller only.
+  config_.limits.stop_when_solved = valueOr(priv, "stop_when_solved", config_.limits.stop_when_solved);
+  const std::int64_t max_episodes =
+      valueOr<std::int64_t>(priv, "max_episodes", static_cast<std::int64_t>(config_.limits.max_episodes));
+  if (max_episodes < 1)
+    refuseParameter(pnh_, "max_episodes", std::to_string(max_episodes), "must be a whole number >= 1");
+  config_.limits.max_episodes = static_cast<std::uint64_t>(max_episodes);
+
   const std::string mode = valueOr<std::string>(priv, "mode", "train");
   if (mode != "train" && mode != "evaluate")
     refuseParameter(pnh_, "mode", "'" + mode + "'", "allowed: train, evaluate");
@@ -246,6 +246,13 @@ void QLearningControllerNode::onJointState(const sensor_msgs::JointStateConstPtr
 
   if (!session_->inEpisode())
   {
+    // Joining a sim that waits on a fallen pole (another controller's episode ended there):
+    // nothing to learn from it, ask for a fresh start.
+    if (session_->task().isTerminal(state))
+    {
+      requestReset();
+      return;
+    }
     command(session_->beginEpisode(state));
     return;
   }
@@ -300,6 +307,16 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp)
 
   if (learning_)
   {
+    if (finish && saved.rfind("nothing written", 0) == 0)
+    {
+      // Keep the trained table alive: the user can still save it elsewhere with ~save_q_table.
+      ROS_ERROR(
+          "qlearning_controller: training ended (%s, episode %llu) but the table could not be saved: %s. "
+          "The node keeps running: call ~save_q_table with another path",
+          s.solved ? "solved" : "max_episodes", static_cast<unsigned long long>(s.episode), saved.c_str());
+      finished_training_ = true;
+      return;
+    }
     if (finish)
     {
       ROS_INFO(

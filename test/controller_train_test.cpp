@@ -28,7 +28,6 @@ using cartpole_qlearning::test::spinUntil;
 
 namespace
 {
-// Spins until the predicate holds or the wall timeout passes.
 std::string qTableDir()
 {
   std::string dir;
@@ -63,9 +62,10 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
   const EpisodeStats& solved = stats_.back();
   EXPECT_GE(solved.mean_return_100, 475.0);
   EXPECT_GE(solved.episode, 100u);
-  // Episodes are numbered 1, 2, 3, ... and none was lost.
-  for (std::size_t i = 0; i < stats_.size(); ++i)
-    ASSERT_EQ(i + 1, stats_[i].episode);
+  // Episodes are numbered one after the other and none was lost (early ones may end before
+  // this test node has subscribed).
+  for (std::size_t i = 1; i < stats_.size(); ++i)
+    ASSERT_EQ(stats_[i - 1].episode + 1, stats_[i].episode);
 
   // 2. The controller saved the table on solving, and it is train_headless's, byte for byte.
   const std::string trained = qTableDir() + "/trained.yaml";

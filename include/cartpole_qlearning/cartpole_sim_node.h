@@ -78,7 +78,6 @@ private:
   // Lockstep: the last published state always awaits its answer, since this wall time.
   std::chrono::steady_clock::time_point published_at_;
   bool repeat_armed_ = false;  // a timer tick already found the state unanswered past the timeout
-  bool state_heard_ = false;   // the pending state reached at least one subscriber
   std::chrono::steady_clock::time_point last_tf_;
   sensor_msgs::JointState joint_state_;  // the last state published (repeats send it again)
   mutable WallThrottle nonfinite_warning_{1.0};

@@ -28,10 +28,6 @@ public:
   {
     return applied_force_;
   }
-  std::uint64_t stepCount() const
-  {
-    return step_count_;
-  }
 
   // Draws x, x_dot, theta, theta_dot in that order from the environment stream.
   const CartPoleState& resetRandom();
@@ -46,7 +42,6 @@ private:
   RandomStream rng_;
   CartPoleState state_ = CartPoleState::Zero();
   double applied_force_ = 0.0;
-  std::uint64_t step_count_ = 0;
 };
 
 }  // namespace cartpole_qlearning

@@ -40,10 +40,6 @@ public:
   {
     return session_;
   }
-  const CartPoleSimulation& simulation() const
-  {
-    return simulation_;
-  }
 
 private:
   TrainingConfig config_;

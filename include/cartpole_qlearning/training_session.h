@@ -60,10 +60,6 @@ public:
   {
     return last_;
   }
-  bool solved() const
-  {
-    return last_.solved;
-  }
   std::uint64_t episodesEnded() const
   {
     return last_.episode;
@@ -76,10 +72,6 @@ public:
   const QLearningAgent& agent() const
   {
     return agent_;
-  }
-  bool learning() const
-  {
-    return learning_;
   }
 
   // The table with its training counters brought up to date.
