@@ -1,0 +1,106 @@
+// A sim or a controller that dies and comes back: training goes on in lockstep (the sim's
+// repeats reach the new controller; the controller notices the silent sim, reconnects its
+// reset client and starts a new episode on the restarted sim's states).
+#include "cartpole_qlearning/EpisodeStats.h"
+#include "ros_test_support.h"
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+using cartpole_qlearning::test::spinUntil;
+
+namespace
+{
+// Starts an executable with ROS arguments; returns its pid.
+pid_t start(const std::string& executable, const std::vector<std::string>& args)
+{
+  const pid_t pid = ::fork();
+  if (pid == 0)
+  {
+    std::vector<char*> argv{const_cast<char*>(executable.c_str())};
+    for (const std::string& a : args)
+      argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(executable.c_str(), argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+void stop(pid_t pid, int signal)
+{
+  ::kill(pid, signal);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+}
+
+std::string tableDir()
+{
+  std::string dir;
+  ros::param::get("~q_table_dir", dir);
+  return dir;
+}
+}  // namespace
+
+TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
+{
+  ros::NodeHandle nh;
+  std::size_t episodes = 0;
+  bool silent_reported = false;
+  ros::Subscriber stats = nh.subscribe<cartpole_qlearning::EpisodeStats>(
+      "/restart/episode_stats", 1000,
+      boost::function<void(const cartpole_qlearning::EpisodeStatsConstPtr&)>(
+          [&](const cartpole_qlearning::EpisodeStatsConstPtr&) { ++episodes; }));
+  ros::Subscriber log = nh.subscribe<rosgraph_msgs::Log>(
+      "/rosout", 1000,
+      boost::function<void(const rosgraph_msgs::LogConstPtr&)>([&](const rosgraph_msgs::LogConstPtr& m) {
+        silent_reported = silent_reported || m->msg.find("no joint_states") != std::string::npos;
+      }));
+
+  const std::vector<std::string> sim_args = {"__ns:=/restart", "__name:=cartpole_sim", "_mode:=lockstep",
+                                             "_publish_tf:=false", "_lockstep_timeout:=0.3"};
+  const std::vector<std::string> controller_args = {"__ns:=/restart",           "__name:=qlearning_controller",
+                                                    "_sim_timeout:=1.0",        "_checkpoint_every:=0",
+                                                    "_save_on_shutdown:=false", "_max_episodes:=1000000",
+                                                    "_stop_when_solved:=false", "_q_table_dir:=" + tableDir()};
+  pid_t sim = start(CARTPOLE_SIM, sim_args);
+  pid_t controller = start(QLEARNING_CONTROLLER, controller_args);
+  ASSERT_TRUE(spinUntil([&] { return episodes >= 20; }, 30.0)) << "training does not start: " << episodes;
+
+  // The sim dies: the controller says so; a new sim comes and training goes on.
+  stop(sim, SIGKILL);
+  EXPECT_TRUE(spinUntil([&] { return silent_reported; }, 15.0)) << "the silent sim was not reported";
+  sim = start(CARTPOLE_SIM, sim_args);
+  std::size_t seen = episodes;
+  EXPECT_TRUE(spinUntil([&] { return episodes >= seen + 20; }, 30.0))
+      << "training did not resume after the sim restarted: " << episodes - seen << " episodes";
+
+  // The controller dies in the middle of an episode: a new one picks up the waiting state.
+  stop(controller, SIGKILL);
+  controller = start(QLEARNING_CONTROLLER, controller_args);
+  seen = episodes;
+  EXPECT_TRUE(spinUntil([&] { return episodes >= seen + 20; }, 30.0))
+      << "training did not resume after the controller restarted: " << episodes - seen << " episodes";
+
+  stop(controller, SIGINT);
+  stop(sim, SIGINT);
+}
+
+int main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "restart_test");
+  ros::NodeHandle nh;
+  const int result = RUN_ALL_TESTS();
+  std::filesystem::remove_all(tableDir());
+  return result;
+}
