@@ -72,17 +72,9 @@ PIDS=()
 OK=false
 cleanup()
 {
-  local pid i
+  local i
   for ((i = ${#PIDS[@]} - 1; i >= 0; i--)); do
-    kill -INT -- "-${PIDS[i]}" 2>/dev/null || true
-  done
-  for pid in "${PIDS[@]}"; do
-    for _ in $(seq 50); do
-      kill -0 -- "-$pid" 2>/dev/null || break
-      sleep 0.1
-    done
-    kill -KILL -- "-$pid" 2>/dev/null || true
-    wait "$pid" 2>/dev/null || true
+    stop "${PIDS[i]}"
   done
   if $OK && [[ "${BENCH_KEEP_LOGS:-0}" != 1 ]]; then
     rm -rf "$WORK"

@@ -22,7 +22,7 @@ DEBIAN_PACKAGES=(
   rosbash python3-roslaunch python3-rostopic python3-rosservice python3-rosnode
   libroscpp-dev libroslib-dev libsensor-msgs-dev libstd-msgs-dev libgeometry-msgs-dev
   libros-rosgraph-msgs-dev libtf2-ros-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev libeigen3-dev libyaml-cpp-dev
-  libgtest-dev libbenchmark-dev catkin-lint
+  libgtest-dev libbenchmark-dev catkin-lint rviz
 )
 
 install_dependencies() {
