@@ -223,6 +223,36 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
   EXPECT_TRUE(spinUntil([&] { return commands == 2; }, 10.0));
 }
 
+TEST(ControllerServices, ARepeatedStateIsNotAnsweredTwice)
+{
+  // cart_effort carries no stamp: a second answer to one state would be taken by the sim for
+  // its next state's. A repeat of a state whose answer reached a subscriber gets no answer; a
+  // new state does.
+  ros::NodeHandle nh;
+  int commands = 0;
+  ros::Subscriber effort = nh.subscribe<std_msgs::Float64>(
+      "/alone/cart_effort", 100,
+      boost::function<void(const std_msgs::Float64ConstPtr&)>([&](const std_msgs::Float64ConstPtr&) { ++commands; }));
+  ros::Publisher states = nh.advertise<sensor_msgs::JointState>("/alone/joint_states", 10);
+  ASSERT_TRUE(spinUntil([&] { return states.getNumSubscribers() > 0 && effort.getNumPublishers() > 0; }, 20.0));
+
+  sensor_msgs::JointState msg;
+  msg.name = {"cart_joint", "pole_joint"};
+  msg.position = {0.0, 0.02};
+  msg.velocity = {0.0, 0.0};
+  msg.header.stamp = ros::Time(100.0);  // later than anything the earlier tests sent
+  states.publish(msg);
+  ASSERT_TRUE(spinUntil([&] { return commands == 1; }, 10.0)) << "a new state was not answered";
+  states.publish(msg);  // the same stamp again, as the sim repeats an unanswered state
+  states.publish(msg);
+  spinUntil([] { return false; }, 1.0);
+  EXPECT_EQ(1, commands) << "a repeated state was answered again";
+  msg.header.stamp = ros::Time(100.02);
+  msg.position[1] = 0.021;
+  states.publish(msg);
+  EXPECT_TRUE(spinUntil([&] { return commands == 2; }, 10.0)) << "the next state was not answered";
+}
+
 int main(int argc, char** argv)
 {
   ::testing::InitGoogleTest(&argc, argv);
