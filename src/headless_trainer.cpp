@@ -27,7 +27,7 @@ TrainingResult HeadlessTrainer::run(const std::function<void(const EpisodeSummar
 {
   const auto start = std::chrono::steady_clock::now();
   TrainingResult result;
-  while (result.episodes < config_.limits.max_episodes)
+  for (;;)
   {
     const EpisodeSummary& summary = runEpisode();
     result.episodes = summary.episode;
@@ -35,7 +35,7 @@ TrainingResult HeadlessTrainer::run(const std::function<void(const EpisodeSummar
     result.solved = result.solved || summary.solved;
     if (on_episode)
       on_episode(summary);
-    if (result.solved && config_.limits.stop_when_solved)
+    if (config_.limits.reached(summary.episode, summary.solved))
       break;
   }
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

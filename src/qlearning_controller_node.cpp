@@ -274,7 +274,7 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp)
   // When training ends here, the table is saved before episode_stats says so: whoever acts on
   // the last message finds the final file.
   const TrainingLimits& limits = config_.limits;
-  const bool finish = learning_ && ((s.solved && limits.stop_when_solved) || s.episode >= limits.max_episodes);
+  const bool finish = learning_ && limits.reached(s.episode, s.solved);
   std::string saved;
   if (finish)
     save("", saved);
@@ -297,10 +297,8 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp)
   if (limits.progress_every > 0 && s.episode % limits.progress_every == 0)
   {
     const double interval = secondsSince(last_progress_);
-    ROS_INFO("episode %6llu  mean_return_%u %7.2f  epsilon %.3f  alpha %.3f  steps/s %7.0f  time %.1f s",
-             static_cast<unsigned long long>(s.episode), config_.task.solved_window, s.mean_return_window, s.epsilon,
-             s.alpha, interval > 0.0 ? (s.total_steps - steps_at_last_progress_) / interval : 0.0,
-             secondsSince(started_));
+    const double rate = interval > 0.0 ? (s.total_steps - steps_at_last_progress_) / interval : 0.0;
+    ROS_INFO("%s", progressLine(s, config_.task.solved_window, rate, secondsSince(started_)).c_str());
     steps_at_last_progress_ = s.total_steps;
     last_progress_ = std::chrono::steady_clock::now();
   }

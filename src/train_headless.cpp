@@ -125,14 +125,13 @@ int main(int argc, char** argv)
   std::uint64_t last_steps = 0;
   auto last_time = start;
   const TrainingResult result = trainer.run([&](const EpisodeSummary& s) {
-    if (every == 0 || (s.episode % every != 0 && !(s.solved && config.limits.stop_when_solved)))
+    if (every == 0 || (s.episode % every != 0 && !config.limits.reached(s.episode, s.solved)))
       return;
     const auto now = std::chrono::steady_clock::now();
     const double interval = std::chrono::duration<double>(now - last_time).count();
     const double rate = interval > 0.0 ? static_cast<double>(s.total_steps - last_steps) / interval : 0.0;
-    std::printf("episode %6llu  mean_return_%u %7.2f  epsilon %.3f  alpha %.3f  steps/s %9.0f  time %.2f s\n",
-                static_cast<unsigned long long>(s.episode), config.task.solved_window, s.mean_return_window, s.epsilon,
-                s.alpha, rate, std::chrono::duration<double>(now - start).count());
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    std::printf("%s\n", progressLine(s, config.task.solved_window, rate, elapsed).c_str());
     last_steps = s.total_steps;
     last_time = now;
   });

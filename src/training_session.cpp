@@ -1,7 +1,19 @@
 #include "cartpole_qlearning/training_session.h"
 
+#include <cstdio>
+
 namespace cartpole_qlearning
 {
+std::string progressLine(const EpisodeSummary& s, unsigned window, double steps_per_second, double elapsed_s)
+{
+  char line[160];
+  std::snprintf(line, sizeof line,
+                "episode %6llu  mean_return_%u %7.2f  epsilon %.3f  alpha %.3f  steps/s %9.0f  time %.2f s",
+                static_cast<unsigned long long>(s.episode), window, s.mean_return_window, s.epsilon, s.alpha,
+                steps_per_second, elapsed_s);
+  return line;
+}
+
 TrainingSession::TrainingSession(const TaskParams& task, const AgentParams& agent, std::uint64_t seed, bool learning)
   : task_(task), agent_(agent, seed), learning_(learning)
 {

@@ -62,6 +62,12 @@ struct TrainingLimits
   std::uint64_t max_episodes = 1000;  // stop after this many episodes, solved or not
   bool stop_when_solved = true;       // stop at the first solved episode
   std::uint64_t progress_every = 50;  // a progress line every this many episodes (0: none)
+
+  // Whether training ends after the episode that made `episodes` in all, `solved` or not.
+  bool reached(std::uint64_t episodes, bool solved) const
+  {
+    return (solved && stop_when_solved) || episodes >= max_episodes;
+  }
 };
 
 struct TrainingConfig

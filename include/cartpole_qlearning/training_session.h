@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <string>
 
 namespace cartpole_qlearning
 {
@@ -32,6 +33,9 @@ struct Decision
   std::size_t action = 0;  // the next action, when the episode goes on
   double effort = 0.0;     // its effort [N]
 };
+
+// The progress line train_headless and the controller print every few episodes.
+std::string progressLine(const EpisodeSummary& summary, unsigned window, double steps_per_second, double elapsed_s);
 
 class TrainingSession
 {
