@@ -6,118 +6,112 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <rosgraph_msgs/Clock.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace cartpole_qlearning
 {
 namespace
 {
-std::string text(double value)
+WallClock::duration wallDuration(double s)
 {
-  std::ostringstream out;
-  out << value;
-  return out.str();
+  return std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(s));
 }
 
-std::chrono::duration<double> seconds(double s)
+ros::Time toRosTime(Stamp stamp)
 {
-  return std::chrono::duration<double>(s);
+  ros::Time time;
+  time.fromNSec(stamp);
+  return time;
 }
 }  // namespace
 
-CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh) : nh_(nh), pnh_(pnh)
+CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
+                                 ros::CallbackQueue* command_queue)
+  : nh_(nh), pnh_(pnh)
 {
+  const std::lock_guard<std::mutex> lock(mutex_);
   readParameters();
   simulation_ = std::make_unique<CartPoleSimulation>(physics_, start_state_bound_, seed_);
   noise_ = std::make_unique<RandomStream>(seed_, kNoiseStream);
 
-  joint_state_.name = {"cart_joint", "pole_joint"};
-  joint_state_.position.assign(2, 0.0);
-  joint_state_.velocity.assign(2, 0.0);
-  joint_state_.effort.assign(2, 0.0);
-
-  // A state that reaches no controller (one that subscribes late or restarts) is sent again
-  // after lockstep_timeout, unchanged. (Not from a subscriber-connect callback: roscpp runs it
-  // some time after the link is up, and in a nodelet manager its copy can overtake or trail the
-  // normal one, so a controller would see old states arrive late.)
-  joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
   if (mode_ == Mode::Lockstep)
+    joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>(
+        "joint_states", 10, [this](const ros::SingleSubscriberPublisher& subscriber) { onSubscriberConnect(subscriber); });
+  else
+    joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
+  if (publish_clock_)
     clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  ros::NodeHandle command_nh(nh_);
+  if (command_queue != nullptr)
+    command_nh.setCallbackQueue(command_queue);
   // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
-  effort_sub_ = nh_.subscribe("cart_effort", 10, &CartPoleSimNode::onEffort, this, ros::TransportHints().tcpNoDelay());
+  command_sub_ = command_nh.subscribe("joint_command", 10, &CartPoleSimNode::onJointCommand, this,
+                                      ros::TransportHints().tcpNoDelay());
+  effort_sub_ =
+      command_nh.subscribe("cart_effort", 10, &CartPoleSimNode::onEffort, this, ros::TransportHints().tcpNoDelay());
   reset_srv_ = pnh_.advertiseService("reset", &CartPoleSimNode::onReset, this);
 
   // The first state: a random start, which takes one tick of sim time like every reset.
   simulation_->resetRandom();
   if (mode_ == Mode::Lockstep)
   {
-    sim_time_ = ros::Time(0) + ros::Duration(physics_.tau);
-    timer_ = nh_.createSteadyTimer(ros::WallDuration(lockstep_timeout_ / 2), &CartPoleSimNode::onLockstepTimeout, this);
+    lockstep_ = std::make_unique<SimProtocol>(tickOf(physics_.tau), wallDuration(lockstep_timeout_));
+    // A state that reaches no controller (one that subscribes late or restarts) is sent again
+    // after lockstep_timeout; the timer looks twice per timeout.
+    timer_ = nh_.createSteadyTimer(ros::WallDuration(lockstep_timeout_ / 2), &CartPoleSimNode::onLockstepTimer, this);
+    publishState(toRosTime(lockstep_->start(WallClock::now())));
   }
   else
   {
+    hold_ = std::make_unique<CommandHold>(wallDuration(command_timeout_));
     timer_ = nh_.createSteadyTimer(ros::WallDuration(physics_.tau), &CartPoleSimNode::onRealtimeTick, this);
+    publishState(ros::Time::now());
   }
-  publishState();
-  ROS_INFO("cartpole_sim: %s mode, tau %g s, integrator %s, seed %llu, start state [%g, %g, %g, %g]",
+  ROS_INFO("cartpole_sim: %s mode, tau %g s, integrator %s, seed %llu, start state [%g, %g, %g, %g]%s",
            mode_ == Mode::Lockstep ? "lockstep" : "realtime", physics_.tau, toString(physics_.integrator).c_str(),
            static_cast<unsigned long long>(seed_), simulation_->state()[0], simulation_->state()[1],
-           simulation_->state()[2], simulation_->state()[3]);
+           simulation_->state()[2], simulation_->state()[3], publish_clock_ ? ", publishing /clock" : "");
 }
 
 void CartPoleSimNode::readParameters()
 {
   readPhysics(RosParameterSource(nh_), physics_, start_state_bound_);
 
-  const RosParameterSource priv(pnh_);
-  const std::string mode = valueOr<std::string>(priv, "mode", "realtime");
-  if (mode == "realtime")
-    mode_ = Mode::Realtime;
-  else if (mode == "lockstep")
-    mode_ = Mode::Lockstep;
-  else
-    refuseParameter(pnh_, "mode", "'" + mode + "'", "allowed: realtime, lockstep");
-
-  const std::int64_t seed = valueOr<std::int64_t>(priv, "seed", 0);
-  if (seed < 0)
-    refuseParameter(pnh_, "seed", std::to_string(seed), "must be a whole number >= 0");
-  seed_ = static_cast<std::uint64_t>(seed);
-
-  const auto positive = [&](const char* name, double& value) {
-    value = valueOr(priv, name, value);
-    if (!(std::isfinite(value) && value > 0.0))
-      refuseParameter(pnh_, name, text(value), "must be finite and > 0");
-  };
-  const auto non_negative = [&](const char* name, double& value) {
-    value = valueOr(priv, name, value);
-    if (!(std::isfinite(value) && value >= 0.0))
-      refuseParameter(pnh_, name, text(value), "must be finite and >= 0");
-  };
-  positive("command_timeout", command_timeout_);
-  positive("lockstep_timeout", lockstep_timeout_);
-  positive("tf_rate", tf_rate_);
+  // Private parameters: the same reader and checks as the shared sections; a key it does not
+  // know (a typo such as lockstep_timout) stops the node instead of being ignored.
+  const RosParameterSource source(pnh_);
+  SectionReader priv(source, "");
+  std::string mode = "realtime";
+  priv.readChoice("mode", mode, {"realtime", "lockstep"});
+  mode_ = mode == "lockstep" ? Mode::Lockstep : Mode::Realtime;
+  priv.read("seed", seed_, 0);
+  priv.readAtLeast("command_timeout", command_timeout_, 0.0, true);
+  priv.readAtLeast("lockstep_timeout", lockstep_timeout_, 0.0, true);
+  priv.readAtLeast("tf_rate", tf_rate_, 0.0, true);
   effort_limit_ = physics_.force_mag;
-  positive("effort_limit", effort_limit_);
+  priv.readAtLeast("effort_limit", effort_limit_, 0.0, true);
   if (effort_limit_ > physics_.force_mag)
-    refuseParameter(pnh_, "effort_limit", text(effort_limit_),
-                    "must be <= physics/force_mag = " + text(physics_.force_mag));
-  non_negative("position_noise_std", position_noise_std_);
-  non_negative("velocity_noise_std", velocity_noise_std_);
-  non_negative("effort_noise_std", effort_noise_std_);
-  publish_tf_ = valueOr(priv, "publish_tf", publish_tf_);
-  world_frame_ = valueOr(priv, "world_frame", world_frame_);
-  cart_frame_ = valueOr(priv, "cart_frame", cart_frame_);
-  pole_frame_ = valueOr(priv, "pole_frame", pole_frame_);
-  for (const std::string* frame : {&world_frame_, &cart_frame_, &pole_frame_})
+    priv.fail("effort_limit", SectionReader::numberText(effort_limit_),
+              "must be <= physics/force_mag = " + SectionReader::numberText(physics_.force_mag));
+  priv.readAtLeast("position_noise_std", position_noise_std_, 0.0, false);
+  priv.readAtLeast("velocity_noise_std", velocity_noise_std_, 0.0, false);
+  priv.readAtLeast("effort_noise_std", effort_noise_std_, 0.0, false);
+  priv.read("publish_clock", publish_clock_);
+  priv.read("publish_tf", publish_tf_);
+  for (const auto& [name, frame] : {std::pair<const char*, std::string*>{"world_frame", &world_frame_},
+                                    {"cart_frame", &cart_frame_},
+                                    {"pole_frame", &pole_frame_}})
   {
+    priv.read(name, *frame);
     if (frame->empty())
-      refuseParameter(pnh_,
-                      frame == &world_frame_  ? "world_frame"
-                      : frame == &cart_frame_ ? "cart_frame"
-                                              : "pole_frame",
-                      "''", "frame names must not be empty");
+      priv.fail(name, "''", "frame names must not be empty");
   }
+  priv.refuseUnknown();
+  if (publish_clock_ && mode_ != Mode::Lockstep)
+    priv.fail("publish_clock", "true", "only in lockstep mode: in realtime the wall clock is the clock");
 }
 
 bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
@@ -125,7 +119,7 @@ bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
   if (!std::isfinite(requested))
   {
     if (nonfinite_warning_.ready())
-      ROS_WARN("cartpole_sim: refused a non-finite effort (%f) on %s", requested, effort_sub_.getTopic().c_str());
+      ROS_WARN("cartpole_sim: refused a non-finite effort (%f)", requested);
     return false;
   }
   effort = std::clamp(requested, -effort_limit_, effort_limit_);
@@ -134,58 +128,108 @@ bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
   return true;
 }
 
+void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
+{
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = std::find(msg->name.begin(), msg->name.end(), "cart_joint");
+  const std::size_t index = static_cast<std::size_t>(it - msg->name.begin());
+  if (it == msg->name.end() || msg->effort.size() != msg->name.size())
+  {
+    if (bad_command_warning_.ready())
+      ROS_WARN("cartpole_sim: dropped a joint_command without an effort for cart_joint (names: %zu, efforts: %zu)",
+               msg->name.size(), msg->effort.size());
+    return;
+  }
+  double effort = 0.0;
+  if (!acceptEffort(msg->effort[index], effort))
+    return;
+  const WallClock::time_point now = WallClock::now();
+  if (mode_ == Mode::Realtime)
+  {
+    if (!hold_->set(effort, msg->header.stamp.toNSec(), now))
+      ROS_DEBUG("cartpole_sim: dropped a joint_command older than the one held");
+    return;
+  }
+  apply(lockstep_->onCommand(msg->header.stamp.toNSec(), now), effort, msg->header.stamp);
+}
+
 void CartPoleSimNode::onEffort(const std_msgs::Float64ConstPtr& msg)
 {
+  const std::lock_guard<std::mutex> lock(mutex_);
   double effort = 0.0;
   if (!acceptEffort(msg->data, effort))
     return;
+  const WallClock::time_point now = WallClock::now();
   if (mode_ == Mode::Realtime)
   {
-    held_effort_ = effort;
-    held_since_ = std::chrono::steady_clock::now();
-    have_command_ = true;
+    hold_->set(effort, 0, now);
     return;
   }
-  advance(effort);
+  apply(lockstep_->onUnstampedCommand(now), effort, ros::Time());
 }
 
-void CartPoleSimNode::advance(double effort)
+void CartPoleSimNode::apply(SimProtocol::Verdict verdict, double effort, const ros::Time& answers)
+{
+  if (verdict == SimProtocol::Verdict::Step)
+  {
+    advance(effort, toRosTime(lockstep_->pending()));
+    return;
+  }
+  if (!dropped_warning_.ready())
+    return;
+  const SimProtocol::Counts& c = lockstep_->counts();
+  // Stale and duplicate answers are expected now and then (a reset with an answer in flight, a
+  // repeat answered twice); future and unstamped ones come from a misbehaving publisher.
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "cartpole_sim: dropped a joint_command stamped %.6f for the state at %.6f: %s (dropped so far: %llu "
+                "stale, %llu duplicate, %llu future, %llu unstamped)",
+                answers.toSec(), toRosTime(lockstep_->pending()).toSec(), describe(verdict),
+                static_cast<unsigned long long>(c.stale), static_cast<unsigned long long>(c.duplicate),
+                static_cast<unsigned long long>(c.future), static_cast<unsigned long long>(c.unstamped));
+  // Stale and duplicate answers are expected now and then (a reset with an answer in flight, a
+  // repeat answered twice); future and unstamped ones come from a misbehaving publisher.
+  if (verdict == SimProtocol::Verdict::Stale || verdict == SimProtocol::Verdict::Duplicate)
+    ROS_INFO("%s", text);
+  else
+    ROS_WARN("%s", text);
+}
+
+void CartPoleSimNode::advance(double effort, const ros::Time& stamp)
 {
   double force = effort;
   if (effort_noise_std_ > 0.0)
     force = std::clamp(effort + effort_noise_std_ * noise_->normal(), -effort_limit_, effort_limit_);
   simulation_->step(force);
-  if (mode_ == Mode::Lockstep)
-    sim_time_ += ros::Duration(physics_.tau);
-  publishState();
+  publishState(stamp);
 }
 
 void CartPoleSimNode::onRealtimeTick(const ros::SteadyTimerEvent&)
 {
-  const bool fresh = have_command_ && std::chrono::steady_clock::now() - held_since_ <= seconds(command_timeout_);
-  advance(fresh ? held_effort_ : 0.0);
+  const std::lock_guard<std::mutex> lock(mutex_);
+  advance(hold_->effort(WallClock::now()), ros::Time::now());
 }
 
-void CartPoleSimNode::onLockstepTimeout(const ros::SteadyTimerEvent&)
+void CartPoleSimNode::onLockstepTimer(const ros::SteadyTimerEvent&)
 {
-  if (std::chrono::steady_clock::now() - published_at_ < seconds(lockstep_timeout_))
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (!lockstep_->repeatDue(WallClock::now()))
     return;
-  // Late by one tick more: after this process was stalled (a loaded machine), an answer may sit
-  // in the queue behind this timer event; it gets its turn before the next tick. Repeating now
-  // would draw a second answer, which the next state would take for its own.
-  if (!repeat_armed_)
-  {
-    repeat_armed_ = true;
-    return;
-  }
-  // Unanswered: the state or its answer was lost (a late or restarted controller). Send the
-  // same state with the same stamp again; the controller answers it without learning twice.
   ROS_DEBUG("cartpole_sim: no command for %.3f s, publishing the state again", lockstep_timeout_);
-  publishState(true);
+  republishState();
+}
+
+void CartPoleSimNode::onSubscriberConnect(const ros::SingleSubscriberPublisher& subscriber)
+{
+  const std::lock_guard<std::mutex> lock(mutex_);
+  // Harmless to anyone: a controller that already has this state takes it as a repeat.
+  if (joint_state_)
+    subscriber.publish(joint_state_);
 }
 
 bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response)
 {
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (request.state.empty())
   {
     simulation_->resetRandom();
@@ -210,12 +254,10 @@ bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response
                        " values; give none (random start) or 4 (x, x_dot, theta, theta_dot)";
     return true;
   }
-  // A reset takes one tick of sim time, so the new start state never shares a stamp with the
-  // state before it and time never goes backwards.
-  if (mode_ == Mode::Lockstep)
-    sim_time_ += ros::Duration(physics_.tau);
+  // In lockstep a reset takes one tick of sim time, so the new start state never shares a stamp
+  // with the state before it, and an answer to that state still in flight is dropped.
+  publishState(mode_ == Mode::Lockstep ? toRosTime(lockstep_->onReset(WallClock::now())) : ros::Time::now());
   const CartPoleState& s = simulation_->state();
-  publishState();
   std::ostringstream out;
   out.precision(17);
   out << "reset to [" << s[0] << ", " << s[1] << ", " << s[2] << ", " << s[3] << "]";
@@ -224,48 +266,45 @@ bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response
   return true;
 }
 
-void CartPoleSimNode::publishState(bool repeat)
+void CartPoleSimNode::republishState()
 {
-  const auto wall_now = std::chrono::steady_clock::now();
-  if (!repeat)
-  {
-    // A repeat sends this same message again: same stamp, same values, no new noise draws.
-    const CartPoleState& s = simulation_->state();
-    joint_state_.header.stamp = mode_ == Mode::Lockstep ? sim_time_ : ros::Time::now();
-    joint_state_.position[0] = s[0];
-    joint_state_.position[1] = s[2];
-    joint_state_.velocity[0] = s[1];
-    joint_state_.velocity[1] = s[3];
-    if (position_noise_std_ > 0.0)
-    {
-      joint_state_.position[0] += position_noise_std_ * noise_->normal();
-      joint_state_.position[1] += position_noise_std_ * noise_->normal();
-    }
-    if (velocity_noise_std_ > 0.0)
-    {
-      joint_state_.velocity[0] += velocity_noise_std_ * noise_->normal();
-      joint_state_.velocity[1] += velocity_noise_std_ * noise_->normal();
-    }
-    joint_state_.effort[0] = simulation_->appliedForce();
-    joint_state_.effort[1] = 0.0;  // the pole joint is not actuated
-  }
-  const ros::Time stamp = joint_state_.header.stamp;
-  if (mode_ == Mode::Lockstep)
+  if (publish_clock_)
   {
     rosgraph_msgs::Clock clock;
-    clock.clock = stamp;
+    clock.clock = joint_state_->header.stamp;
     clock_pub_.publish(clock);
   }
-  published_at_ = wall_now;
-  repeat_armed_ = false;
   joint_state_pub_.publish(joint_state_);
+}
 
-  if (!publish_tf_ || repeat)  // tf2 refuses a second transform with the same stamp
+void CartPoleSimNode::publishState(const ros::Time& stamp)
+{
+  const CartPoleState& s = simulation_->state();
+  auto msg = boost::make_shared<sensor_msgs::JointState>();
+  msg->header.stamp = stamp;
+  msg->name = {"cart_joint", "pole_joint"};
+  msg->position = {s[0], s[2]};
+  msg->velocity = {s[1], s[3]};
+  msg->effort = {simulation_->appliedForce(), 0.0};  // the pole joint is not actuated
+  if (position_noise_std_ > 0.0)
+  {
+    msg->position[0] += position_noise_std_ * noise_->normal();
+    msg->position[1] += position_noise_std_ * noise_->normal();
+  }
+  if (velocity_noise_std_ > 0.0)
+  {
+    msg->velocity[0] += velocity_noise_std_ * noise_->normal();
+    msg->velocity[1] += velocity_noise_std_ * noise_->normal();
+  }
+  joint_state_ = msg;
+  republishState();
+
+  if (!publish_tf_)
     return;
-  if (mode_ == Mode::Lockstep && wall_now - last_tf_ < seconds(1.0 / tf_rate_))
+  const WallClock::time_point wall_now = WallClock::now();
+  if (mode_ == Mode::Lockstep && wall_now - last_tf_ < wallDuration(1.0 / tf_rate_))
     return;
   last_tf_ = wall_now;
-  const CartPoleState& s = simulation_->state();
   geometry_msgs::TransformStamped cart;
   cart.header.stamp = stamp;
   cart.header.frame_id = world_frame_;

@@ -1,23 +1,89 @@
 // The two nodes as nodelets: the same classes as the executables, in one manager, so states
 // and commands pass as pointers instead of through sockets.
+//
+// The lockstep topics (the sim's commands, the controller's states) of every cartpole nodelet
+// in a manager queue on one callback queue served by one thread of their own. A step is then
+// two callbacks in a row on that thread: a published message waits in the queue until the
+// callback that published it returns, and no thread is ever woken for it. Through the
+// manager's own queues each message would cross threads (its dispatcher, then a worker), which
+// costs about ten times more than the step itself (bench/run_benchmarks.sh). Timers and
+// services stay on the manager's threads; the node classes lock their state for that.
 #include "cartpole_qlearning/cartpole_sim_node.h"
 #include "cartpole_qlearning/qlearning_controller_node.h"
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
+#include <ros/callback_queue.h>
 
+#include <atomic>
 #include <memory>
+#include <mutex>
+#include <thread>
 
 namespace cartpole_qlearning
 {
+namespace
+{
+class LockstepThread
+{
+public:
+  // The manager's one instance, made by its first user and ended with its last.
+  static std::shared_ptr<LockstepThread> acquire()
+  {
+    static std::mutex mutex;
+    static std::weak_ptr<LockstepThread> instance;
+    const std::lock_guard<std::mutex> lock(mutex);
+    std::shared_ptr<LockstepThread> thread = instance.lock();
+    if (!thread)
+    {
+      thread = std::make_shared<LockstepThread>();
+      instance = thread;
+    }
+    return thread;
+  }
+
+  LockstepThread() : thread_([this] { serve(); }) {}
+  ~LockstepThread()
+  {
+    stopping_ = true;
+    thread_.join();
+  }
+  LockstepThread(const LockstepThread&) = delete;
+  LockstepThread& operator=(const LockstepThread&) = delete;
+
+  ros::CallbackQueue* queue()
+  {
+    return &queue_;
+  }
+
+private:
+  void serve()
+  {
+    while (!stopping_ && ros::ok())
+      queue_.callAvailable(ros::WallDuration(0.1));
+  }
+
+  ros::CallbackQueue queue_;
+  std::atomic<bool> stopping_{false};
+  std::thread thread_;
+};
+}  // namespace
+
 class CartPoleSimNodelet : public nodelet::Nodelet
 {
+public:
+  ~CartPoleSimNodelet() override
+  {
+    node_.reset();  // before the thread that serves its callbacks
+  }
+
 private:
   void onInit() override
   {
     try
     {
-      node_ = std::make_unique<CartPoleSimNode>(getNodeHandle(), getPrivateNodeHandle());
+      lockstep_ = LockstepThread::acquire();
+      node_ = std::make_unique<CartPoleSimNode>(getNodeHandle(), getPrivateNodeHandle(), lockstep_->queue());
     }
     catch (const std::exception& e)
     {
@@ -26,19 +92,29 @@ private:
     }
   }
 
+  std::shared_ptr<LockstepThread> lockstep_;
   std::unique_ptr<CartPoleSimNode> node_;
 };
 
 class QLearningControllerNodelet : public nodelet::Nodelet
 {
+public:
+  ~QLearningControllerNodelet() override
+  {
+    node_.reset();  // before the thread that serves its callbacks
+  }
+
 private:
   void onInit() override
   {
     try
     {
-      // A nodelet cannot end its manager: when training ends the controller saves, reports
-      // and stops acting; the manager and the other nodelets keep running.
-      node_ = std::make_unique<QLearningControllerNode>(getNodeHandle(), getPrivateNodeHandle(), nullptr);
+      lockstep_ = LockstepThread::acquire();
+      // When training ends the controller saves, reports and stops acting; the manager and the
+      // other nodelets keep running unless ~shutdown_when_finished asks to end the manager
+      // (train.launch nodelet:=true, where the manager is the run's own).
+      node_ = std::make_unique<QLearningControllerNode>(
+          getNodeHandle(), getPrivateNodeHandle(), [] { ros::requestShutdown(); }, false, lockstep_->queue());
     }
     catch (const std::exception& e)
     {
@@ -47,6 +123,7 @@ private:
     }
   }
 
+  std::shared_ptr<LockstepThread> lockstep_;
   std::unique_ptr<QLearningControllerNode> node_;
 };
 

@@ -4,9 +4,8 @@
 #include "cartpole_qlearning/q_table_file.h"
 #include "cartpole_qlearning/ros_parameter_source.h"
 
-#include <std_msgs/Float64.h>
-
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -38,11 +37,14 @@ int jointIndex(const sensor_msgs::JointState& msg, const char* name)
 }  // namespace
 
 QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
-                                                 std::function<void()> finished)
-  : nh_(nh), pnh_(pnh), finished_(std::move(finished))
+                                                 std::function<void()> shutdown, bool shutdown_by_default,
+                                                 ros::CallbackQueue* state_queue)
+  : nh_(nh), pnh_(pnh), shutdown_(std::move(shutdown)), shutdown_when_finished_(shutdown_by_default)
 {
+  const std::lock_guard<std::mutex> lock(mutex_);
   readParameters();
   session_ = std::make_unique<TrainingSession>(config_.task, config_.agent, seed_, learning_);
+  protocol_ = std::make_unique<ControllerProtocol>(*session_, protocol_params_);
   if (!load_on_start_.empty())
   {
     std::string path;
@@ -67,23 +69,29 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   }
 
   started_ = last_episode_end_ = last_state_at_ = last_progress_ = std::chrono::steady_clock::now();
-  // An answer that went out while the sim was not yet subscribed is sent again when the sim
-  // repeats the state (see onJointState).
-  effort_pub_ = nh_.advertise<std_msgs::Float64>("cart_effort", 10);
+  command_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_command", 10);
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
   save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
   load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
-  // Persistent: a new connection per episode would cost a master lookup and a TCP set-up.
-  reset_client_ = nh_.serviceClient<Reset>(reset_service_, true);
-  reset_thread_ = std::thread(&QLearningControllerNode::resetLoop, this);
+  if (protocol_params_.reset_service)
+  {
+    // Persistent: a new connection per episode would cost a master lookup and a TCP set-up.
+    reset_client_ = nh_.serviceClient<Reset>(reset_service_, true);
+    reset_thread_ = std::thread(&QLearningControllerNode::resetLoop, this);
+  }
   watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, sim_timeout_ / 2.0)),
                                     &QLearningControllerNode::onWatchdog, this);
   // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
-  joint_state_sub_ = nh_.subscribe("joint_states", 10, &QLearningControllerNode::onJointState, this,
-                                   ros::TransportHints().tcpNoDelay());
-  ROS_INFO("qlearning_controller: %s, seed %llu, %zu states x %zu actions, tables under %s",
+  ros::NodeHandle state_nh(nh_);
+  if (state_queue != nullptr)
+    state_nh.setCallbackQueue(state_queue);
+  joint_state_sub_ = state_nh.subscribe("joint_states", 10, &QLearningControllerNode::onJointState, this,
+                                        ros::TransportHints().tcpNoDelay());
+  ROS_INFO("qlearning_controller: %s, seed %llu, %zu states x %zu actions, tables under %s, %s",
            learning_ ? "training" : "evaluating (greedy, no learning)", static_cast<unsigned long long>(seed_),
-           session_->table().stateCount(), session_->table().actionCount(), q_table_dir_.c_str());
+           session_->table().stateCount(), session_->table().actionCount(), q_table_dir_.c_str(),
+           protocol_params_.reset_service ? ("resets by " + reset_client_.getService()).c_str()
+                                          : "no reset service: episodes start when the state is in ~start_region");
 }
 
 QLearningControllerNode::~QLearningControllerNode()
@@ -95,6 +103,9 @@ QLearningControllerNode::~QLearningControllerNode()
   reset_wanted_.notify_all();
   if (reset_thread_.joinable())
     reset_thread_.join();
+  // No state callback may run during the save (in a nodelet they run on another thread).
+  joint_state_sub_.shutdown();
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (learning_ && save_on_shutdown_ && !finished_training_)
   {
     std::string message;
@@ -109,51 +120,54 @@ void QLearningControllerNode::readParameters()
   const RosParameterSource shared(nh_);
   config_ = readTrainingConfig(shared);
 
-  const RosParameterSource priv(pnh_);
+  // Private parameters: the same reader and checks as the shared sections; a key it does not
+  // know (a typo) stops the node instead of being ignored.
+  const RosParameterSource source(pnh_);
+  SectionReader priv(source, "");
   // The launch files' stop_when_solved and max_episodes arrive as private parameters; they
   // override the shared training/ keys for this controller only.
-  config_.limits.stop_when_solved = valueOr(priv, "stop_when_solved", config_.limits.stop_when_solved);
-  const std::int64_t max_episodes =
-      valueOr<std::int64_t>(priv, "max_episodes", static_cast<std::int64_t>(config_.limits.max_episodes));
-  if (max_episodes < 1)
-    refuseParameter(pnh_, "max_episodes", std::to_string(max_episodes), "must be a whole number >= 1");
-  config_.limits.max_episodes = static_cast<std::uint64_t>(max_episodes);
+  priv.read("stop_when_solved", config_.limits.stop_when_solved);
+  priv.read("max_episodes", config_.limits.max_episodes, 1);
 
-  const std::string mode = valueOr<std::string>(priv, "mode", "train");
-  if (mode != "train" && mode != "evaluate")
-    refuseParameter(pnh_, "mode", "'" + mode + "'", "allowed: train, evaluate");
+  std::string mode = "train";
+  priv.readChoice("mode", mode, {"train", "evaluate"});
   learning_ = mode == "train";
+  priv.read("seed", seed_, 0);
 
-  const std::int64_t seed = valueOr<std::int64_t>(priv, "seed", 0);
-  if (seed < 0)
-    refuseParameter(pnh_, "seed", std::to_string(seed), "must be a whole number >= 0");
-  seed_ = static_cast<std::uint64_t>(seed);
-
-  q_table_dir_ = valueOr(priv, "q_table_dir", defaultTableDirectory());
+  q_table_dir_ = defaultTableDirectory();
+  priv.read("q_table_dir", q_table_dir_);
   if (q_table_dir_.empty())
-    refuseParameter(pnh_, "q_table_dir", "''", "must name a directory");
-  q_table_path_ = valueOr(priv, "q_table_path", q_table_path_);
+    priv.fail("q_table_dir", "''", "must name a directory");
+  priv.read("q_table_path", q_table_path_);
   try
   {
     resolve(q_table_path_);
   }
   catch (const QTableFileError& e)
   {
-    refuseParameter(pnh_, "q_table_path", "'" + q_table_path_ + "'", e.what());
+    priv.fail("q_table_path", "'" + q_table_path_ + "'", e.what());
   }
-  load_on_start_ = valueOr(priv, "load_on_start", load_on_start_);
-
-  const std::int64_t checkpoint = valueOr<std::int64_t>(priv, "checkpoint_every", 100);
-  if (checkpoint < 0)
-    refuseParameter(pnh_, "checkpoint_every", std::to_string(checkpoint), "must be a whole number >= 0 (0: never)");
-  checkpoint_every_ = static_cast<std::uint64_t>(checkpoint);
-  save_on_shutdown_ = valueOr(priv, "save_on_shutdown", save_on_shutdown_);
-  sim_timeout_ = valueOr(priv, "sim_timeout", sim_timeout_);
-  if (!(std::isfinite(sim_timeout_) && sim_timeout_ > 0.0))
-    refuseParameter(pnh_, "sim_timeout", std::to_string(sim_timeout_), "must be finite and > 0");
-  reset_service_ = valueOr(priv, "reset_service", reset_service_);
-  if (reset_service_.empty())
-    refuseParameter(pnh_, "reset_service", "''", "must name the sim's reset service");
+  priv.read("load_on_start", load_on_start_);
+  priv.read("checkpoint_every", checkpoint_every_, 0);
+  priv.read("save_on_shutdown", save_on_shutdown_);
+  priv.read("shutdown_when_finished", shutdown_when_finished_);
+  priv.readAtLeast("sim_timeout", sim_timeout_, 0.0, true);
+  priv.read("reset_service", reset_service_);
+  protocol_params_.reset_service = !reset_service_.empty();
+  protocol_params_.start_region = CartPoleState::Constant(config_.start_state_bound);
+  std::array<double, kStateDimensions> region{};
+  for (std::size_t i = 0; i < kStateDimensions; ++i)
+    region[i] = protocol_params_.start_region[i];
+  priv.readDimensions("start_region", region, false);
+  for (std::size_t i = 0; i < kStateDimensions; ++i)
+  {
+    if (!(std::isfinite(region[i]) && region[i] > 0.0))
+      priv.fail("start_region", SectionReader::listText({region.begin(), region.end()}),
+                "must be 4 finite values > 0: |x|, |x_dot|, |theta|, |theta_dot| bounds");
+    protocol_params_.start_region[i] = region[i];
+  }
+  priv.refuseUnknown();
+  protocol_params_.limits = config_.limits;
 }
 
 std::string QLearningControllerNode::resolve(const std::string& path) const
@@ -188,17 +202,19 @@ bool QLearningControllerNode::extractState(const sensor_msgs::JointState& msg, C
   return true;
 }
 
-void QLearningControllerNode::command(double effort)
+void QLearningControllerNode::command(double effort, const ros::Time& stamp)
 {
-  last_effort_ = effort;
-  answer_unheard_ = effort_pub_.getNumSubscribers() == 0;
-  std_msgs::Float64 msg;
-  msg.data = effort;
-  effort_pub_.publish(msg);
+  // A new message each time: in a nodelet manager the sim receives this very pointer.
+  auto msg = boost::make_shared<sensor_msgs::JointState>();
+  msg->header.stamp = stamp;
+  msg->name = {"cart_joint"};
+  msg->effort = {effort};
+  command_pub_.publish(msg);
 }
 
 void QLearningControllerNode::onJointState(const sensor_msgs::JointStateConstPtr& msg)
 {
+  const std::lock_guard<std::mutex> lock(mutex_);
   CartPoleState state;
   if (finished_training_ || !extractState(*msg, state))
     return;
@@ -209,63 +225,41 @@ void QLearningControllerNode::onJointState(const sensor_msgs::JointStateConstPtr
     ROS_INFO("qlearning_controller: joint_states are back; going on");
   }
 
-  const ros::Time stamp = msg->header.stamp;
-  if (have_stamp_ && stamp == last_stamp_)
-  {
-    // The sim sent this state again (lockstep, no answer within its timeout). Answer again, the
-    // same effort and without learning twice, only if the first answer went out with nobody
-    // subscribed to cart_effort. Otherwise it is on its way (a slow answer, a stalled sim): a
-    // second one would be taken by the sim for its next state, and every action after it would
-    // land one state late. After the episode's end there is nothing to answer.
-    if (!awaiting_reset_ && answer_unheard_)
-      command(last_effort_);
-    return;
-  }
-  if (have_stamp_ && stamp < last_stamp_)
-  {
-    // Time went back: the sim was restarted. The running episode cannot be finished.
-    ROS_WARN(
-        "qlearning_controller: joint_states time went back (%.3f -> %.3f s): the sim restarted; "
-        "starting a new episode",
-        last_stamp_.toSec(), stamp.toSec());
-    session_->abortEpisode();
-    awaiting_reset_ = false;
-  }
-  if (awaiting_reset_)
-  {
-    // In realtime the sim goes on stepping until it handles the reset; those states come after
-    // a fall and so are terminal themselves. (After a truncation one such state can still start
-    // the episode; in lockstep none comes, the sim waits for the reset.) The stamps cannot
-    // decide: the sim's are on its own clock, which need not be this node's.
-    if (session_->task().isTerminal(state))
-      return;
-    awaiting_reset_ = false;
-  }
-  last_stamp_ = stamp;
-  have_stamp_ = true;
-
-  if (!session_->inEpisode())
-  {
-    // Joining a sim that waits on a fallen pole (another controller's episode ended there):
-    // nothing to learn from it, ask for a fresh start.
-    if (session_->task().isTerminal(state))
-    {
-      requestReset();
-      return;
-    }
-    command(session_->beginEpisode(state));
-    return;
-  }
-  const Decision decision = session_->observe(state);
-  if (!decision.episode_over)
-  {
-    command(decision.effort);
-    return;
-  }
-  endEpisode(stamp);
+  const Reaction reaction = protocol_->onState(msg->header.stamp.toNSec(), state);
+  report(reaction, msg->header.stamp);
+  if (reaction.answer)
+    command(reaction.effort, msg->header.stamp);
+  if (reaction.episode_ended)
+    endEpisode(msg->header.stamp, reaction.training_finished);
+  if (reaction.request_reset && !finished_training_)
+    requestReset();
 }
 
-void QLearningControllerNode::endEpisode(const ros::Time& stamp)
+void QLearningControllerNode::report(const Reaction& reaction, const ros::Time& stamp)
+{
+  const ControllerProtocol::Counts& c = protocol_->counts();
+  if (reaction.kind == Reaction::Kind::Stale && dropped_state_warning_.ready())
+    ROS_WARN(
+        "qlearning_controller: dropped joint_states stamped %.6f, older than the last state (a replayed or "
+        "reordered message; a restarted sim is recognised when it sends its state again). Dropped so far: %llu",
+        stamp.toSec(), static_cast<unsigned long long>(c.stale));
+  if (reaction.kind == Reaction::Kind::Stray && dropped_state_warning_.ready())
+    ROS_WARN("qlearning_controller: dropped joint_states without a stamp among stamped ones. Dropped so far: %llu",
+             static_cast<unsigned long long>(c.stray));
+  if (reaction.first_unstamped)
+    ROS_WARN(
+        "qlearning_controller: joint_states carry no stamp (0): every message is taken as a new state, and "
+        "commands go out unstamped");
+  if (reaction.sim_restarted)
+    ROS_WARN("qlearning_controller: joint_states time went back to %.3f s: the sim restarted; starting a new episode",
+             stamp.toSec());
+  if (reaction.waiting_for_start)
+    ROS_INFO(
+        "qlearning_controller: episode over; no reset service, so commanding 0 until the state is back inside "
+        "~start_region (stand the pole up)");
+}
+
+void QLearningControllerNode::endEpisode(const ros::Time& stamp, bool training_finished)
 {
   const EpisodeSummary& s = session_->lastEpisode();
   const double episode_wall = secondsSince(last_episode_end_);
@@ -273,10 +267,8 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp)
 
   // When training ends here, the table is saved before episode_stats says so: whoever acts on
   // the last message finds the final file.
-  const TrainingLimits& limits = config_.limits;
-  const bool finish = learning_ && limits.reached(s.episode, s.solved);
   std::string saved;
-  if (finish)
+  if (training_finished)
     save("", saved);
 
   EpisodeStats stats;
@@ -294,6 +286,7 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp)
   stats.steps_per_second = episode_wall > 0.0 ? s.steps / episode_wall : 0.0;
   stats_pub_.publish(stats);
 
+  const TrainingLimits& limits = config_.limits;
   if (limits.progress_every > 0 && s.episode % limits.progress_every == 0)
   {
     const double interval = secondsSince(last_progress_);
@@ -303,40 +296,36 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp)
     last_progress_ = std::chrono::steady_clock::now();
   }
 
-  if (learning_)
+  if (!learning_)
+    return;
+  if (training_finished)
   {
-    if (finish && saved.rfind("nothing written", 0) == 0)
+    finished_training_ = true;
+    if (saved.rfind("nothing written", 0) == 0)
     {
       // Keep the trained table alive: the user can still save it elsewhere with ~save_q_table.
       ROS_ERROR(
           "qlearning_controller: training ended (%s, episode %llu) but the table could not be saved: %s. "
           "The node keeps running: call ~save_q_table with another path",
           s.solved ? "solved" : "max_episodes", static_cast<unsigned long long>(s.episode), saved.c_str());
-      finished_training_ = true;
       return;
     }
-    if (finish)
-    {
-      ROS_INFO(
-          "qlearning_controller: %s after %llu episodes, %llu steps, %.1f s (mean return of the last %u: %.2f); %s",
-          s.solved ? "SOLVED" : "NOT solved, max_episodes reached", static_cast<unsigned long long>(s.episode),
-          static_cast<unsigned long long>(s.total_steps), secondsSince(started_), config_.task.solved_window,
-          s.mean_return_window, saved.c_str());
-      finished_training_ = true;
-      if (finished_)
-        finished_();
-      return;
-    }
-    if (checkpoint_every_ > 0 && s.episode % checkpoint_every_ == 0)
-    {
-      std::string message;
-      if (save("", message))
-        ROS_DEBUG("qlearning_controller: checkpoint: %s", message.c_str());
-      else
-        ROS_WARN("qlearning_controller: checkpoint failed: %s", message.c_str());
-    }
+    ROS_INFO("qlearning_controller: %s after %llu episodes, %llu steps, %.1f s (mean return of the last %u: %.2f); %s",
+             s.solved ? "SOLVED" : "NOT solved, max_episodes reached", static_cast<unsigned long long>(s.episode),
+             static_cast<unsigned long long>(s.total_steps), secondsSince(started_), config_.task.solved_window,
+             s.mean_return_window, saved.c_str());
+    if (shutdown_when_finished_ && shutdown_)
+      shutdown_();
+    return;
   }
-  requestReset();
+  if (checkpoint_every_ > 0 && s.episode % checkpoint_every_ == 0)
+  {
+    std::string message;
+    if (save("", message))
+      ROS_DEBUG("qlearning_controller: checkpoint: %s", message.c_str());
+    else
+      ROS_WARN("qlearning_controller: checkpoint failed: %s", message.c_str());
+  }
 }
 
 bool QLearningControllerNode::save(const std::string& path, std::string& message)
@@ -358,6 +347,7 @@ bool QLearningControllerNode::save(const std::string& path, std::string& message
 
 bool QLearningControllerNode::onSave(SaveQTable::Request& request, SaveQTable::Response& response)
 {
+  const std::lock_guard<std::mutex> lock(mutex_);
   response.success = save(request.path, response.message);
   if (response.success)
     ROS_INFO("qlearning_controller: save_q_table: %s", response.message.c_str());
@@ -368,6 +358,7 @@ bool QLearningControllerNode::onSave(SaveQTable::Request& request, SaveQTable::R
 
 bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::Response& response)
 {
+  const std::lock_guard<std::mutex> lock(mutex_);
   try
   {
     const std::string path = resolve(request.path);
@@ -393,6 +384,7 @@ bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::R
 
 void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
 {
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (finished_training_ || sim_silent_reported_ || secondsSince(last_state_at_) < sim_timeout_)
     return;
   sim_silent_reported_ = true;
@@ -402,7 +394,6 @@ void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
 
 void QLearningControllerNode::requestReset()
 {
-  awaiting_reset_ = true;
   {
     std::lock_guard<std::mutex> lock(reset_mutex_);
     reset_pending_ = true;

@@ -26,7 +26,7 @@ void collect(XmlRpcValue& value, const std::string& prefix, std::vector<std::str
     return;
   }
   for (auto& entry : value)
-    collect(entry.second, prefix + "/" + entry.first, keys);
+    collect(entry.second, (prefix.empty() ? "" : prefix + "/") + entry.first, keys);
 }
 }  // namespace
 
@@ -41,13 +41,18 @@ std::string RosParameterSource::origin() const
   return "parameter server (" + nh_.getNamespace() + ")";
 }
 
+std::string RosParameterSource::describe(const std::string& key) const
+{
+  return "parameter " + nh_.resolveName(key);
+}
+
 bool RosParameterSource::get(const std::string& key, double& value) const
 {
   XmlRpcValue v;
   if (!nh_.getParam(key, v))
     return false;
   if (!isNumber(v))
-    throw ConfigError(origin() + ": " + key + " = '" + v.toXml() + "' is not allowed (must be a number)");
+    throw ConfigError(describe(key) + " = '" + v.toXml() + "' is not allowed (must be a number)");
   value = toDouble(v);
   return true;
 }
@@ -58,7 +63,7 @@ bool RosParameterSource::get(const std::string& key, std::int64_t& value) const
   if (!nh_.getParam(key, v))
     return false;
   if (v.getType() != XmlRpcValue::TypeInt)
-    throw ConfigError(origin() + ": " + key + " = '" + v.toXml() + "' is not allowed (must be a whole number)");
+    throw ConfigError(describe(key) + " = '" + v.toXml() + "' is not allowed (must be a whole number)");
   value = static_cast<int>(v);
   return true;
 }
@@ -69,7 +74,7 @@ bool RosParameterSource::get(const std::string& key, bool& value) const
   if (!nh_.getParam(key, v))
     return false;
   if (v.getType() != XmlRpcValue::TypeBoolean)
-    throw ConfigError(origin() + ": " + key + " = '" + v.toXml() + "' is not allowed (must be true or false)");
+    throw ConfigError(describe(key) + " = '" + v.toXml() + "' is not allowed (must be true or false)");
   value = static_cast<bool>(v);
   return true;
 }
@@ -80,7 +85,7 @@ bool RosParameterSource::get(const std::string& key, std::string& value) const
   if (!nh_.getParam(key, v))
     return false;
   if (v.getType() != XmlRpcValue::TypeString)
-    throw ConfigError(origin() + ": " + key + " = '" + v.toXml() + "' is not allowed (must be a string)");
+    throw ConfigError(describe(key) + " = '" + v.toXml() + "' is not allowed (must be a string)");
   value = static_cast<std::string>(v);
   return true;
 }
@@ -91,12 +96,12 @@ bool RosParameterSource::get(const std::string& key, std::vector<double>& value)
   if (!nh_.getParam(key, v))
     return false;
   if (v.getType() != XmlRpcValue::TypeArray)
-    throw ConfigError(origin() + ": " + key + " must be a list of numbers");
+    throw ConfigError(describe(key) + " must be a list of numbers");
   value.clear();
   for (int i = 0; i < v.size(); ++i)
   {
     if (!isNumber(v[i]))
-      throw ConfigError(origin() + ": " + key + "[" + std::to_string(i) + "] = '" + v[i].toXml() +
+      throw ConfigError(describe(key) + "[" + std::to_string(i) + "] = '" + v[i].toXml() +
                         "' is not allowed (must be a number)");
     value.push_back(toDouble(v[i]));
   }
@@ -107,7 +112,8 @@ std::vector<std::string> RosParameterSource::keysUnder(const std::string& sectio
 {
   std::vector<std::string> keys;
   XmlRpcValue v;
-  if (nh_.getParam(section, v))
+  // An empty section: every parameter in the node handle's namespace.
+  if (nh_.getParam(section.empty() ? nh_.getNamespace() : section, v))
     collect(v, section, keys);
   return keys;
 }

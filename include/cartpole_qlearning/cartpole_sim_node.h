@@ -1,19 +1,23 @@
 // cartpole_sim: the core's cart-pole as a ROS robot. Publishes joint_states and TF, takes
-// cart_effort, serves ~reset, and in lockstep mode drives /clock.
+// joint_command (stamped) and cart_effort (unstamped), serves ~reset, and in lockstep mode
+// can drive /clock. What a command means in lockstep is the core's SimProtocol's decision;
+// this class translates messages and services into its calls.
 #pragma once
 
 #include "cartpole_qlearning/Reset.h"
 #include "cartpole_qlearning/cartpole_simulation.h"
+#include "cartpole_qlearning/lockstep_protocol.h"
 #include "cartpole_qlearning/random.h"
 #include "cartpole_qlearning/wall_throttle.h"
 
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <std_msgs/Float64.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include <chrono>
 #include <memory>
+#include <mutex>
 #include <string>
 
 namespace cartpole_qlearning
@@ -22,32 +26,45 @@ class CartPoleSimNode
 {
 public:
   // nh: the instance's namespace (topics, physics/* parameters); pnh: the node's private
-  // namespace (sim parameters, ~reset). Throws ConfigError naming a bad parameter.
-  CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
+  // namespace (sim parameters, ~reset). command_queue: where the command topics' callbacks
+  // queue (nullptr: nh's queue); a nodelet passes the queue its lockstep thread serves.
+  // Throws ConfigError naming a bad parameter.
+  CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, ros::CallbackQueue* command_queue = nullptr);
 
 private:
   enum class Mode
   {
     Realtime,  // steps on a wall timer, holding the last command
-    Lockstep   // steps when the command answering the last state arrives
+    Lockstep   // steps when the command answering the pending state arrives
   };
 
   void readParameters();
+  void onJointCommand(const sensor_msgs::JointStateConstPtr& msg);
   void onEffort(const std_msgs::Float64ConstPtr& msg);
   bool onReset(Reset::Request& request, Reset::Response& response);
   void onRealtimeTick(const ros::SteadyTimerEvent& event);
-  void onLockstepTimeout(const ros::SteadyTimerEvent& event);
+  void onLockstepTimer(const ros::SteadyTimerEvent& event);
+  // Lockstep: a controller that subscribes gets the pending state at once (instead of after
+  // lockstep_timeout); to everyone else nothing is sent.
+  void onSubscriberConnect(const ros::SingleSubscriberPublisher& subscriber);
 
-  // Steps with the force (after validation), advances the clock and publishes.
-  void advance(double effort);
-  // Publishes /clock (lockstep), joint_states and, at most at tf_rate in lockstep, TF. A repeat
-  // (the same state and stamp again) sends no TF.
-  void publishState(bool repeat = false);
+  // Lockstep: carries out the protocol's verdict on a command (step, or say why it was dropped).
+  void apply(SimProtocol::Verdict verdict, double effort, const ros::Time& answers);
+  // Steps with the force (after validation) and publishes the new state stamped `stamp`.
+  void advance(double effort, const ros::Time& stamp);
+  // Publishes a new state message (/clock first when asked, then joint_states and, at most at
+  // tf_rate in lockstep, TF).
+  void publishState(const ros::Time& stamp);
+  // Publishes the last state message again, unchanged (no TF: tf2 refuses a repeated stamp).
+  void republishState();
   // A valid effort, clamped; false (with a throttled warning) for NaN or Inf.
   bool acceptEffort(double requested, double& effort) const;
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
+  // Callbacks may run on two threads (a nodelet's command topics on the lockstep thread, its
+  // timer and service on the manager's): each holds this while it runs.
+  std::mutex mutex_;
 
   // Parameters
   Mode mode_ = Mode::Realtime;
@@ -57,6 +74,7 @@ private:
   double command_timeout_ = 0.5;   // [s] realtime: an older command counts as zero
   double lockstep_timeout_ = 0.5;  // [s] lockstep: republish the state when unanswered this long
   double effort_limit_ = 10.0;     // [N]
+  bool publish_clock_ = false;     // lockstep: drive /clock (one lockstep instance per master)
   bool publish_tf_ = true;
   double tf_rate_ = 30.0;  // [Hz] lockstep: TF at most this often (wall clock)
   std::string world_frame_ = "world";
@@ -68,23 +86,21 @@ private:
 
   std::unique_ptr<CartPoleSimulation> simulation_;
   std::unique_ptr<RandomStream> noise_;
-  ros::Time sim_time_;
+  std::unique_ptr<SimProtocol> lockstep_;  // lockstep mode
+  std::unique_ptr<CommandHold> hold_;      // realtime mode
 
-  // Realtime: the last command and when it came.
-  double held_effort_ = 0.0;
-  std::chrono::steady_clock::time_point held_since_;
-  bool have_command_ = false;
-
-  // Lockstep: the last published state always awaits its answer, since this wall time.
-  std::chrono::steady_clock::time_point published_at_;
-  bool repeat_armed_ = false;  // a timer tick already found the state unanswered past the timeout
-  std::chrono::steady_clock::time_point last_tf_;
-  sensor_msgs::JointState joint_state_;  // the last state published (repeats send it again)
+  // The last state published. A new one is a new message: in a nodelet manager subscribers
+  // receive this very pointer (no copy, no serialisation), so a published message never changes.
+  sensor_msgs::JointStatePtr joint_state_;
+  WallClock::time_point last_tf_;
   mutable WallThrottle nonfinite_warning_{1.0};
   mutable WallThrottle clamp_warning_{1.0};
+  WallThrottle bad_command_warning_{1.0};
+  WallThrottle dropped_warning_{1.0};
 
   ros::Publisher joint_state_pub_;
   ros::Publisher clock_pub_;
+  ros::Subscriber command_sub_;
   ros::Subscriber effort_sub_;
   ros::ServiceServer reset_srv_;
   ros::SteadyTimer timer_;

@@ -5,11 +5,16 @@
 
 #include "cartpole_qlearning/cartpole_dynamics.h"
 #include "cartpole_qlearning/cartpole_task.h"
+#include "cartpole_qlearning/discretiser.h"
 #include "cartpole_qlearning/q_learning_agent.h"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -39,6 +44,11 @@ public:
   virtual std::vector<std::string> keysUnder(const std::string& section) const = 0;
   // Where the parameters come from, for messages ("config/cartpole.yaml", "/cartpole").
   virtual std::string origin() const = 0;
+  // A key as messages name it ("config/cartpole.yaml: learning/gamma", "parameter /cartpole/learning/gamma").
+  virtual std::string describe(const std::string& key) const
+  {
+    return origin() + ": " + key;
+  }
 };
 
 // The value of a key, or fallback when it is absent (a wrong type still throws ConfigError).
@@ -48,6 +58,137 @@ T valueOr(const ParameterSource& source, const std::string& key, T fallback)
   source.get(key, fallback);
   return fallback;
 }
+
+// Reads the keys of one section, remembers which keys it knows, and refuses the others, so
+// that a misspelt key stops the run instead of being silently ignored.
+class SectionReader
+{
+public:
+  SectionReader(const ParameterSource& source, std::string section) : source_(source), section_(std::move(section)) {}
+
+  template <typename T>
+  void read(const std::string& name, T& value)
+  {
+    known_.insert(key(name));
+    source_.get(key(name), value);
+  }
+
+  void read(const std::string& name, unsigned& value, std::int64_t min, std::int64_t max)
+  {
+    std::int64_t v = value;
+    read(name, v);
+    if (v < min || v > max)
+      fail(name, std::to_string(v),
+           "must be a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+    value = static_cast<unsigned>(v);
+  }
+
+  // A finite number, > min (strict) or >= min.
+  void readAtLeast(const std::string& name, double& value, double min, bool strict)
+  {
+    read(name, value);
+    if (!(std::isfinite(value) && (strict ? value > min : value >= min)))
+      fail(name, numberText(value), std::string("must be finite and ") + (strict ? "> " : ">= ") + numberText(min));
+  }
+
+  // One of the allowed strings.
+  void readChoice(const std::string& name, std::string& value, const std::vector<std::string>& allowed)
+  {
+    read(name, value);
+    if (std::find(allowed.begin(), allowed.end(), value) != allowed.end())
+      return;
+    std::string list;
+    for (const std::string& a : allowed)
+      list += (list.empty() ? "" : ", ") + a;
+    fail(name, "'" + value + "'", "allowed: " + list);
+  }
+
+  void read(const std::string& name, std::uint64_t& value, std::int64_t min)
+  {
+    std::int64_t v = static_cast<std::int64_t>(value);
+    read(name, v);
+    if (v < min)
+      fail(name, std::to_string(v), "must be a whole number >= " + std::to_string(min));
+    value = static_cast<std::uint64_t>(v);
+  }
+
+  // A list of exactly kStateDimensions values.
+  template <typename T>
+  void readDimensions(const std::string& name, std::array<T, kStateDimensions>& values, bool whole)
+  {
+    std::vector<double> list;
+    known_.insert(key(name));
+    if (!source_.get(key(name), list))
+      return;
+    if (list.size() != kStateDimensions)
+      fail(name, listText(list), "must list 4 values: x, x_dot, theta, theta_dot");
+    for (std::size_t i = 0; i < kStateDimensions; ++i)
+    {
+      if (whole && (list[i] != std::floor(list[i]) || list[i] < 1))
+        fail(name, listText(list), "must be whole numbers >= 1");
+      values[i] = static_cast<T>(list[i]);
+    }
+  }
+
+  // Refuses a key under this section that no read() asked for.
+  void refuseUnknown() const
+  {
+    for (const std::string& k : source_.keysUnder(section_))
+    {
+      if (known_.count(k) == 0)
+        throw ConfigError(source_.origin() + ": unknown key " + k + " (known keys" +
+                          (section_.empty() ? std::string() : " of " + section_) + ": " + knownText() + ")");
+    }
+  }
+
+  // Turns a validate() message, which names the field relative to this section, into a ConfigError.
+  void check(const std::string& error) const
+  {
+    if (!error.empty())
+      throw ConfigError(source_.origin() + ": " + section_ + "/" + error);
+  }
+
+  [[noreturn]] void fail(const std::string& name, const std::string& value, const std::string& allowed) const
+  {
+    throw ConfigError(source_.describe(key(name)) + " = " + value + " is not allowed (" + allowed + ")");
+  }
+
+  // The key of a name in this section ("learning" + "gamma" -> "learning/gamma"; no section: the name).
+  std::string key(const std::string& name) const
+  {
+    return section_.empty() ? name : section_ + "/" + name;
+  }
+
+  static std::string numberText(double value)
+  {
+    std::ostringstream out;
+    out << value;
+    return out.str();
+  }
+
+  static std::string listText(const std::vector<double>& list)
+  {
+    std::ostringstream out;
+    out << "[";
+    for (std::size_t i = 0; i < list.size(); ++i)
+      out << (i ? ", " : "") << list[i];
+    out << "]";
+    return out.str();
+  }
+
+private:
+  std::string knownText() const
+  {
+    std::string text;
+    for (const std::string& k : known_)
+      text += (text.empty() ? "" : ", ") + k.substr(section_.empty() ? 0 : section_.size() + 1);
+    return text;
+  }
+
+  const ParameterSource& source_;
+  std::string section_;
+  std::set<std::string> known_;
+};
 
 // A YAML document as a parameter source. Throws ConfigError when the file cannot be read or parsed.
 std::unique_ptr<ParameterSource> loadYamlParameters(const std::string& path);

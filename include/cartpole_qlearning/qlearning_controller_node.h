@@ -1,15 +1,19 @@
 // qlearning_controller: a tabular Q-learning controller on the ROS graph. Receives
-// joint_states, decides with the core's TrainingSession, commands cart_effort, ends episodes
-// by calling the sim's reset, publishes episode_stats, and saves or loads its Q-table.
+// joint_states, decides with the core's ControllerProtocol (which drives the TrainingSession),
+// answers each state on joint_command stamped with the state's stamp, ends episodes by calling
+// the sim's reset (or, for a robot without one, waits for it to be stood up), publishes
+// episode_stats, and saves or loads its Q-table.
 #pragma once
 
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/LoadQTable.h"
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/lockstep_protocol.h"
 #include "cartpole_qlearning/training_session.h"
 #include "cartpole_qlearning/wall_throttle.h"
 
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 
@@ -27,10 +31,14 @@ class QLearningControllerNode
 {
 public:
   // nh: the instance's namespace (topics; physics, task, learning and training parameters);
-  // pnh: the node's private namespace (controller parameters and services). finished is called
-  // when training ends (solved or max_episodes); the node's main shuts ROS down there.
+  // pnh: the node's private namespace (controller parameters and services). shutdown is called
+  // when training ends (solved or max_episodes) if ~shutdown_when_finished, whose default is
+  // shutdown_by_default: the executable ends there; a nodelet ends its manager only when asked.
   // Throws ConfigError naming a bad parameter, QTableFileError for a bad ~load_on_start file.
-  QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::function<void()> finished);
+  // state_queue: where the joint_states callbacks queue (nullptr: nh's queue); a nodelet passes
+  // the queue its lockstep thread serves.
+  QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::function<void()> shutdown,
+                          bool shutdown_by_default, ros::CallbackQueue* state_queue = nullptr);
   // Saves the table when ~save_on_shutdown (training), and stops the reset thread.
   ~QLearningControllerNode();
 
@@ -46,8 +54,11 @@ private:
 
   // The state in a message, or false (with a throttled warning) when it cannot be used.
   bool extractState(const sensor_msgs::JointState& msg, CartPoleState& state) const;
-  void command(double effort);
-  void endEpisode(const ros::Time& stamp);
+  void command(double effort, const ros::Time& stamp);
+  // Statistics, progress, checkpoints and, when training reached its limits, the final save.
+  void endEpisode(const ros::Time& stamp, bool training_finished);
+  // Logs what the protocol did with a state that was not simply answered.
+  void report(const Reaction& reaction, const ros::Time& stamp);
   // Saves to a user path (empty: the default); returns the message for the log or service.
   bool save(const std::string& path, std::string& message);
   std::string resolve(const std::string& path) const;
@@ -59,7 +70,11 @@ private:
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
-  std::function<void()> finished_;
+  // Callbacks may run on two threads (a nodelet's joint_states on the lockstep thread, its
+  // services and timer on the manager's): each holds this while it runs.
+  std::mutex mutex_;
+  std::function<void()> shutdown_;
+  bool shutdown_when_finished_;
 
   // Parameters
   TrainingConfig config_;
@@ -71,17 +86,11 @@ private:
   std::uint64_t checkpoint_every_ = 100;
   bool save_on_shutdown_ = true;
   double sim_timeout_ = 2.0;  // [s] wall
-  std::string reset_service_ = "cartpole_sim/reset";
+  std::string reset_service_ = "cartpole_sim/reset";  // "": a robot that cannot be reset on command
+  ControllerProtocolParams protocol_params_;
 
   std::unique_ptr<TrainingSession> session_;
-
-  // Stamps: a repeated stamp is not learnt from again, and answered again only when the first
-  // answer was lost; after an episode ends, only a newer state that is not terminal starts the next.
-  ros::Time last_stamp_;
-  bool have_stamp_ = false;
-  double last_effort_ = 0.0;
-  bool answer_unheard_ = false;  // the last answer went out while nobody subscribed to cart_effort
-  bool awaiting_reset_ = false;
+  std::unique_ptr<ControllerProtocol> protocol_;
   bool finished_training_ = false;
 
   // Wall-clock bookkeeping for steps/s and the sim watchdog.
@@ -92,9 +101,10 @@ private:
   std::chrono::steady_clock::time_point last_progress_;
   bool sim_silent_reported_ = false;
   mutable WallThrottle bad_state_warning_{1.0};
+  WallThrottle dropped_state_warning_{1.0};
 
   ros::Subscriber joint_state_sub_;
-  ros::Publisher effort_pub_;
+  ros::Publisher command_pub_;
   ros::Publisher stats_pub_;
   ros::ServiceServer save_srv_;
   ros::ServiceServer load_srv_;

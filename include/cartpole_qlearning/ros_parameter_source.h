@@ -21,6 +21,7 @@ public:
   bool get(const std::string& key, std::vector<double>& value) const override;
   std::vector<std::string> keysUnder(const std::string& section) const override;
   std::string origin() const override;
+  std::string describe(const std::string& key) const override;
 
 private:
   ros::NodeHandle nh_;

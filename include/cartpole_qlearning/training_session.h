@@ -53,6 +53,11 @@ public:
   {
     return in_episode_;
   }
+  // False: evaluation (greedy, no updates).
+  bool learning() const
+  {
+    return learning_;
+  }
   // Abandons the running episode without learning from its unfinished end (e.g. an external reset).
   void abortEpisode()
   {

@@ -1,0 +1,273 @@
+#include "cartpole_qlearning/lockstep_protocol.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace cartpole_qlearning
+{
+Stamp tickOf(double tau_s)
+{
+  const double ns = std::round(tau_s * 1e9);
+  if (!(std::isfinite(ns) && ns >= 1.0 && ns < 1e18))
+    throw std::invalid_argument("tau = " + std::to_string(tau_s) + " s is not a usable tick (at least 1 ns)");
+  return static_cast<Stamp>(ns);
+}
+
+// --- The sim's side ---------------------------------------------------------------------------
+
+SimProtocol::SimProtocol(Stamp tick, WallClock::duration repeat_after) : tick_(tick), repeat_after_(repeat_after)
+{
+  if (tick_ == 0)
+    throw std::invalid_argument("SimProtocol: the tick must be at least 1 ns");
+}
+
+Stamp SimProtocol::advance(WallClock::time_point now)
+{
+  pending_ += tick_;
+  published_at_ = now;
+  return pending_;
+}
+
+Stamp SimProtocol::start(WallClock::time_point now)
+{
+  pending_ = 0;
+  last_stepped_ = 0;
+  return advance(now);
+}
+
+SimProtocol::Verdict SimProtocol::onCommand(Stamp answers, WallClock::time_point now)
+{
+  if (answers == 0)
+  {
+    ++counts_.unstamped;
+    return Verdict::Unstamped;
+  }
+  if (answers == pending_)
+    return onUnstampedCommand(now);
+  if (answers == last_stepped_)
+  {
+    ++counts_.duplicate;
+    return Verdict::Duplicate;
+  }
+  if (answers < pending_)
+  {
+    ++counts_.stale;
+    return Verdict::Stale;
+  }
+  ++counts_.future;
+  return Verdict::Future;
+}
+
+SimProtocol::Verdict SimProtocol::onUnstampedCommand(WallClock::time_point now)
+{
+  last_stepped_ = pending_;
+  ++counts_.steps;
+  advance(now);
+  return Verdict::Step;
+}
+
+Stamp SimProtocol::onReset(WallClock::time_point now)
+{
+  ++counts_.resets;
+  return advance(now);
+}
+
+bool SimProtocol::repeatDue(WallClock::time_point now)
+{
+  if (now - published_at_ < repeat_after_)
+    return false;
+  published_at_ = now;
+  ++counts_.repeats;
+  return true;
+}
+
+const char* describe(SimProtocol::Verdict verdict)
+{
+  switch (verdict)
+  {
+    case SimProtocol::Verdict::Step:
+      return "";
+    case SimProtocol::Verdict::Stale:
+      return "it answers an older state (or one a reset replaced)";
+    case SimProtocol::Verdict::Duplicate:
+      return "it is a second answer to a state already stepped on";
+    case SimProtocol::Verdict::Future:
+      return "its stamp is later than any state published";
+    case SimProtocol::Verdict::Unstamped:
+      return "it has no stamp (stamp it with the state's stamp, or publish on cart_effort)";
+  }
+  return "";
+}
+
+CommandHold::CommandHold(WallClock::duration timeout) : timeout_(timeout) {}
+
+bool CommandHold::set(double effort, Stamp stamp, WallClock::time_point now)
+{
+  if (stamp != 0 && stamp < stamp_)
+    return false;
+  if (stamp != 0)
+    stamp_ = stamp;
+  effort_ = effort;
+  since_ = now;
+  return true;
+}
+
+double CommandHold::effort(WallClock::time_point now) const
+{
+  return since_ && now - *since_ <= timeout_ ? effort_ : 0.0;
+}
+
+// --- The controller's side --------------------------------------------------------------------
+
+ControllerProtocol::ControllerProtocol(TrainingSession& session, const ControllerProtocolParams& params)
+  : session_(session), params_(params)
+{
+}
+
+bool ControllerProtocol::inStartRegion(const CartPoleState& state) const
+{
+  return (state.array().abs() <= params_.start_region.array()).all();
+}
+
+void ControllerProtocol::answer(Reaction& reaction, double effort)
+{
+  reaction.answer = true;
+  reaction.effort = effort;
+  last_effort_ = effort;
+}
+
+void ControllerProtocol::begin(Reaction& reaction, const CartPoleState& state)
+{
+  reaction.episode_began = true;
+  phase_ = Phase::InEpisode;
+  answer(reaction, session_.beginEpisode(state));
+}
+
+Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
+{
+  Reaction reaction;
+  reaction.stamp = stamp;
+  if (phase_ == Phase::Finished)
+  {
+    reaction.kind = Reaction::Kind::Finished;
+    return reaction;
+  }
+
+  if (stamp == 0)
+  {
+    if (have_stamp_)
+    {
+      ++counts_.stray;
+      reaction.kind = Reaction::Kind::Stray;
+      return reaction;
+    }
+    reaction.first_unstamped = !unstamped_stream_;
+    unstamped_stream_ = true;
+    return onNewState(reaction, state);
+  }
+
+  if (have_stamp_ && stamp == last_)
+  {
+    ++counts_.repeats;
+    reaction.kind = Reaction::Kind::Repeat;
+    if (phase_ == Phase::InEpisode || phase_ == Phase::WaitingForPerson)
+      answer(reaction, last_effort_);
+    return reaction;
+  }
+
+  if (have_stamp_ && stamp < last_)
+  {
+    if (older_seen_ != stamp)
+    {
+      older_seen_ = stamp;
+      ++counts_.stale;
+      reaction.kind = Reaction::Kind::Stale;
+      return reaction;
+    }
+    // The same older state twice: a restarted sim repeating its first state.
+    ++counts_.restarts;
+    reaction.sim_restarted = true;
+    session_.abortEpisode();
+    phase_ = Phase::WaitingForStart;
+  }
+  return onNewState(reaction, state);
+}
+
+Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& state)
+{
+  reaction.kind = Reaction::Kind::New;
+  ++counts_.states;
+  older_seen_.reset();
+  if (reaction.stamp != 0)
+  {
+    last_ = reaction.stamp;
+    have_stamp_ = true;
+  }
+  const bool terminal = session_.task().isTerminal(state);
+
+  switch (phase_)
+  {
+    case Phase::Finished:
+      break;
+    case Phase::AwaitingReset:
+      // States that come before the reset is served (realtime) are past the fall.
+      if (!terminal)
+        begin(reaction, state);
+      break;
+    case Phase::WaitingForStart:
+    case Phase::WaitingForPerson:
+      if (!params_.reset_service)
+      {
+        if (!terminal && inStartRegion(state))
+        {
+          begin(reaction, state);
+          break;
+        }
+        reaction.waiting_for_start = phase_ != Phase::WaitingForPerson;
+        phase_ = Phase::WaitingForPerson;
+        answer(reaction, 0.0);
+        break;
+      }
+      if (terminal)
+      {
+        // Joining a sim that waits on a fallen pole: nothing to learn from, ask for a start.
+        reaction.request_reset = true;
+        phase_ = Phase::AwaitingReset;
+        break;
+      }
+      begin(reaction, state);
+      break;
+    case Phase::InEpisode:
+    {
+      const Decision decision = session_.observe(state);
+      reaction.learned = session_.learning();
+      if (!decision.episode_over)
+      {
+        answer(reaction, decision.effort);
+        break;
+      }
+      reaction.episode_ended = true;
+      const EpisodeSummary& summary = session_.lastEpisode();
+      if (session_.learning() && params_.limits.reached(summary.episode, summary.solved))
+      {
+        reaction.training_finished = true;
+        phase_ = Phase::Finished;
+        break;
+      }
+      if (params_.reset_service)
+      {
+        reaction.request_reset = true;
+        phase_ = Phase::AwaitingReset;
+        break;
+      }
+      reaction.waiting_for_start = true;
+      phase_ = Phase::WaitingForPerson;
+      answer(reaction, 0.0);
+      break;
+    }
+  }
+  return reaction;
+}
+
+}  // namespace cartpole_qlearning
