@@ -168,9 +168,10 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
   int commands = 0;
   bool silent_reported = false;
   bool back_reported = false;
-  ros::Subscriber effort = nh.subscribe<std_msgs::Float64>(
-      "/alone/cart_effort", 100,
-      boost::function<void(const std_msgs::Float64ConstPtr&)>([&](const std_msgs::Float64ConstPtr&) { ++commands; }));
+  ros::Subscriber effort = nh.subscribe<sensor_msgs::JointState>(
+      "/alone/joint_command", 100,
+      boost::function<void(const sensor_msgs::JointStateConstPtr&)>(
+          [&](const sensor_msgs::JointStateConstPtr&) { ++commands; }));
   ros::Subscriber log = nh.subscribe<rosgraph_msgs::Log>(
       "/rosout", 1000,
       boost::function<void(const rosgraph_msgs::LogConstPtr&)>([&](const rosgraph_msgs::LogConstPtr& m) {
@@ -223,18 +224,23 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
   EXPECT_TRUE(spinUntil([&] { return commands == 2; }, 10.0));
 }
 
-TEST(ControllerServices, ARepeatedStateIsNotAnsweredTwice)
+TEST(ControllerServices, EachStateIsAnsweredWithItsOwnStampAndLearntFromOnce)
 {
-  // cart_effort carries no stamp: a second answer to one state would be taken by the sim for
-  // its next state's. A repeat of a state whose answer reached a subscriber gets no answer; a
-  // new state does.
+  // The sim repeats a state whose answer it did not get; the controller answers a repeat again
+  // (the same effort, the same stamp: the sim steps on one of them at most) and learns from it
+  // only once. An older stamp (a replayed message) is dropped; the next new state is answered.
   ros::NodeHandle nh;
-  int commands = 0;
-  ros::Subscriber effort = nh.subscribe<std_msgs::Float64>(
-      "/alone/cart_effort", 100,
-      boost::function<void(const std_msgs::Float64ConstPtr&)>([&](const std_msgs::Float64ConstPtr&) { ++commands; }));
+  std::vector<sensor_msgs::JointState> commands;
+  ros::Subscriber command = nh.subscribe<sensor_msgs::JointState>(
+      "/alone/joint_command", 100,
+      boost::function<void(const sensor_msgs::JointStateConstPtr&)>(
+          [&](const sensor_msgs::JointStateConstPtr& m) { commands.push_back(*m); }));
   ros::Publisher states = nh.advertise<sensor_msgs::JointState>("/alone/joint_states", 10);
-  ASSERT_TRUE(spinUntil([&] { return states.getNumSubscribers() > 0 && effort.getNumPublishers() > 0; }, 20.0));
+  ASSERT_TRUE(spinUntil([&] { return states.getNumSubscribers() > 0 && command.getNumPublishers() > 0; }, 20.0));
+  const auto steps = [](const std::string& name) {
+    EXPECT_TRUE(save("alone", name).success);
+    return loadQTableFile(root() + "/alone/" + name).steps;
+  };
 
   sensor_msgs::JointState msg;
   msg.name = {"cart_joint", "pole_joint"};
@@ -242,15 +248,31 @@ TEST(ControllerServices, ARepeatedStateIsNotAnsweredTwice)
   msg.velocity = {0.0, 0.0};
   msg.header.stamp = ros::Time(100.0);  // later than anything the earlier tests sent
   states.publish(msg);
-  ASSERT_TRUE(spinUntil([&] { return commands == 1; }, 10.0)) << "a new state was not answered";
+  ASSERT_TRUE(spinUntil([&] { return commands.size() == 1; }, 10.0)) << "a new state was not answered";
+  const std::uint64_t learnt = steps("repeat_before.yaml");
   states.publish(msg);  // the same stamp again, as the sim repeats an unanswered state
   states.publish(msg);
+  ASSERT_TRUE(spinUntil([&] { return commands.size() == 3; }, 10.0)) << "a repeated state was not answered again";
+  for (const sensor_msgs::JointState& c : commands)
+  {
+    EXPECT_EQ(ros::Time(100.0), c.header.stamp) << "an answer must carry the stamp of the state it answers";
+    ASSERT_EQ(std::vector<std::string>{"cart_joint"}, c.name);
+    ASSERT_EQ(1u, c.effort.size());
+    EXPECT_EQ(commands.front().effort, c.effort) << "a repeat was answered with another effort";
+  }
+  EXPECT_EQ(learnt, steps("repeat_after.yaml")) << "a repeated state was learnt from again";
+
+  msg.header.stamp = ros::Time(99.98);  // older: a replayed message
+  states.publish(msg);
   spinUntil([] { return false; }, 1.0);
-  EXPECT_EQ(1, commands) << "a repeated state was answered again";
+  EXPECT_EQ(3u, commands.size()) << "an older state was answered";
+
   msg.header.stamp = ros::Time(100.02);
   msg.position[1] = 0.021;
   states.publish(msg);
-  EXPECT_TRUE(spinUntil([&] { return commands == 2; }, 10.0)) << "the next state was not answered";
+  ASSERT_TRUE(spinUntil([&] { return commands.size() == 4; }, 10.0)) << "the next state was not answered";
+  EXPECT_EQ(ros::Time(100.02), commands.back().header.stamp);
+  EXPECT_EQ(learnt + 1, steps("next_after.yaml")) << "the transition into the new state was not learnt once";
 }
 
 int main(int argc, char** argv)

@@ -151,7 +151,29 @@ TEST_F(NodeParametersTest, SimRefusesAnEffortLimitAboveTheForceMagnitude)
                 "[/~]effort_limit\\b.*" + number("50(\\.0*)?"));
 }
 
+TEST_F(NodeParametersTest, SimRefusesAMisspeltPrivateParameter)
+{
+  // A typo must stop the node, not leave the default silently in force.
+  expectRefused(kSim, "/ko_sim_typo", {{"cartpole_sim/lockstep_timout", XmlRpcValue(0.3)}},
+                "unknown key lockstep_timout\\b.*lockstep_timeout");
+}
+
+TEST_F(NodeParametersTest, SimRefusesAClockInRealtime)
+{
+  expectRefused(kSim, "/ko_sim_clock",
+                {{"cartpole_sim/mode", XmlRpcValue("realtime")}, {"cartpole_sim/publish_clock", XmlRpcValue(true)}},
+                "[/~]publish_clock\\b.*\\blockstep");
+}
+
 // qlearning_controller
+
+TEST_F(NodeParametersTest, ControllerRefusesAMisspeltPrivateParameter)
+{
+  expectRefused(kController, "/ko_controller_typo",
+                {{"qlearning_controller/checkpoint_evry", XmlRpcValue(10)},
+                 {"qlearning_controller/q_table_dir", XmlRpcValue(dir_.string())}},
+                "unknown key checkpoint_evry\\b");
+}
 
 TEST_F(NodeParametersTest, ControllerRunsWithValidParametersFromItsNamespace)
 {

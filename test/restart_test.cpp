@@ -1,12 +1,14 @@
 // A sim or a controller that dies and comes back: training goes on in lockstep (the sim's
 // repeats reach the new controller; the controller notices the silent sim, reconnects its
-// reset client and starts a new episode on the restarted sim's states).
+// reset client and starts a new episode on the restarted sim's states). All the while another
+// node (this test) subscribes to joint_command: nothing may depend on who listens.
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "ros_test_support.h"
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
+#include <sensor_msgs/JointState.h>
 
 #include <filesystem>
 #include <string>
@@ -60,6 +62,11 @@ TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
       "/restart/episode_stats", 1000,
       boost::function<void(const cartpole_qlearning::EpisodeStatsConstPtr&)>(
           [&](const cartpole_qlearning::EpisodeStatsConstPtr&) { ++episodes; }));
+  std::size_t commands = 0;
+  ros::Subscriber listener = nh.subscribe<sensor_msgs::JointState>(
+      "/restart/joint_command", 1000,
+      boost::function<void(const sensor_msgs::JointStateConstPtr&)>(
+          [&](const sensor_msgs::JointStateConstPtr&) { ++commands; }));
   ros::Subscriber log = nh.subscribe<rosgraph_msgs::Log>(
       "/rosout", 1000,
       boost::function<void(const rosgraph_msgs::LogConstPtr&)>([&](const rosgraph_msgs::LogConstPtr& m) {
@@ -84,12 +91,18 @@ TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
   EXPECT_TRUE(spinUntil([&] { return episodes >= seen + 20; }, 30.0))
       << "training did not resume after the sim restarted: " << episodes - seen << " episodes";
 
-  // The controller dies in the middle of an episode: a new one picks up the waiting state.
+  // The controller dies in the middle of an episode: a new one picks up the waiting state, and
+  // training goes on within 5 s of its start.
+  EXPECT_GT(commands, 0u) << "this test's joint_command subscription heard nothing";
   stop(controller, SIGKILL);
   controller = start(QLEARNING_CONTROLLER, controller_args);
+  const ros::WallTime restarted = ros::WallTime::now();
   seen = episodes;
+  EXPECT_TRUE(spinUntil([&] { return episodes >= seen + 2; }, 5.0))
+      << "training did not resume within 5 s of the controller's restart: " << episodes - seen << " episodes";
   EXPECT_TRUE(spinUntil([&] { return episodes >= seen + 20; }, 30.0))
-      << "training did not resume after the controller restarted: " << episodes - seen << " episodes";
+      << "training did not go on after the controller restarted: " << episodes - seen << " episodes in "
+      << (ros::WallTime::now() - restarted).toSec() << " s";
 
   stop(controller, SIGINT);
   stop(sim, SIGINT);

@@ -79,14 +79,15 @@ protected:
                                 ros::TransportHints().tcpNoDelay());
     clock_sub_ = nh_.subscribe("/clock", 100, &SimLockstepTest::onClock, this, ros::TransportHints().tcpNoDelay());
     effort_pub_ = nh_.advertise<std_msgs::Float64>("/cartpole/cart_effort", 10);
+    command_pub_ = nh_.advertise<sensor_msgs::JointState>("/cartpole/joint_command", 10);
     reset_client_ = nh_.serviceClient<cartpole_qlearning::Reset>("/cartpole/cartpole_sim/reset");
     ASSERT_TRUE(ros::service::waitForService(reset_client_.getService(), ros::Duration(20.0)))
         << reset_client_.getService() << " never came up";
     // Publisher side: the sim's subscription is connected, so a command is delivered.
     ASSERT_TRUE(spinUntil([&] {
-      return effort_pub_.getNumSubscribers() > 0 && states_sub_.getNumPublishers() > 0 &&
-             clock_sub_.getNumPublishers() > 0;
-    })) << "the sim never connected to cart_effort, joint_states or /clock";
+      return effort_pub_.getNumSubscribers() > 0 && command_pub_.getNumSubscribers() > 0 &&
+             states_sub_.getNumPublishers() > 0 && clock_sub_.getNumPublishers() > 0;
+    })) << "the sim never connected to cart_effort, joint_command, joint_states or /clock";
   }
 
   void onJointState(const sensor_msgs::JointStateConstPtr& msg)
@@ -229,6 +230,17 @@ protected:
     return Observed();
   }
 
+  // A joint_command as the controller sends it: the effort of cart_joint, stamped with the stamp
+  // of the state it answers.
+  void command(double effort, const ros::Time& answers)
+  {
+    sensor_msgs::JointState msg;
+    msg.header.stamp = answers;
+    msg.name = {"cart_joint"};
+    msg.effort = {effort};
+    command_pub_.publish(msg);
+  }
+
   // Sends one command and returns the one state that answers it; quiet: also waits a while to
   // see that no second state follows.
   Observed step(double effort, bool quiet)
@@ -284,6 +296,7 @@ protected:
   ros::Subscriber states_sub_;
   ros::Subscriber clock_sub_;
   ros::Publisher effort_pub_;
+  ros::Publisher command_pub_;
   ros::ServiceClient reset_client_;
   std::vector<sensor_msgs::JointState> states_;
   std::vector<ros::Time> clocks_;
@@ -373,6 +386,69 @@ TEST_F(SimLockstepTest, RefusedResetChangesNeitherStateNorTime)
   spinFor(0.5);
   EXPECT_TRUE(noNewState(count)) << "a refused reset published a state";
   expectExactSteps(before, {-10.0, -10.0});
+}
+
+TEST_F(SimLockstepTest, OnlyTheCommandStampedWithThePendingStateStepsIt)
+{
+  const Observed start = resetTo(CartPoleState(0.02, -0.01, 0.01, 0.03));
+  ASSERT_FALSE(HasFailure());
+  expectExactSteps(start, {10.0});  // a state before the pending one, for a stale stamp
+  ASSERT_FALSE(HasFailure());
+  const Observed pending = current();
+  const ros::Duration tau(kTau);
+
+  // Stray commands: an answer to the state before, one to a state not yet published, one
+  // without a stamp, one for another joint, one with mismatched arrays. None may step the sim.
+  const std::size_t count = states_.size();
+  command(-10.0, pending.stamp - tau);
+  command(-10.0, pending.stamp + tau);
+  command(-10.0, ros::Time(0));
+  sensor_msgs::JointState other;
+  other.header.stamp = pending.stamp;
+  other.name = {"pole_joint"};
+  other.effort = {-10.0};
+  command_pub_.publish(other);
+  sensor_msgs::JointState mismatched;
+  mismatched.header.stamp = pending.stamp;
+  mismatched.name = {"cart_joint", "pole_joint"};
+  mismatched.effort = {-10.0};
+  command_pub_.publish(mismatched);
+  spinFor(0.5);
+  EXPECT_TRUE(noNewState(count)) << "a command with a wrong stamp or shape stepped the sim";
+
+  // The pending state's own answer steps it, once, to the core's next state; the same answer
+  // again (a duplicate) and a late one for the state it replaced step nothing.
+  const std::size_t before = states_.size();
+  command(10.0, pending.stamp);
+  ASSERT_TRUE(spinUntil([&] { return newStateArrived(before); })) << "the stamped answer did not step the sim";
+  command(10.0, pending.stamp);
+  command(-10.0, pending.stamp - tau);
+  spinFor(0.5);
+  ASSERT_TRUE(takeOneNewState(before, false)) << "one stamped answer must step exactly once";
+  const Observed next = current();
+  EXPECT_TRUE(near(CartPoleDynamics(CartPoleParams()).step(pending.state, 10.0), next.state, kTolerance));
+  EXPECT_EQ(10.0, next.cart_effort);
+  EXPECT_NEAR(kTau, (next.stamp - pending.stamp).toSec(), 1e-9);
+  expectClock(next.stamp);
+}
+
+TEST_F(SimLockstepTest, AnAnswerInFlightDuringAResetIsDropped)
+{
+  const Observed start = resetTo(CartPoleState(0.01, 0.0, -0.02, 0.0));
+  ASSERT_FALSE(HasFailure());
+  // A user's reset comes between the state and its answer: the answer, stamped with the state
+  // the reset replaced, must not step the new start state.
+  const Observed restart = resetTo(CartPoleState(-0.01, 0.02, 0.0, 0.01));
+  ASSERT_FALSE(HasFailure());
+  const std::size_t count = states_.size();
+  command(10.0, start.stamp);
+  spinFor(0.5);
+  EXPECT_TRUE(noNewState(count)) << "an answer to the state before the reset stepped the new one";
+  const std::size_t before = states_.size();
+  command(-10.0, restart.stamp);
+  ASSERT_TRUE(spinUntil([&] { return newStateArrived(before); }));
+  ASSERT_TRUE(takeOneNewState(before, false));
+  EXPECT_TRUE(near(CartPoleDynamics(CartPoleParams()).step(restart.state, -10.0), current().state, kTolerance));
 }
 
 // Started by sim_lockstep_repeat.test, with a short ~lockstep_timeout (0.2 s): a state nobody
