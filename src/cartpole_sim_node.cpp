@@ -39,7 +39,8 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
 
   if (mode_ == Mode::Lockstep)
     joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>(
-        "joint_states", 10, [this](const ros::SingleSubscriberPublisher& subscriber) { onSubscriberConnect(subscriber); });
+        "joint_states", 10,
+        [this](const ros::SingleSubscriberPublisher& subscriber) { onSubscriberConnect(subscriber); });
   else
     joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
   if (publish_clock_)

@@ -238,8 +238,7 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
       }
       begin(reaction, state);
       break;
-    case Phase::InEpisode:
-    {
+    case Phase::InEpisode: {
       const Decision decision = session_.observe(state);
       reaction.learned = session_.learning();
       if (!decision.episode_over)

@@ -8,7 +8,8 @@ int main(int argc, char** argv)
   ros::NodeHandle pnh("~");
   try
   {
-    cartpole_qlearning::QLearningControllerNode node(nh, pnh, [] { ros::shutdown(); }, true);
+    cartpole_qlearning::QLearningControllerNode node(
+        nh, pnh, [] { ros::shutdown(); }, true);
     ros::spin();
   }
   catch (const std::exception& e)

@@ -168,10 +168,10 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
   int commands = 0;
   bool silent_reported = false;
   bool back_reported = false;
-  ros::Subscriber effort = nh.subscribe<sensor_msgs::JointState>(
-      "/alone/joint_command", 100,
-      boost::function<void(const sensor_msgs::JointStateConstPtr&)>(
-          [&](const sensor_msgs::JointStateConstPtr&) { ++commands; }));
+  ros::Subscriber effort =
+      nh.subscribe<sensor_msgs::JointState>("/alone/joint_command", 100,
+                                            boost::function<void(const sensor_msgs::JointStateConstPtr&)>(
+                                                [&](const sensor_msgs::JointStateConstPtr&) { ++commands; }));
   ros::Subscriber log = nh.subscribe<rosgraph_msgs::Log>(
       "/rosout", 1000,
       boost::function<void(const rosgraph_msgs::LogConstPtr&)>([&](const rosgraph_msgs::LogConstPtr& m) {

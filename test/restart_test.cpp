@@ -63,10 +63,10 @@ TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
       boost::function<void(const cartpole_qlearning::EpisodeStatsConstPtr&)>(
           [&](const cartpole_qlearning::EpisodeStatsConstPtr&) { ++episodes; }));
   std::size_t commands = 0;
-  ros::Subscriber listener = nh.subscribe<sensor_msgs::JointState>(
-      "/restart/joint_command", 1000,
-      boost::function<void(const sensor_msgs::JointStateConstPtr&)>(
-          [&](const sensor_msgs::JointStateConstPtr&) { ++commands; }));
+  ros::Subscriber listener =
+      nh.subscribe<sensor_msgs::JointState>("/restart/joint_command", 1000,
+                                            boost::function<void(const sensor_msgs::JointStateConstPtr&)>(
+                                                [&](const sensor_msgs::JointStateConstPtr&) { ++commands; }));
   ros::Subscriber log = nh.subscribe<rosgraph_msgs::Log>(
       "/rosout", 1000,
       boost::function<void(const rosgraph_msgs::LogConstPtr&)>([&](const rosgraph_msgs::LogConstPtr& m) {

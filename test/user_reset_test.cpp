@@ -54,7 +54,7 @@ bool read(const sensor_msgs::JointState& msg, Recorded& out)
 TEST(UserReset, EveryStepIsThePhysicsOfTheStateItsCommandWasStampedWith)
 {
   ros::NodeHandle nh;
-  std::map<std::uint64_t, Recorded> states;  // by stamp; a repeat carries the same values
+  std::map<std::uint64_t, Recorded> states;               // by stamp; a repeat carries the same values
   std::map<std::uint64_t, std::vector<double>> commands;  // efforts by the stamp they answer
   std::size_t bad_messages = 0;
   std::size_t repeats_differing = 0;
@@ -142,13 +142,13 @@ TEST(UserReset, EveryStepIsThePhysicsOfTheStateItsCommandWasStampedWith)
                        std::all_of(answer->second.begin(), answer->second.end(), [&](double e) { return e == effort; });
     if (!exact && wrong++ == 0)
       first_wrong << "the state at " << stamp << " ns is [" << recorded.state.transpose() << "] under "
-                  << recorded.cart_effort << " N; the physics of the state before it under its command ("
-                  << effort << " N) give [" << expected.transpose() << "]";
+                  << recorded.cart_effort << " N; the physics of the state before it under its command (" << effort
+                  << " N) give [" << expected.transpose() << "]";
   }
   EXPECT_GT(checked, 4000u) << "too few steps recorded to judge";
   EXPECT_GE(resets_seen, static_cast<std::size_t>(user_resets)) << "the user's resets did not all show";
-  EXPECT_EQ(0u, wrong) << wrong << " of " << checked << " steps do not follow from their command: "
-                       << first_wrong.str();
+  EXPECT_EQ(0u, wrong) << wrong << " of " << checked
+                       << " steps do not follow from their command: " << first_wrong.str();
 }
 
 int main(int argc, char** argv)

@@ -155,25 +155,25 @@ struct Reaction
 {
   enum class Kind
   {
-    New,        // a new state (learnt from when an episode ran)
-    Repeat,     // the last state again
-    Stale,      // older than the last state: dropped
-    Stray,      // stamp 0 amid stamped states: dropped
-    Finished    // training has ended: ignored
+    New,      // a new state (learnt from when an episode ran)
+    Repeat,   // the last state again
+    Stale,    // older than the last state: dropped
+    Stray,    // stamp 0 amid stamped states: dropped
+    Finished  // training has ended: ignored
   };
   Kind kind = Kind::New;
   bool answer = false;  // publish a command: effort, stamped with stamp
   double effort = 0.0;
   Stamp stamp = 0;
-  bool learned = false;          // a transition was learnt from (at most once per stamp)
-  bool episode_began = false;    // this state starts an episode
-  bool episode_ended = false;    // TrainingSession::lastEpisode() describes it
+  bool learned = false;            // a transition was learnt from (at most once per stamp)
+  bool episode_began = false;      // this state starts an episode
+  bool episode_ended = false;      // TrainingSession::lastEpisode() describes it
   bool training_finished = false;  // the episode just ended reached the training limits
-  bool request_reset = false;    // call the sim's reset service
+  bool request_reset = false;      // call the sim's reset service
   bool waiting_for_start = false;  // no reset service: the episode ended, now commanding 0 until
                                    // the state is back in the start region (said once per gap)
-  bool sim_restarted = false;    // time went back: the running episode was abandoned
-  bool first_unstamped = false;  // the first state of a stream without stamps (warn once)
+  bool sim_restarted = false;      // time went back: the running episode was abandoned
+  bool first_unstamped = false;    // the first state of a stream without stamps (warn once)
 };
 
 struct ControllerProtocolParams

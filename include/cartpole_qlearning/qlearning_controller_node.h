@@ -85,7 +85,7 @@ private:
   std::string load_on_start_;
   std::uint64_t checkpoint_every_ = 100;
   bool save_on_shutdown_ = true;
-  double sim_timeout_ = 2.0;  // [s] wall
+  double sim_timeout_ = 2.0;                          // [s] wall
   std::string reset_service_ = "cartpole_sim/reset";  // "": a robot that cannot be reset on command
   ControllerProtocolParams protocol_params_;
 
