@@ -1,13 +1,15 @@
-// bare_ping: the reference for the lockstep rate. Publishes a sensor_msgs/JointState shaped like
-// cartpole_sim's (2 joints, 2 positions, 2 velocities, 2 efforts), waits for the std_msgs/Float64
-// that answers it, publishes the next one, and counts round trips over a fixed wall duration.
-// Prints one line "round_trips=N wall_s=T rate=R". Answered by bare_pong, which echoes
-// position[0]: here the sequence number, so that exactly one state is ever in flight.
+// bare_ping: the reference for the lockstep rate. Exchanges the lockstep loop's messages between
+// two processes over TCPROS and nothing else: publishes a sensor_msgs/JointState shaped like
+// cartpole_sim's state (2 joints, 2 positions, 2 velocities, 2 efforts), waits for the command
+// that answers it (a 1-joint JointState stamped with the state's stamp, as the controller's
+// joint_command), publishes the next one, and counts round trips over a fixed wall duration.
+// Prints one line "round_trips=N wall_s=T rate=R". Answered by bare_pong. Every state has a
+// stamp of its own and only the command carrying the latest one moves on, so exactly one state
+// is ever in flight.
 //
-// usage: bare_ping [_duration:=3.0] [_warmup:=0.5]   (topics ping_state, ping_answer)
+// usage: bare_ping [_duration:=3.0] [_warmup:=0.5]   (topics ping_state, ping_command)
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
-#include <std_msgs/Float64.h>
 
 #include <chrono>
 #include <cstdint>
@@ -27,7 +29,7 @@ public:
     state_.velocity = {-0.01, 0.03};
     state_.effort = {10.0, 0.0};
     state_pub_ = nh.advertise<sensor_msgs::JointState>("ping_state", 10);
-    answer_sub_ = nh.subscribe("ping_answer", 10, &BarePing::onAnswer, this, ros::TransportHints().tcpNoDelay());
+    command_sub_ = nh.subscribe("ping_command", 10, &BarePing::onCommand, this, ros::TransportHints().tcpNoDelay());
     // Until the first answer the connections may not be up yet: send again now and then. Wall
     // timer, so that /use_sim_time cannot stall it.
     retry_ = nh.createSteadyTimer(ros::WallDuration(0.1), &BarePing::onRetry, this);
@@ -37,8 +39,7 @@ private:
   void publish()
   {
     ++state_.header.seq;
-    state_.header.stamp.fromNSec(state_.header.seq * 20000000ULL);
-    state_.position[0] = state_.header.seq;
+    state_.header.stamp.fromNSec(state_.header.seq * 20000000ULL);  // one 20 ms tick each, as the sim's
     state_pub_.publish(state_);
   }
 
@@ -48,9 +49,9 @@ private:
       publish();
   }
 
-  void onAnswer(const std_msgs::Float64ConstPtr& msg)
+  void onCommand(const sensor_msgs::JointStateConstPtr& msg)
   {
-    if (msg->data != state_.position[0])
+    if (msg->header.stamp != state_.header.stamp || msg->effort.empty())
       return;  // answers a retry sent before the connections were up: the latest one counts
     if (!answered_)
     {
@@ -78,7 +79,7 @@ private:
         return;
       }
     }
-    state_.effort[0] = -state_.effort[0];
+    state_.effort[0] = msg->effort[0];  // the applied effort, as the sim reports it
     publish();
   }
 
@@ -86,7 +87,7 @@ private:
   double duration_;
   sensor_msgs::JointState state_;
   ros::Publisher state_pub_;
-  ros::Subscriber answer_sub_;
+  ros::Subscriber command_sub_;
   ros::SteadyTimer retry_;
   bool answered_ = false;
   bool counting_ = false;

@@ -1,10 +1,12 @@
 // Speed of the ROS-free core: one physics step, one discretisation, one agent decision and
-// update, one training-session step, and a whole headless training run to solved. The same
-// code runs inside the nodes, so these are the ceilings the ROS graph can approach.
+// update, one training-session step, and a whole training run to solved, headless and through
+// the lockstep protocol's classes (LockstepLoopback). The same code runs inside the nodes, so
+// these are the ceilings the ROS graph can approach.
 #include "cartpole_qlearning/cartpole_dynamics.h"
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/discretiser.h"
 #include "cartpole_qlearning/headless_trainer.h"
+#include "cartpole_qlearning/lockstep_loopback.h"
 #include "cartpole_qlearning/q_learning_agent.h"
 #include "cartpole_qlearning/random.h"
 #include "cartpole_qlearning/training_session.h"
@@ -130,15 +132,17 @@ void BM_TrainingSessionObserve(benchmark::State& state)
 }
 BENCHMARK(BM_TrainingSessionObserve);
 
-// train_headless's work with the shipped config/cartpole.yaml and seed 0, to the solved episode.
-void BM_HeadlessTrainingToSolved(benchmark::State& state)
+// A whole training run with the shipped config/cartpole.yaml and seed 0, to the solved episode.
+// Both trainers make the same calls in the same order, so they run the same steps.
+template <typename Trainer>
+void trainingToSolved(benchmark::State& state)
 {
   const TrainingConfig config = readTrainingConfig(*loadYamlParameters(CARTPOLE_CONFIG_FILE));
   std::uint64_t steps = 0;
   std::uint64_t episodes = 0;
   for (auto _ : state)
   {
-    HeadlessTrainer trainer(config, 0);
+    Trainer trainer(config, 0);
     TrainingResult result = trainer.run();
     benchmark::DoNotOptimize(result);
     if (!result.solved)
@@ -153,8 +157,23 @@ void BM_HeadlessTrainingToSolved(benchmark::State& state)
   state.counters["steps"] = static_cast<double>(state.iterations() > 0 ? steps / state.iterations() : 0);
   state.counters["episodes"] = static_cast<double>(episodes);
 }
+
+// train_headless's work: the simulation and the session wired directly, no protocol.
+void BM_HeadlessTrainingToSolved(benchmark::State& state)
+{
+  trainingToSolved<HeadlessTrainer>(state);
+}
 // Wall time, as train_headless reports it (steps_per_s is then per wall second too).
 BENCHMARK(BM_HeadlessTrainingToSolved)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The lockstep loop without ROS: SimProtocol and ControllerProtocol between the simulation and
+// the session, messages as calls. Its difference from the headless run is the protocol's own
+// cost per step; the nodelet loop adds roscpp's intra-process passing to it.
+void BM_LockstepLoopbackToSolved(benchmark::State& state)
+{
+  trainingToSolved<LockstepLoopback>(state);
+}
+BENCHMARK(BM_LockstepLoopbackToSolved)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

@@ -1,14 +1,17 @@
 // lockstep_answer: drives cartpole_sim in lockstep as fast as it goes. Answers every state on
-// joint_states with a constant effort on cart_effort (no decision: the cheapest controller) and
-// counts states per wall second over a fixed duration. The sim needs no reset: the physics just
-// go on, and stay finite (a constant push for a million steps is checked to). Prints one line
-// "states=N repeats=R wall_s=T rate=R"; repeats are states published again with the same stamp
-// (an answer that did not arrive within the sim's lockstep_timeout), which should be 0.
+// joint_states with a constant effort on joint_command, stamped with the state's stamp as the
+// controller answers (no decision: the cheapest controller), and counts states per wall second
+// over a fixed duration. The sim needs no reset: the physics just go on, and stay finite (a
+// constant push for a million steps is checked to). Prints one line
+// "states=N repeats=R wall_s=T rate=R". repeats are states received again with the stamp of the
+// one before, which the sim sends when it has not stepped on an answer within its
+// lockstep_timeout (the answer was lost, or came too late); they should be 0. A sim that never
+// steps on our answers (one that drops them: a stamp it does not await) would only repeat its
+// state: that is an error (exit 1 after ~start_timeout), not a count of repeats.
 //
-// usage: lockstep_answer __ns:=cartpole [_duration:=3.0] [_warmup:=0.5] [_effort:=10.0]
+// usage: lockstep_answer __ns:=cartpole [_duration:=3.0] [_warmup:=0.5] [_effort:=10.0] [_start_timeout:=5.0]
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
-#include <std_msgs/Float64.h>
 
 #include <chrono>
 #include <cstdint>
@@ -21,15 +24,42 @@ using Clock = std::chrono::steady_clock;
 class LockstepAnswer
 {
 public:
-  LockstepAnswer(ros::NodeHandle& nh, double warmup, double duration, double effort)
+  LockstepAnswer(ros::NodeHandle& nh, double warmup, double duration, double effort, double start_timeout)
     : warmup_(warmup), duration_(duration)
   {
-    answer_.data = effort;
-    effort_pub_ = nh.advertise<std_msgs::Float64>("cart_effort", 10);
+    command_.name = {"cart_joint"};
+    command_.effort = {effort};
+    command_pub_ = nh.advertise<sensor_msgs::JointState>("joint_command", 10);
     state_sub_ = nh.subscribe("joint_states", 10, &LockstepAnswer::onState, this, ros::TransportHints().tcpNoDelay());
+    start_timer_ = nh.createSteadyTimer(ros::WallDuration(start_timeout), &LockstepAnswer::onStartTimeout, this, true);
+  }
+
+  bool failed() const
+  {
+    return failed_;
   }
 
 private:
+  void onStartTimeout(const ros::SteadyTimerEvent&)
+  {
+    if (started_)
+      return;
+    ROS_ERROR(
+        "lockstep_answer: the sim has not stepped on an answer of ours (%s on %s): no lockstep sim there, or "
+        "it drops our joint_command",
+        have_first_stamp_ ? "only one state, repeated" : "no state", state_sub_.getTopic().c_str());
+    failed_ = true;
+    ros::shutdown();
+  }
+
+  void answer(const sensor_msgs::JointState& state)
+  {
+    // A repeat is answered again, as the controller does: its first answer may be the one that
+    // was lost, and a second one that is not is dropped by the sim (at most one step per stamp).
+    command_.header.stamp = state.header.stamp;
+    command_pub_.publish(command_);
+  }
+
   void onState(const sensor_msgs::JointStateConstPtr& msg)
   {
     const Clock::time_point now = Clock::now();
@@ -37,7 +67,8 @@ private:
     {
       // Warm up from the first state that follows an answer of ours: until then an answer can be
       // lost while the connections come up, and the sim sends the state again only after its
-      // lockstep_timeout.
+      // lockstep_timeout. The first state is the one the last client left unanswered, sent
+      // again by the sim when this one subscribed.
       if (!have_first_stamp_)
       {
         first_stamp_ = msg->header.stamp;
@@ -51,7 +82,7 @@ private:
     }
     if (!started_)
     {
-      effort_pub_.publish(answer_);
+      answer(*msg);
       return;
     }
     if (!counting_ && now - warmup_start_ >= std::chrono::duration<double>(warmup_))
@@ -76,14 +107,16 @@ private:
     }
     last_stamp_ = msg->header.stamp;
     have_stamp_ = true;
-    effort_pub_.publish(answer_);
+    answer(*msg);
   }
 
   double warmup_;
   double duration_;
-  std_msgs::Float64 answer_;
-  ros::Publisher effort_pub_;
+  sensor_msgs::JointState command_;
+  ros::Publisher command_pub_;
   ros::Subscriber state_sub_;
+  ros::SteadyTimer start_timer_;
+  bool failed_ = false;
   bool have_first_stamp_ = false;
   ros::Time first_stamp_;
   bool started_ = false;
@@ -105,15 +138,18 @@ int main(int argc, char** argv)
   double duration = 3.0;
   double warmup = 0.5;
   double effort = 10.0;
+  double start_timeout = 5.0;
   pnh.param("duration", duration, duration);
   pnh.param("warmup", warmup, warmup);
   pnh.param("effort", effort, effort);
-  if (!(duration > 0.0) || !(warmup >= 0.0))
+  pnh.param("start_timeout", start_timeout, start_timeout);
+  if (!(duration > 0.0) || !(warmup >= 0.0) || !(start_timeout > 0.0))
   {
-    ROS_ERROR("lockstep_answer: ~duration must be > 0 and ~warmup >= 0 (got %g, %g)", duration, warmup);
+    ROS_ERROR("lockstep_answer: ~duration and ~start_timeout must be > 0 and ~warmup >= 0 (got %g, %g, %g)", duration,
+              start_timeout, warmup);
     return 1;
   }
-  LockstepAnswer answer(nh, warmup, duration, effort);
+  LockstepAnswer answer(nh, warmup, duration, effort, start_timeout);
   ros::spin();
-  return 0;
+  return answer.failed() ? 1 : 0;
 }
