@@ -4,19 +4,20 @@
 
 namespace cartpole_qlearning
 {
-HeadlessTrainer::HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed)
-  : config_(config),
-    simulation_(config.physics, config.start_state_bound, seed),
-    session_(config.task, config.agent, seed)
+HeadlessTrainer::HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed, std::size_t robots)
+  : config_(config), session_(config.task, config.agent, seed, true, robots)
 {
+  for (std::size_t r = 0; r < robots; ++r)
+    simulations_.emplace_back(config.physics, config.start_state_bound, robotSeed(seed, r));
 }
 
 const EpisodeSummary& HeadlessTrainer::runEpisode()
 {
-  double effort = session_.beginEpisode(simulation_.resetRandom());
+  CartPoleSimulation& simulation = simulations_.front();
+  double effort = session_.beginEpisode(simulation.resetRandom());
   for (;;)
   {
-    const Decision decision = session_.observe(simulation_.step(effort));
+    const Decision decision = session_.observe(simulation.step(effort));
     if (decision.episode_over)
       return session_.lastEpisode();
     effort = decision.effort;
@@ -27,19 +28,40 @@ TrainingResult HeadlessTrainer::run(const std::function<void(const EpisodeSummar
 {
   const auto start = std::chrono::steady_clock::now();
   TrainingResult result;
+  // As each sim starts: a random start state. The episodes begin in the first round.
+  std::vector<double> efforts(simulations_.size(), 0.0);
+  for (CartPoleSimulation& simulation : simulations_)
+    simulation.resetRandom();
   for (;;)
   {
-    const EpisodeSummary& summary = runEpisode();
-    result.episodes = summary.episode;
-    result.steps = summary.total_steps;
-    result.solved = result.solved || summary.solved;
-    if (on_episode)
-      on_episode(summary);
-    if (config_.limits.reached(summary.episode, summary.solved))
-      break;
+    for (std::size_t r = 0; r < simulations_.size(); ++r)
+    {
+      CartPoleSimulation& simulation = simulations_[r];
+      if (!session_.inEpisode(r))
+      {
+        efforts[r] = session_.beginEpisode(simulation.state(), r);
+        continue;
+      }
+      const Decision decision = session_.observe(simulation.step(efforts[r]), r);
+      if (!decision.episode_over)
+      {
+        efforts[r] = decision.effort;
+        continue;
+      }
+      const EpisodeSummary& summary = session_.lastEpisode();
+      result.episodes = summary.episode;
+      result.steps = summary.total_steps;
+      result.solved = result.solved || summary.solved;
+      if (on_episode)
+        on_episode(summary);
+      if (config_.limits.reached(summary.episode, summary.solved))
+      {
+        result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return result;
+      }
+      simulation.resetRandom();  // the sim's reset; the next episode begins in the next round
+    }
   }
-  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return result;
 }
 
 }  // namespace cartpole_qlearning

@@ -141,7 +141,20 @@ void ControllerProtocol::begin(Reaction& reaction, const CartPoleState& state)
 {
   reaction.episode_began = true;
   phase_ = Phase::InEpisode;
-  answer(reaction, session_.beginEpisode(state));
+  answer(reaction, session_.beginEpisode(state, params_.robot));
+}
+
+bool ControllerProtocol::takesAsNew(Stamp stamp) const
+{
+  if (phase_ == Phase::Finished)
+    return false;
+  if (stamp == 0)
+    return !have_stamp_;
+  if (have_stamp_ && stamp == last_)
+    return false;
+  if (have_stamp_ && stamp < last_)
+    return older_seen_ == stamp;
+  return true;
 }
 
 Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
@@ -188,7 +201,7 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
     // The same older state twice: a restarted sim repeating its first state.
     ++counts_.restarts;
     reaction.sim_restarted = true;
-    session_.abortEpisode();
+    session_.abortEpisode(params_.robot);
     phase_ = Phase::WaitingForStart;
   }
   return onNewState(reaction, state);
@@ -239,7 +252,7 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
       begin(reaction, state);
       break;
     case Phase::InEpisode: {
-      const Decision decision = session_.observe(state);
+      const Decision decision = session_.observe(state, params_.robot);
       reaction.learned = session_.learning();
       if (!decision.episode_over)
       {

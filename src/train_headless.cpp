@@ -15,10 +15,12 @@ namespace
 {
 void usage(std::ostream& out)
 {
-  out << "usage: train_headless [--config FILE] [--seed N] [--save PATH] [--max-episodes N] [--quiet]\n"
+  out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--save PATH] [--max-episodes N] [--quiet]\n"
          "  --config FILE     physics, task, learning and training parameters (YAML);\n"
          "                    default: the package's config/cartpole.yaml\n"
          "  --seed N          seed of the start states and of exploration (default 0)\n"
+         "  --robots N        N simulated robots feed one learner, served in lockstep rounds in robot order\n"
+         "                    (as train.launch robots:=N); robot r starts from seed S + r (default 1)\n"
          "  --save PATH       write the final Q-table there (atomic)\n"
          "  --max-episodes N  override training/max_episodes\n"
          "  --quiet           no progress lines, only the result line\n";
@@ -53,6 +55,7 @@ int main(int argc, char** argv)
   std::string save_path;
   std::uint64_t seed = 0;
   std::uint64_t max_episodes = 0;
+  std::uint64_t robots = 1;
   bool quiet = false;
   for (int i = 1; i < argc; ++i)
   {
@@ -74,6 +77,14 @@ int main(int argc, char** argv)
       if (!parseCount(argv[++i], seed))
       {
         std::cerr << "train_headless: --seed " << argv[i] << " is not allowed (must be a whole number >= 0)\n";
+        return 2;
+      }
+    }
+    else if (arg == "--robots" && has_value)
+    {
+      if (!parseCount(argv[++i], robots) || robots == 0 || robots > 1000)
+      {
+        std::cerr << "train_headless: --robots " << argv[i] << " is not allowed (must be a whole number in [1, 1000])\n";
         return 2;
       }
     }
@@ -119,7 +130,7 @@ int main(int argc, char** argv)
   if (max_episodes > 0)
     config.limits.max_episodes = max_episodes;
 
-  HeadlessTrainer trainer(config, seed);
+  HeadlessTrainer trainer(config, seed, robots);
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t every = quiet ? 0 : config.limits.progress_every;
   std::uint64_t last_steps = 0;

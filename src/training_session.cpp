@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/training_session.h"
 
 #include <cstdio>
+#include <stdexcept>
 
 namespace cartpole_qlearning
 {
@@ -14,75 +15,90 @@ std::string progressLine(const EpisodeSummary& s, unsigned window, double steps_
   return line;
 }
 
-TrainingSession::TrainingSession(const TaskParams& task, const AgentParams& agent, std::uint64_t seed, bool learning)
-  : task_(task), agent_(agent, seed), learning_(learning)
+void ReturnWindow::push(double value)
 {
+  values_.push_back(value);
+  sum_ += value;
+  if (values_.size() > size_)
+  {
+    sum_ -= values_.front();
+    values_.pop_front();
+  }
 }
 
-std::size_t TrainingSession::chooseAction(std::size_t state)
+TrainingSession::TrainingSession(const TaskParams& task, const AgentParams& agent, std::uint64_t seed, bool learning,
+                                 std::size_t robots)
+  : task_(task), agent_(agent, seed), learning_(learning), returns_(task.solved_window)
 {
-  return learning_ ? agent_.selectAction(state, epsilon_) : agent_.greedyAction(state);
+  if (robots < 1)
+    throw std::invalid_argument("TrainingSession: at least one robot");
+  episodes_.assign(robots, Episode(task.solved_window));
 }
 
-double TrainingSession::beginEpisode(const CartPoleState& start_state)
+std::size_t TrainingSession::chooseAction(std::size_t state, double epsilon)
 {
+  return learning_ ? agent_.selectAction(state, epsilon) : agent_.greedyAction(state);
+}
+
+double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size_t robot)
+{
+  Episode& e = episodes_.at(robot);
   // Schedules count every episode the table has seen, so a loaded table resumes where it was.
   const std::uint64_t episode = agent_.table().episodes;
-  epsilon_ = learning_ ? agent_.epsilon(episode) : 0.0;
-  alpha_ = learning_ ? agent_.alpha(episode) : 0.0;
-  in_episode_ = true;
-  steps_ = 0;
-  return_ = 0.0;
-  state_ = agent_.discretiser().index(start_state);
-  action_ = chooseAction(state_);
-  return agent_.table().actions()[action_];
+  e.epsilon = learning_ ? agent_.epsilon(episode) : 0.0;
+  e.alpha = learning_ ? agent_.alpha(episode) : 0.0;
+  e.running = true;
+  e.steps = 0;
+  e.episode_return = 0.0;
+  e.state = agent_.discretiser().index(start_state);
+  e.action = chooseAction(e.state, e.epsilon);
+  return agent_.table().actions()[e.action];
 }
 
-Decision TrainingSession::observe(const CartPoleState& state)
+Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
 {
+  Episode& e = episodes_.at(robot);
   Decision decision;
-  ++steps_;
-  decision.outcome = task_.evaluate(state, steps_);
-  return_ += decision.outcome.reward;
+  ++e.steps;
+  decision.outcome = task_.evaluate(state, e.steps);
+  e.episode_return += decision.outcome.reward;
   const std::size_t next_state = agent_.discretiser().index(state);
   if (learning_)
   {
-    agent_.update(state_, action_, decision.outcome.reward, next_state, decision.outcome.terminated, alpha_);
+    agent_.update(e.state, e.action, decision.outcome.reward, next_state, decision.outcome.terminated, e.alpha);
     ++agent_.table().steps;
   }
 
   if (!decision.outcome.done())
   {
-    state_ = next_state;
-    action_ = chooseAction(state_);
-    decision.action = action_;
-    decision.effort = agent_.table().actions()[action_];
+    e.state = next_state;
+    e.action = chooseAction(e.state, e.epsilon);
+    decision.action = e.action;
+    decision.effort = agent_.table().actions()[e.action];
     return decision;
   }
 
   decision.episode_over = true;
-  in_episode_ = false;
+  e.running = false;
   if (learning_)
     ++agent_.table().episodes;
+  returns_.push(e.episode_return);
+  e.returns.push(e.episode_return);
+  ++e.ended;
 
-  const unsigned window = task_.params().solved_window;
-  window_.push_back(return_);
-  window_sum_ += return_;
-  if (window_.size() > window)
-  {
-    window_sum_ -= window_.front();
-    window_.pop_front();
-  }
   last_.episode += 1;
-  last_.steps = steps_;
-  last_.episode_return = return_;
-  last_.mean_return_window = window_sum_ / static_cast<double>(window_.size());
-  last_.epsilon = epsilon_;
-  last_.alpha = alpha_;
+  last_.steps = e.steps;
+  last_.episode_return = e.episode_return;
+  last_.mean_return_window = returns_.mean();
+  last_.epsilon = e.epsilon;
+  last_.alpha = e.alpha;
   last_.terminated = decision.outcome.terminated;
   last_.truncated = decision.outcome.truncated;
-  last_.solved = window_.size() == window && last_.mean_return_window >= task_.params().solved_mean_return;
-  last_.total_steps += steps_;
+  last_.solved = returns_.full() && last_.mean_return_window >= task_.params().solved_mean_return;
+  last_.total_steps += e.steps;
+  last_.robot = robot;
+  last_.robot_episode = e.ended;
+  last_.robot_mean_return_window = e.returns.mean();
   return decision;
 }
 

@@ -786,6 +786,37 @@ TEST(LockstepLoopback, SolvesWithTheShippedConfigExactlyAsHeadlessTrainer)
   EXPECT_TRUE(bitIdentical(headless.session().table().values(), loopback.session().table().values()));
 }
 
+// Several robots, one learner: the loopback's rounds (the learner node's order) and the
+// headless trainer's give the same table for each robot count, and every robot takes part.
+TEST(LockstepLoopback, SeveralRobotsTrainExactlyAsHeadlessTrainerWithTheSameRobots)
+{
+  for (const std::size_t robots : {2u, 3u, 4u})
+  {
+    SCOPED_TRACE(std::to_string(robots) + " robots");
+    const TrainingConfig config = shippedConfig();
+    LockstepLoopback loopback(config, 0, robots);
+    HeadlessTrainer headless(config, 0, robots);
+    std::vector<std::uint64_t> episodes_of(robots, 0);
+    const TrainingResult looped = loopback.run([&](const EpisodeSummary& s) {
+      ASSERT_LT(s.robot, robots);
+      EXPECT_EQ(++episodes_of[s.robot], s.robot_episode);
+    });
+    const TrainingResult direct = headless.run();
+    EXPECT_TRUE(looped.solved);
+    EXPECT_EQ(direct.episodes, looped.episodes);
+    EXPECT_EQ(direct.steps, looped.steps);
+    EXPECT_TRUE(bitIdentical(headless.session().table().values(), loopback.session().table().values()));
+    for (std::size_t r = 0; r < robots; ++r)
+      EXPECT_GT(episodes_of[r], looped.episodes / robots / 2) << "robot " << r << " hardly took part";
+  }
+  // One robot is today's single sim: the same table as before robots existed.
+  LockstepLoopback one(shippedConfig(), 0, 1);
+  HeadlessTrainer single(shippedConfig(), 0);
+  one.run();
+  single.run();
+  EXPECT_TRUE(bitIdentical(single.session().table().values(), one.session().table().values()));
+}
+
 namespace
 {
 // How often each fault strikes (every n-th message; 0: never).

@@ -1,6 +1,9 @@
-// Training with the core alone: the simulation and the training session wired directly,
+// Training with the core alone: the simulations and the training session wired directly,
 // one process, no messages. It makes the same calls in the same order as the simulator and
-// controller nodes in lockstep, so a seed gives the same Q-table in both.
+// controller nodes in lockstep, so a seed gives the same Q-table in both. With several robots
+// it serves them in rounds, as the learner node does in lockstep: in each round every robot's
+// next state, in robot order (a robot whose episode ended starts its next one in the round
+// after, from the start state its reset drew).
 #pragma once
 
 #include "cartpole_qlearning/cartpole_simulation.h"
@@ -9,6 +12,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 namespace cartpole_qlearning
 {
@@ -20,16 +24,23 @@ struct TrainingResult
   double wall_s = 0.0;         // wall-clock seconds of the training loop
 };
 
+// The seed of robot r's start states: the run's seed for robot 0 (so one robot is today's
+// single sim), then one more per robot. The sims of train.launch robots:=N get these.
+inline std::uint64_t robotSeed(std::uint64_t seed, std::size_t robot)
+{
+  return seed + robot;
+}
+
 class HeadlessTrainer
 {
 public:
-  HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed);
+  HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed, std::size_t robots = 1);
 
-  // One whole episode from a random start; returns its summary.
+  // Robot 0 alone: one whole episode from a random start; returns its summary.
   const EpisodeSummary& runEpisode();
 
-  // Episodes until solved (when limits.stop_when_solved) or limits.max_episodes; on_episode is
-  // called after each one.
+  // Rounds until solved (when limits.stop_when_solved) or limits.max_episodes; on_episode is
+  // called after each episode.
   TrainingResult run(const std::function<void(const EpisodeSummary&)>& on_episode = {});
 
   const TrainingSession& session() const
@@ -43,7 +54,7 @@ public:
 
 private:
   TrainingConfig config_;
-  CartPoleSimulation simulation_;
+  std::vector<CartPoleSimulation> simulations_;
   TrainingSession session_;
 };
 

@@ -1,8 +1,11 @@
 // The lockstep loop without ROS: the sim's and the controller's protocol classes wired to each
 // other in one process, messages as function calls, the reset service as a call. Everything
-// the two nodes decide is decided here by the same classes in the same order, so its Q-table
-// is the nodes' (and train_headless's) for a seed, and its cost per step is the protocol's own:
+// the nodes decide is decided here by the same classes in the same order, so its Q-table is
+// the nodes' (and train_headless's) for a seed, and its cost per step is the protocol's own:
 // the bound for the nodelet loop (bench/core_benchmark).
+//
+// Several robots: one simulation and one pair of protocols each, one shared learner, served in
+// rounds as the learner node serves them: every robot's state of the round, in robot order.
 #pragma once
 
 #include "cartpole_qlearning/cartpole_simulation.h"
@@ -12,13 +15,16 @@
 #include "cartpole_qlearning/training_session.h"
 
 #include <functional>
+#include <memory>
+#include <vector>
 
 namespace cartpole_qlearning
 {
 class LockstepLoopback
 {
 public:
-  LockstepLoopback(const TrainingConfig& config, std::uint64_t seed);
+  // Robot r's simulation draws its start states from robotSeed(seed, r), as its sim node does.
+  LockstepLoopback(const TrainingConfig& config, std::uint64_t seed, std::size_t robots = 1);
 
   // Trains until the limits are reached; on_episode is called after each episode.
   TrainingResult run(const std::function<void(const EpisodeSummary&)>& on_episode = {});
@@ -27,20 +33,27 @@ public:
   {
     return session_;
   }
-  const SimProtocol& simProtocol() const
+  const SimProtocol& simProtocol(std::size_t robot = 0) const
   {
-    return sim_protocol_;
+    return robots_.at(robot)->sim_protocol;
   }
-  const ControllerProtocol& controllerProtocol() const
+  const ControllerProtocol& controllerProtocol(std::size_t robot = 0) const
   {
-    return controller_protocol_;
+    return robots_.at(robot)->controller_protocol;
   }
 
 private:
-  CartPoleSimulation simulation_;
-  SimProtocol sim_protocol_;
+  struct Robot
+  {
+    Robot(const TrainingConfig& config, std::uint64_t seed, TrainingSession& session, std::size_t index);
+    CartPoleSimulation simulation;
+    SimProtocol sim_protocol;
+    ControllerProtocol controller_protocol;
+    Stamp stamp = 0;  // of the state waiting for the controller
+  };
+
   TrainingSession session_;
-  ControllerProtocol controller_protocol_;
+  std::vector<std::unique_ptr<Robot>> robots_;
 };
 
 }  // namespace cartpole_qlearning

@@ -183,6 +183,8 @@ struct ControllerProtocolParams
   CartPoleState start_region = CartPoleState::Constant(0.05);
   // Training ends after the episode that reaches these (when learning).
   TrainingLimits limits;
+  // Which of the session's robots this protocol serves (one protocol per robot).
+  std::size_t robot = 0;
 };
 
 class ControllerProtocol
@@ -211,6 +213,11 @@ public:
   ControllerProtocol(TrainingSession& session, const ControllerProtocolParams& params);
 
   Reaction onState(Stamp stamp, const CartPoleState& state);
+  // Whether onState would take a state with this stamp as new (and so may learn and draw from
+  // the exploration stream). A learner serving several robots in rounds holds such a state
+  // back until every robot has one; any other it passes on at once (a repeat is answered, a
+  // stale state dropped, without touching the session).
+  bool takesAsNew(Stamp stamp) const;
 
   Phase phase() const
   {

@@ -1,6 +1,13 @@
 // What the controller does with each state it receives: judge the last step with the task,
 // learn from it, choose the next action, and keep the episode statistics. The controller node
 // and the headless trainer both drive this class, so they learn identically.
+//
+// Several robots may feed one session: each has an episode of its own (the state and action
+// it left off at, its step count and return), and all share the learner (one Q-table, one
+// exploration stream, one count of episodes for the schedules, one solved window over every
+// episode in the order they end). The order of the calls across robots is then part of the
+// result: the same seed gives the same table only for the same order (a lockstep round answers
+// the robots in index order).
 #pragma once
 
 #include "cartpole_qlearning/cartpole_task.h"
@@ -9,12 +16,13 @@
 #include <cstdint>
 #include <deque>
 #include <string>
+#include <vector>
 
 namespace cartpole_qlearning
 {
 struct EpisodeSummary
 {
-  std::uint64_t episode = 0;  // 1-based count of episodes this session has ended
+  std::uint64_t episode = 0;  // 1-based count of episodes this session has ended (all robots)
   unsigned steps = 0;
   double episode_return = 0.0;
   double mean_return_window = 0.0;  // over the last solved_window episodes (fewer at the start)
@@ -24,6 +32,9 @@ struct EpisodeSummary
   bool truncated = false;
   bool solved = false;  // a full window whose mean return reaches solved_mean_return
   std::uint64_t total_steps = 0;
+  std::size_t robot = 0;                   // the robot whose episode this was
+  std::uint64_t robot_episode = 0;         // 1-based count of that robot's episodes
+  double robot_mean_return_window = 0.0;   // over that robot's last solved_window episodes
 };
 
 struct Decision
@@ -37,34 +48,61 @@ struct Decision
 // The progress line train_headless and the controller print every few episodes.
 std::string progressLine(const EpisodeSummary& summary, unsigned window, double steps_per_second, double elapsed_s);
 
+// The mean of the last `size` returns.
+class ReturnWindow
+{
+public:
+  explicit ReturnWindow(unsigned size) : size_(size) {}
+  void push(double value);
+  double mean() const
+  {
+    return values_.empty() ? 0.0 : sum_ / static_cast<double>(values_.size());
+  }
+  bool full() const
+  {
+    return values_.size() == size_;
+  }
+
+private:
+  unsigned size_;
+  std::deque<double> values_;
+  double sum_ = 0.0;
+};
+
 class TrainingSession
 {
 public:
   // learning = false: greedy actions, no updates, no exploration draws (evaluation).
-  TrainingSession(const TaskParams& task, const AgentParams& agent, std::uint64_t seed, bool learning = true);
+  // robots: how many robots feed this session (each call names its robot, 0-based).
+  TrainingSession(const TaskParams& task, const AgentParams& agent, std::uint64_t seed, bool learning = true,
+                  std::size_t robots = 1);
 
   // The first state of an episode; returns the first action's effort.
-  double beginEpisode(const CartPoleState& start_state);
+  double beginEpisode(const CartPoleState& start_state, std::size_t robot = 0);
 
   // The state the last action led to: learns from the transition and decides what comes next.
-  Decision observe(const CartPoleState& state);
+  Decision observe(const CartPoleState& state, std::size_t robot = 0);
 
-  bool inEpisode() const
+  bool inEpisode(std::size_t robot = 0) const
   {
-    return in_episode_;
+    return episodes_.at(robot).running;
+  }
+  // Abandons the running episode without learning from its unfinished end (e.g. an external reset).
+  void abortEpisode(std::size_t robot = 0)
+  {
+    episodes_.at(robot).running = false;
   }
   // False: evaluation (greedy, no updates).
   bool learning() const
   {
     return learning_;
   }
-  // Abandons the running episode without learning from its unfinished end (e.g. an external reset).
-  void abortEpisode()
+  std::size_t robots() const
   {
-    in_episode_ = false;
+    return episodes_.size();
   }
 
-  // Valid once an episode has ended.
+  // Valid once an episode has ended: the last one, of whichever robot.
   const EpisodeSummary& lastEpisode() const
   {
     return last_;
@@ -93,22 +131,28 @@ public:
   std::string replaceTable(QTable table);
 
 private:
-  std::size_t chooseAction(std::size_t state);
+  // One robot's episode.
+  struct Episode
+  {
+    explicit Episode(unsigned window) : returns(window) {}
+    bool running = false;
+    std::size_t state = 0;
+    std::size_t action = 0;
+    unsigned steps = 0;
+    double episode_return = 0.0;
+    double epsilon = 0.0;
+    double alpha = 0.0;
+    std::uint64_t ended = 0;
+    ReturnWindow returns;
+  };
+
+  std::size_t chooseAction(std::size_t state, double epsilon);
 
   CartPoleTask task_;
   QLearningAgent agent_;
   bool learning_;
-
-  bool in_episode_ = false;
-  std::size_t state_ = 0;
-  std::size_t action_ = 0;
-  unsigned steps_ = 0;
-  double return_ = 0.0;
-  double epsilon_ = 0.0;
-  double alpha_ = 0.0;
-
-  std::deque<double> window_;
-  double window_sum_ = 0.0;
+  std::vector<Episode> episodes_;
+  ReturnWindow returns_;  // every robot's episodes
   EpisodeSummary last_;
 };
 
