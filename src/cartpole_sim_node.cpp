@@ -102,6 +102,9 @@ void CartPoleSimNode::readParameters()
   priv.readAtLeast("effort_noise_std", effort_noise_std_, 0.0, false);
   priv.read("publish_clock", publish_clock_);
   priv.read("publish_tf", publish_tf_);
+  priv.read("track_y", track_y_);
+  if (!std::isfinite(track_y_))
+    priv.fail("track_y", SectionReader::numberText(track_y_), "must be finite");
   for (const auto& [name, frame] : {std::pair<const char*, std::string*>{"world_frame", &world_frame_},
                                     {"cart_frame", &cart_frame_},
                                     {"pole_frame", &pole_frame_}})
@@ -311,6 +314,7 @@ void CartPoleSimNode::publishState(const ros::Time& stamp)
   cart.header.frame_id = world_frame_;
   cart.child_frame_id = cart_frame_;
   cart.transform.translation.x = s[0];
+  cart.transform.translation.y = track_y_;
   cart.transform.rotation.w = 1.0;
   geometry_msgs::TransformStamped pole;
   pole.header.stamp = stamp;

@@ -4,6 +4,9 @@
 #include "cartpole_qlearning/q_table_file.h"
 #include "cartpole_qlearning/ros_parameter_source.h"
 
+#include <ros/names.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,6 +24,47 @@ std::string defaultTableDirectory()
     return std::string(ros_home) + "/cartpole_qlearning";
   const char* home = std::getenv("HOME");
   return std::string(home != nullptr ? home : ".") + "/.ros/cartpole_qlearning";
+}
+
+// ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
+// the learner's own namespace (N = 1), or robot_0 ... robot_<N-1> (train.launch robots:=N).
+void readRobots(const ros::NodeHandle& pnh, SectionReader& priv, std::vector<std::string>& names)
+{
+  priv.know("robots");
+  XmlRpc::XmlRpcValue value;
+  if (!pnh.getParam("robots", value))
+    return;
+  const auto refuse = [&](const std::string& why) {
+    refuseParameter(pnh, "robots", "'" + value.toXml() + "'", why);
+  };
+  const char* allowed = "a whole number in [1, 1000] or a list of namespaces relative to the controller's";
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeInt)
+  {
+    const int count = static_cast<int>(value);
+    if (count < 1 || count > 1000)
+      refuse(allowed);
+    names.clear();
+    if (count == 1)
+      names.push_back("");
+    for (int i = 0; count > 1 && i < count; ++i)
+      names.push_back("robot_" + std::to_string(i));
+    return;
+  }
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeArray || value.size() < 1 || value.size() > 1000)
+    refuse(allowed);
+  names.clear();
+  for (int i = 0; i < value.size(); ++i)
+  {
+    if (value[i].getType() != XmlRpc::XmlRpcValue::TypeString)
+      refuse(allowed);
+    const std::string name = static_cast<std::string>(value[i]);
+    std::string error;
+    if (!name.empty() && !ros::names::validate(name, error))
+      refuse("'" + name + "' is not a valid ROS name: " + error);
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      refuse("'" + name + "' is listed twice");
+    names.push_back(name);
+  }
 }
 
 double secondsSince(std::chrono::steady_clock::time_point then)
@@ -43,8 +87,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
 {
   const std::lock_guard<std::mutex> lock(mutex_);
   readParameters();
-  session_ = std::make_unique<TrainingSession>(config_.task, config_.agent, seed_, learning_);
-  protocol_ = std::make_unique<ControllerProtocol>(*session_, protocol_params_);
+  session_ = std::make_unique<TrainingSession>(config_.task, config_.agent, seed_, learning_, robot_names_.size());
   if (!load_on_start_.empty())
   {
     std::string path;
@@ -68,30 +111,60 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
     ROS_WARN("qlearning_controller: evaluating a table of zeros (set ~load_on_start to a trained table)");
   }
 
-  started_ = last_episode_end_ = last_state_at_ = last_progress_ = std::chrono::steady_clock::now();
-  command_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_command", 10);
+  started_ = last_episode_end_ = last_progress_ = std::chrono::steady_clock::now();
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
   save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
   load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
+  setUpRobots(state_queue);
   if (protocol_params_.reset_service)
   {
-    // Persistent: a new connection per episode would cost a master lookup and a TCP set-up.
-    reset_client_ = nh_.serviceClient<Reset>(reset_service_, true);
+    reset_pending_.assign(robots_.size(), false);
     reset_thread_ = std::thread(&QLearningControllerNode::resetLoop, this);
   }
   watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, sim_timeout_ / 2.0)),
                                     &QLearningControllerNode::onWatchdog, this);
-  // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
-  ros::NodeHandle state_nh(nh_);
-  if (state_queue != nullptr)
-    state_nh.setCallbackQueue(state_queue);
-  joint_state_sub_ = state_nh.subscribe("joint_states", 10, &QLearningControllerNode::onJointState, this,
-                                        ros::TransportHints().tcpNoDelay());
-  ROS_INFO("qlearning_controller: %s, seed %llu, %zu states x %zu actions, tables under %s, %s",
+  std::string served;
+  for (const Robot& robot : robots_)
+    served += (served.empty() ? "" : ", ") + describe(robot);
+  ROS_INFO("qlearning_controller: %s, seed %llu, %zu states x %zu actions, tables under %s; serving %s%s; %s",
            learning_ ? "training" : "evaluating (greedy, no learning)", static_cast<unsigned long long>(seed_),
-           session_->table().stateCount(), session_->table().actionCount(), q_table_dir_.c_str(),
-           protocol_params_.reset_service ? ("resets by " + reset_client_.getService()).c_str()
+           session_->table().stateCount(), session_->table().actionCount(), q_table_dir_.c_str(), served.c_str(),
+           robots_.size() > 1 ? (sync_ ? " in lockstep rounds" : ", each as its states come") : "",
+           protocol_params_.reset_service ? ("resets by ~" + reset_service_).c_str()
                                           : "no reset service: episodes start when the state is in ~start_region");
+}
+
+void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
+{
+  rounds_ = std::make_unique<RobotRounds>(
+      robot_names_.size(), sync_,
+      std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(sim_timeout_)));
+  robots_.resize(robot_names_.size());
+  const auto now = std::chrono::steady_clock::now();
+  for (std::size_t r = 0; r < robots_.size(); ++r)
+  {
+    Robot& robot = robots_[r];
+    robot.name = robot_names_[r];
+    ControllerProtocolParams params = protocol_params_;
+    params.robot = r;
+    robot.protocol = std::make_unique<ControllerProtocol>(*session_, params);
+    ros::NodeHandle robot_nh = robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name);
+    robot.command_pub = robot_nh.advertise<sensor_msgs::JointState>("joint_command", 10);
+    if (!robot.name.empty())
+      robot.stats_pub = robot_nh.advertise<EpisodeStats>("episode_stats", 100);
+    if (protocol_params_.reset_service)
+      // Persistent: a new connection per episode would cost a master lookup and a TCP set-up.
+      robot.reset_client = robot_nh.serviceClient<Reset>(reset_service_, true);
+    robot.last_state_at = robot.last_episode_end = now;
+    ros::NodeHandle state_nh(robot_nh);
+    if (state_queue != nullptr)
+      state_nh.setCallbackQueue(state_queue);
+    // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
+    robot.state_sub = state_nh.subscribe<sensor_msgs::JointState>(
+        "joint_states", 10,
+        [this, r](const sensor_msgs::JointStateConstPtr& msg) { onJointState(r, msg); }, ros::VoidConstPtr(),
+        ros::TransportHints().tcpNoDelay());
+  }
 }
 
 QLearningControllerNode::~QLearningControllerNode()
@@ -104,7 +177,8 @@ QLearningControllerNode::~QLearningControllerNode()
   if (reset_thread_.joinable())
     reset_thread_.join();
   // No state callback may run during the save (in a nodelet they run on another thread).
-  joint_state_sub_.shutdown();
+  for (Robot& robot : robots_)
+    robot.state_sub.shutdown();
   const std::lock_guard<std::mutex> lock(mutex_);
   if (learning_ && save_on_shutdown_ && !finished_training_)
   {
@@ -166,6 +240,8 @@ void QLearningControllerNode::readParameters()
                 "must be 4 finite values > 0: |x|, |x_dot|, |theta|, |theta_dot| bounds");
     protocol_params_.start_region[i] = region[i];
   }
+  readRobots(pnh_, priv, robot_names_);
+  priv.read("sync", sync_);
   priv.refuseUnknown();
   protocol_params_.limits = config_.limits;
 }
@@ -202,68 +278,108 @@ bool QLearningControllerNode::extractState(const sensor_msgs::JointState& msg, C
   return true;
 }
 
-void QLearningControllerNode::command(double effort, const ros::Time& stamp)
+std::string QLearningControllerNode::describe(const Robot& robot) const
+{
+  return robot.state_sub.getTopic().empty() ? robot.name : robot.state_sub.getTopic();
+}
+
+void QLearningControllerNode::command(Robot& robot, double effort, const ros::Time& stamp)
 {
   // A new message each time: in a nodelet manager the sim receives this very pointer.
   auto msg = boost::make_shared<sensor_msgs::JointState>();
   msg->header.stamp = stamp;
   msg->name = {"cart_joint"};
   msg->effort = {effort};
-  command_pub_.publish(msg);
+  robot.command_pub.publish(msg);
 }
 
-void QLearningControllerNode::onJointState(const sensor_msgs::JointStateConstPtr& msg)
+void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::JointStateConstPtr& msg)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
   CartPoleState state;
   if (finished_training_ || !extractState(*msg, state))
     return;
-  last_state_at_ = std::chrono::steady_clock::now();
-  if (sim_silent_reported_)
+  Robot& robot = robots_[r];
+  robot.last_state_at = std::chrono::steady_clock::now();
+  if (robot.silent_reported)
   {
-    sim_silent_reported_ = false;
-    ROS_INFO("qlearning_controller: joint_states are back; going on");
+    robot.silent_reported = false;
+    ROS_INFO("qlearning_controller: joint_states are back on %s; going on", describe(robot).c_str());
   }
+  if (rounds_->heard(r, robot.last_state_at))
+    ROS_INFO("qlearning_controller: %s takes part in the rounds again", describe(robot).c_str());
 
-  const Reaction reaction = protocol_->onState(msg->header.stamp.toNSec(), state);
-  report(reaction, msg->header.stamp);
-  if (reaction.answer)
-    command(reaction.effort, msg->header.stamp);
-  if (reaction.episode_ended)
-    endEpisode(msg->header.stamp, reaction.training_finished);
-  if (reaction.request_reset && !finished_training_)
-    requestReset();
+  const ros::Time stamp = msg->header.stamp;
+  if (!rounds_->holds() || !robot.protocol->takesAsNew(stamp.toNSec()))
+  {
+    serve(r, stamp, state);
+    return;
+  }
+  robot.held_stamp = stamp;
+  robot.held_state = state;
+  rounds_->hold(r);
+  serveRounds();
 }
 
-void QLearningControllerNode::report(const Reaction& reaction, const ros::Time& stamp)
+void QLearningControllerNode::serveRounds()
 {
-  const ControllerProtocol::Counts& c = protocol_->counts();
+  while (!finished_training_ && rounds_->roundComplete())
+  {
+    for (std::size_t r = 0; r < robots_.size() && !finished_training_; ++r)
+    {
+      if (!rounds_->held(r))
+        continue;
+      rounds_->take(r);
+      serve(r, robots_[r].held_stamp, robots_[r].held_state);
+    }
+  }
+}
+
+void QLearningControllerNode::serve(std::size_t r, const ros::Time& stamp, const CartPoleState& state)
+{
+  Robot& robot = robots_[r];
+  const Reaction reaction = robot.protocol->onState(stamp.toNSec(), state);
+  report(robot, reaction, stamp);
+  if (reaction.answer)
+    command(robot, reaction.effort, stamp);
+  if (reaction.episode_ended)
+    endEpisode(robot, stamp, reaction.training_finished);
+  if (reaction.request_reset && !finished_training_)
+    requestReset(r);
+}
+
+void QLearningControllerNode::report(const Robot& robot, const Reaction& reaction, const ros::Time& stamp)
+{
+  const ControllerProtocol::Counts& c = robot.protocol->counts();
   if (reaction.kind == Reaction::Kind::Stale && dropped_state_warning_.ready())
     ROS_WARN(
-        "qlearning_controller: dropped joint_states stamped %.6f, older than the last state (a replayed or "
+        "qlearning_controller: dropped joint_states on %s stamped %.6f, older than the last state (a replayed or "
         "reordered message; a restarted sim is recognised when it sends its state again). Dropped so far: %llu",
-        stamp.toSec(), static_cast<unsigned long long>(c.stale));
+        describe(robot).c_str(), stamp.toSec(), static_cast<unsigned long long>(c.stale));
   if (reaction.kind == Reaction::Kind::Stray && dropped_state_warning_.ready())
-    ROS_WARN("qlearning_controller: dropped joint_states without a stamp among stamped ones. Dropped so far: %llu",
-             static_cast<unsigned long long>(c.stray));
+    ROS_WARN("qlearning_controller: dropped joint_states on %s without a stamp among stamped ones. Dropped so far: %llu",
+             describe(robot).c_str(), static_cast<unsigned long long>(c.stray));
   if (reaction.first_unstamped)
     ROS_WARN(
-        "qlearning_controller: joint_states carry no stamp (0): every message is taken as a new state, and "
-        "commands go out unstamped");
+        "qlearning_controller: joint_states on %s carry no stamp (0): every message is taken as a new state, and "
+        "commands go out unstamped",
+        describe(robot).c_str());
   if (reaction.sim_restarted)
-    ROS_WARN("qlearning_controller: joint_states time went back to %.3f s: the sim restarted; starting a new episode",
-             stamp.toSec());
+    ROS_WARN("qlearning_controller: %s: time went back to %.3f s: the sim restarted; starting a new episode",
+             describe(robot).c_str(), stamp.toSec());
   if (reaction.waiting_for_start)
     ROS_INFO(
-        "qlearning_controller: episode over; no reset service, so commanding 0 until the state is back inside "
-        "~start_region (stand the pole up)");
+        "qlearning_controller: %s: episode over; no reset service, so commanding 0 until the state is back inside "
+        "~start_region (stand the pole up)",
+        describe(robot).c_str());
 }
 
-void QLearningControllerNode::endEpisode(const ros::Time& stamp, bool training_finished)
+void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, bool training_finished)
 {
   const EpisodeSummary& s = session_->lastEpisode();
-  const double episode_wall = secondsSince(last_episode_end_);
-  last_episode_end_ = std::chrono::steady_clock::now();
+  const double wall = secondsSince(last_episode_end_);
+  const double robot_wall = secondsSince(robot.last_episode_end);
+  last_episode_end_ = robot.last_episode_end = std::chrono::steady_clock::now();
 
   // When training ends here, the table is saved before episode_stats says so: whoever acts on
   // the last message finds the final file.
@@ -273,6 +389,7 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp, bool training_f
 
   EpisodeStats stats;
   stats.header.stamp = stamp;
+  stats.robot = robot.name;
   stats.episode = static_cast<std::uint32_t>(s.episode);
   stats.steps = s.steps;
   stats.episode_return = s.episode_return;
@@ -283,8 +400,17 @@ void QLearningControllerNode::endEpisode(const ros::Time& stamp, bool training_f
   stats.truncated = s.truncated;
   stats.solved = s.solved;
   stats.total_steps = s.total_steps;
-  stats.steps_per_second = episode_wall > 0.0 ? s.steps / episode_wall : 0.0;
+  stats.steps_per_second = wall > 0.0 ? (s.total_steps - steps_at_last_episode_) / wall : 0.0;
+  steps_at_last_episode_ = s.total_steps;
   stats_pub_.publish(stats);
+  if (robot.stats_pub)
+  {
+    stats.episode = static_cast<std::uint32_t>(s.robot_episode);
+    stats.mean_return_100 = s.robot_mean_return_window;
+    stats.total_steps = s.robot_total_steps;
+    stats.steps_per_second = robot_wall > 0.0 ? s.steps / robot_wall : 0.0;
+    robot.stats_pub.publish(stats);
+  }
 
   const TrainingLimits& limits = config_.limits;
   if (limits.progress_every > 0 && s.episode % limits.progress_every == 0)
@@ -385,56 +511,93 @@ bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::R
 void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (finished_training_ || sim_silent_reported_ || secondsSince(last_state_at_) < sim_timeout_)
+  if (finished_training_)
     return;
-  sim_silent_reported_ = true;
-  ROS_WARN("qlearning_controller: no joint_states on %s for %.1f s: is cartpole_sim running? Waiting for it",
-           joint_state_sub_.getTopic().c_str(), sim_timeout_);
+  for (Robot& robot : robots_)
+  {
+    if (robot.silent_reported || secondsSince(robot.last_state_at) < sim_timeout_)
+      continue;
+    robot.silent_reported = true;
+    ROS_WARN("qlearning_controller: no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting for it",
+             describe(robot).c_str(), sim_timeout_);
+  }
+  const std::vector<std::size_t> dropped = rounds_->dropOuts(WallClock::now());
+  for (const std::size_t r : dropped)
+    ROS_WARN("qlearning_controller: %s is silent; the rounds go on without it until it is back",
+             describe(robots_[r]).c_str());
+  if (!dropped.empty())
+    serveRounds();
 }
 
-void QLearningControllerNode::requestReset()
+void QLearningControllerNode::requestReset(std::size_t robot)
 {
   {
     std::lock_guard<std::mutex> lock(reset_mutex_);
-    reset_pending_ = true;
+    reset_pending_.at(robot) = true;
   }
   reset_wanted_.notify_one();
 }
 
 void QLearningControllerNode::resetLoop()
 {
-  bool failing = false;
+  // Robots whose reset failed are called again no sooner than this later, so that one dead
+  // robot does not hold up the others' resets.
+  const auto retry_after = std::chrono::milliseconds(200);
+  std::vector<std::chrono::steady_clock::time_point> retry_at(robots_.size());
+  std::vector<bool> failing(robots_.size(), false);
   for (;;)
   {
+    std::size_t r = robots_.size();
     {
       std::unique_lock<std::mutex> lock(reset_mutex_);
-      reset_wanted_.wait(lock, [this] { return reset_pending_ || stopping_; });
-      if (stopping_)
-        return;
+      for (;;)
+      {
+        if (stopping_)
+          return;
+        const auto now = std::chrono::steady_clock::now();
+        auto next_retry = std::chrono::steady_clock::time_point::max();
+        for (std::size_t i = 0; i < robots_.size() && r == robots_.size(); ++i)
+        {
+          if (!reset_pending_[i])
+            continue;
+          if (retry_at[i] <= now)
+            r = i;
+          else
+            next_retry = std::min(next_retry, retry_at[i]);
+        }
+        if (r < robots_.size())
+          break;
+        if (next_retry == std::chrono::steady_clock::time_point::max())
+          reset_wanted_.wait(lock);
+        else
+          reset_wanted_.wait_until(lock, next_retry);
+      }
       // Taken before the call: a request made while the call is under way (a short episode
       // can end before this thread sees the answer) is then served by the next call, not lost.
-      reset_pending_ = false;
+      reset_pending_[r] = false;
     }
+    Robot& robot = robots_[r];
     Reset reset;  // empty state: a random start
-    if (reset_client_.call(reset) && reset.response.success)
+    if (robot.reset_client.call(reset) && reset.response.success)
     {
-      if (failing)
-        ROS_INFO("qlearning_controller: %s answers again; going on", reset_client_.getService().c_str());
-      failing = false;
+      if (failing[r])
+        ROS_INFO("qlearning_controller: %s answers again; going on", robot.reset_client.getService().c_str());
+      failing[r] = false;
       continue;
     }
-    if (!failing)
+    if (!failing[r])
       ROS_WARN("qlearning_controller: reset call to %s failed%s; retrying until it answers",
-               reset_client_.getService().c_str(),
+               robot.reset_client.getService().c_str(),
                reset.response.message.empty() ? "" : (": " + reset.response.message).c_str());
-    failing = true;
-    if (!reset_client_.isValid())  // the persistent connection broke (sim restarted): reconnect
-      reset_client_ = nh_.serviceClient<Reset>(reset_service_, true);
-    std::unique_lock<std::mutex> lock(reset_mutex_);
-    reset_pending_ = true;
-    reset_wanted_.wait_for(lock, std::chrono::milliseconds(200), [this] { return stopping_; });
-    if (stopping_)
-      return;
+    failing[r] = true;
+    if (!robot.reset_client.isValid())  // the persistent connection broke (sim restarted): reconnect
+    {
+      ros::NodeHandle robot_nh = robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name);
+      robot.reset_client = robot_nh.serviceClient<Reset>(reset_service_, true);
+    }
+    std::lock_guard<std::mutex> lock(reset_mutex_);
+    reset_pending_[r] = true;
+    retry_at[r] = std::chrono::steady_clock::now() + retry_after;
   }
 }
 

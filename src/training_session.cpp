@@ -85,6 +85,7 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   returns_.push(e.episode_return);
   e.returns.push(e.episode_return);
   ++e.ended;
+  e.total_steps += e.steps;
 
   last_.episode += 1;
   last_.steps = e.steps;
@@ -99,6 +100,7 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   last_.robot = robot;
   last_.robot_episode = e.ended;
   last_.robot_mean_return_window = e.returns.mean();
+  last_.robot_total_steps = e.total_steps;
   return decision;
 }
 

@@ -130,6 +130,12 @@ public:
     }
   }
 
+  // A key read by other means (a value of a form the sources do not offer): not unknown.
+  void know(const std::string& name)
+  {
+    known_.insert(key(name));
+  }
+
   // Refuses a key under this section that no read() asked for.
   void refuseUnknown() const
   {

@@ -35,6 +35,7 @@ struct EpisodeSummary
   std::size_t robot = 0;                   // the robot whose episode this was
   std::uint64_t robot_episode = 0;         // 1-based count of that robot's episodes
   double robot_mean_return_window = 0.0;   // over that robot's last solved_window episodes
+  std::uint64_t robot_total_steps = 0;     // that robot's steps over all its episodes
 };
 
 struct Decision
@@ -143,6 +144,7 @@ private:
     double epsilon = 0.0;
     double alpha = 0.0;
     std::uint64_t ended = 0;
+    std::uint64_t total_steps = 0;
     ReturnWindow returns;
   };
 
