@@ -4,6 +4,7 @@
 // node (this test) subscribes to joint_command: nothing may depend on who listens.
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "ros_test_support.h"
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -19,32 +20,11 @@
 #include <unistd.h>
 
 using cartpole_qlearning::test::spinUntil;
+using cartpole_qlearning::test::startProcess;
+using cartpole_qlearning::test::stopProcess;
 
 namespace
 {
-// Starts an executable with ROS arguments; returns its pid.
-pid_t start(const std::string& executable, const std::vector<std::string>& args)
-{
-  const pid_t pid = ::fork();
-  if (pid == 0)
-  {
-    std::vector<char*> argv{const_cast<char*>(executable.c_str())};
-    for (const std::string& a : args)
-      argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(executable.c_str(), argv.data());
-    ::_exit(127);
-  }
-  return pid;
-}
-
-void stop(pid_t pid, int signal)
-{
-  ::kill(pid, signal);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-}
-
 std::string tableDir()
 {
   std::string dir;
@@ -79,14 +59,14 @@ TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
                                                     "_sim_timeout:=1.0",        "_checkpoint_every:=0",
                                                     "_save_on_shutdown:=false", "_max_episodes:=1000000",
                                                     "_stop_when_solved:=false", "_q_table_dir:=" + tableDir()};
-  pid_t sim = start(CARTPOLE_SIM, sim_args);
-  pid_t controller = start(QLEARNING_CONTROLLER, controller_args);
+  pid_t sim = startProcess(CARTPOLE_SIM, sim_args);
+  pid_t controller = startProcess(QLEARNING_CONTROLLER, controller_args);
   ASSERT_TRUE(spinUntil([&] { return episodes >= 20; }, 30.0)) << "training does not start: " << episodes;
 
   // The sim dies: the controller says so; a new sim comes and training goes on.
-  stop(sim, SIGKILL);
+  stopProcess(sim, SIGKILL);
   EXPECT_TRUE(spinUntil([&] { return silent_reported; }, 15.0)) << "the silent sim was not reported";
-  sim = start(CARTPOLE_SIM, sim_args);
+  sim = startProcess(CARTPOLE_SIM, sim_args);
   std::size_t seen = episodes;
   EXPECT_TRUE(spinUntil([&] { return episodes >= seen + 20; }, 30.0))
       << "training did not resume after the sim restarted: " << episodes - seen << " episodes";
@@ -94,8 +74,8 @@ TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
   // The controller dies in the middle of an episode: a new one picks up the waiting state, and
   // training goes on within 5 s of its start.
   EXPECT_GT(commands, 0u) << "this test's joint_command subscription heard nothing";
-  stop(controller, SIGKILL);
-  controller = start(QLEARNING_CONTROLLER, controller_args);
+  stopProcess(controller, SIGKILL);
+  controller = startProcess(QLEARNING_CONTROLLER, controller_args);
   const ros::WallTime restarted = ros::WallTime::now();
   seen = episodes;
   EXPECT_TRUE(spinUntil([&] { return episodes >= seen + 2; }, 5.0))
@@ -104,8 +84,8 @@ TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
       << "training did not go on after the controller restarted: " << episodes - seen << " episodes in "
       << (ros::WallTime::now() - restarted).toSec() << " s";
 
-  stop(controller, SIGINT);
-  stop(sim, SIGINT);
+  stopProcess(controller, SIGINT);
+  stopProcess(sim, SIGINT);
 }
 
 int main(int argc, char** argv)

@@ -7,6 +7,10 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include <signal.h>
+#include <unistd.h>
 
 #include <sys/wait.h>
 
@@ -53,6 +57,34 @@ inline std::string readFile(const std::string& path)
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();
+}
+
+// Starts an executable with arguments (and extra NAME=VALUE environment entries) in the
+// background; returns its pid.
+inline pid_t startProcess(const std::string& executable, const std::vector<std::string>& args,
+                          const std::vector<std::string>& environment = {})
+{
+  const pid_t pid = ::fork();
+  if (pid == 0)
+  {
+    for (const std::string& entry : environment)
+      ::putenv(const_cast<char*>(entry.c_str()));
+    std::vector<char*> argv{const_cast<char*>(executable.c_str())};
+    for (const std::string& a : args)
+      argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(executable.c_str(), argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// Sends the signal and waits for the process to end.
+inline void stopProcess(pid_t pid, int signal)
+{
+  ::kill(pid, signal);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
 }
 
 }  // namespace test

@@ -1,0 +1,84 @@
+// train.launch robots:=3, seed 0 (started by robots_train.test, two processes or nodelets):
+// one learner fed by three sims in lockstep rounds writes the table train_headless --robots 3
+// writes, byte for byte; every robot's own episode_stats count its episodes, and the learner's
+// count them all.
+#include "cartpole_qlearning/EpisodeStats.h"
+
+#include "ros_test_support.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using cartpole_qlearning::EpisodeStats;
+using cartpole_qlearning::EpisodeStatsConstPtr;
+using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::spinUntil;
+
+TEST(RobotsTrain, ThreeRobotsWriteTheHeadlessTableForThreeRobots)
+{
+  ros::NodeHandle nh;
+  std::string dir;
+  ASSERT_TRUE(ros::param::get("~q_table_dir", dir));
+  std::vector<EpisodeStats> all;
+  std::vector<std::vector<EpisodeStats>> per_robot(3);
+  std::vector<ros::Subscriber> subs;
+  subs.push_back(nh.subscribe<EpisodeStats>(
+      "/robots3/episode_stats", 10000,
+      boost::function<void(const EpisodeStatsConstPtr&)>([&](const EpisodeStatsConstPtr& m) { all.push_back(*m); })));
+  for (std::size_t r = 0; r < 3; ++r)
+    subs.push_back(nh.subscribe<EpisodeStats>(
+        "/robots3/robot_" + std::to_string(r) + "/episode_stats", 10000,
+        boost::function<void(const EpisodeStatsConstPtr&)>(
+            [&, r](const EpisodeStatsConstPtr& m) { per_robot[r].push_back(*m); })));
+
+  ASSERT_TRUE(spinUntil([&] { return !all.empty() && all.back().solved; }, 120.0))
+      << "no solved episode; episodes seen: " << all.size();
+  const std::string trained = dir + "/q_table.yaml";
+  ASSERT_TRUE(spinUntil([&] { return fs::exists(trained); }, 10.0)) << trained;
+  const std::string headless = dir + "/headless.yaml";
+  const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --robots 3 --quiet --config " +
+                              CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
+  ASSERT_EQ(0, std::system(command.c_str())) << command;
+  EXPECT_EQ(readFile(headless), readFile(trained)) << "robots:=3 and train_headless --robots 3 differ for seed 0";
+
+  // The learner's topic numbers every episode; each robot's numbers its own, and names it.
+  bool check_episode_stats = true;
+  ros::param::get("~check_episode_stats", check_episode_stats);
+  if (!check_episode_stats)
+    return;
+  spinUntil([] { return false; }, 0.5);
+  std::uint64_t robot_episodes = 0;
+  for (std::size_t r = 0; r < 3; ++r)
+  {
+    SCOPED_TRACE("robot_" + std::to_string(r));
+    EXPECT_GT(per_robot[r].size(), 20u) << "the robot hardly took part";
+    for (std::size_t i = 1; i < per_robot[r].size(); ++i)
+      EXPECT_EQ(per_robot[r][i - 1].episode + 1, per_robot[r][i].episode);
+    for (const EpisodeStats& s : per_robot[r])
+      EXPECT_EQ("robot_" + std::to_string(r), s.robot);
+    if (!per_robot[r].empty())
+      robot_episodes += per_robot[r].back().episode;
+  }
+  for (std::size_t i = 1; i < all.size(); ++i)
+    EXPECT_EQ(all[i - 1].episode + 1, all[i].episode);
+  EXPECT_EQ(all.back().episode, robot_episodes) << "the learner's episodes are not the robots' episodes together";
+}
+
+int main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "robots_train_test");
+  ros::NodeHandle nh;
+  const int result = RUN_ALL_TESTS();
+  std::string dir;
+  if (ros::param::get("~q_table_dir", dir))
+    fs::remove_all(dir);
+  return result;
+}
