@@ -69,8 +69,7 @@ TrainingResult LockstepLoopback::run(const std::function<void(const EpisodeSumma
         robot->stamp = robot->sim_protocol.onReset(now);
         continue;
       }
-      if (!reaction.answer ||
-          robot->sim_protocol.onCommand(reaction.stamp, now) != SimProtocol::Verdict::Step)
+      if (!reaction.answer || robot->sim_protocol.onCommand(reaction.stamp, now) != SimProtocol::Verdict::Step)
         throw std::logic_error("lockstep loopback: the controller's reaction does not move the sim on");
       robot->simulation.step(reaction.effort);
       robot->stamp = robot->sim_protocol.pending();

@@ -34,9 +34,7 @@ void readRobots(const ros::NodeHandle& pnh, SectionReader& priv, std::vector<std
   XmlRpc::XmlRpcValue value;
   if (!pnh.getParam("robots", value))
     return;
-  const auto refuse = [&](const std::string& why) {
-    refuseParameter(pnh, "robots", "'" + value.toXml() + "'", why);
-  };
+  const auto refuse = [&](const std::string& why) { refuseParameter(pnh, "robots", "'" + value.toXml() + "'", why); };
   const char* allowed = "a whole number in [1, 1000] or a list of namespaces relative to the controller's";
   if (value.getType() == XmlRpc::XmlRpcValue::TypeInt)
   {
@@ -161,9 +159,8 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
       state_nh.setCallbackQueue(state_queue);
     // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
     robot.state_sub = state_nh.subscribe<sensor_msgs::JointState>(
-        "joint_states", 10,
-        [this, r](const sensor_msgs::JointStateConstPtr& msg) { onJointState(r, msg); }, ros::VoidConstPtr(),
-        ros::TransportHints().tcpNoDelay());
+        "joint_states", 10, [this, r](const sensor_msgs::JointStateConstPtr& msg) { onJointState(r, msg); },
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   }
 }
 
@@ -357,8 +354,9 @@ void QLearningControllerNode::report(const Robot& robot, const Reaction& reactio
         "reordered message; a restarted sim is recognised when it sends its state again). Dropped so far: %llu",
         describe(robot).c_str(), stamp.toSec(), static_cast<unsigned long long>(c.stale));
   if (reaction.kind == Reaction::Kind::Stray && dropped_state_warning_.ready())
-    ROS_WARN("qlearning_controller: dropped joint_states on %s without a stamp among stamped ones. Dropped so far: %llu",
-             describe(robot).c_str(), static_cast<unsigned long long>(c.stray));
+    ROS_WARN(
+        "qlearning_controller: dropped joint_states on %s without a stamp among stamped ones. Dropped so far: %llu",
+        describe(robot).c_str(), static_cast<unsigned long long>(c.stray));
   if (reaction.first_unstamped)
     ROS_WARN(
         "qlearning_controller: joint_states on %s carry no stamp (0): every message is taken as a new state, and "
@@ -577,6 +575,11 @@ void QLearningControllerNode::resetLoop()
       reset_pending_[r] = false;
     }
     Robot& robot = robots_[r];
+    // A persistent client made before its service existed, or whose sim restarted, is not
+    // valid: connect again first.
+    if (!robot.reset_client.isValid())
+      robot.reset_client =
+          (robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name)).serviceClient<Reset>(reset_service_, true);
     Reset reset;  // empty state: a random start
     if (robot.reset_client.call(reset) && reset.response.success)
     {
@@ -590,11 +593,6 @@ void QLearningControllerNode::resetLoop()
                robot.reset_client.getService().c_str(),
                reset.response.message.empty() ? "" : (": " + reset.response.message).c_str());
     failing[r] = true;
-    if (!robot.reset_client.isValid())  // the persistent connection broke (sim restarted): reconnect
-    {
-      ros::NodeHandle robot_nh = robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name);
-      robot.reset_client = robot_nh.serviceClient<Reset>(reset_service_, true);
-    }
     std::lock_guard<std::mutex> lock(reset_mutex_);
     reset_pending_[r] = true;
     retry_at[r] = std::chrono::steady_clock::now() + retry_after;

@@ -84,7 +84,8 @@ int main(int argc, char** argv)
     {
       if (!parseCount(argv[++i], robots) || robots == 0 || robots > 1000)
       {
-        std::cerr << "train_headless: --robots " << argv[i] << " is not allowed (must be a whole number in [1, 1000])\n";
+        std::cerr << "train_headless: --robots " << argv[i]
+                  << " is not allowed (must be a whole number in [1, 1000])\n";
         return 2;
       }
     }

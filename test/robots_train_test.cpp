@@ -33,10 +33,10 @@ TEST(RobotsTrain, ThreeRobotsWriteTheHeadlessTableForThreeRobots)
       "/robots3/episode_stats", 10000,
       boost::function<void(const EpisodeStatsConstPtr&)>([&](const EpisodeStatsConstPtr& m) { all.push_back(*m); })));
   for (std::size_t r = 0; r < 3; ++r)
-    subs.push_back(nh.subscribe<EpisodeStats>(
-        "/robots3/robot_" + std::to_string(r) + "/episode_stats", 10000,
-        boost::function<void(const EpisodeStatsConstPtr&)>(
-            [&, r](const EpisodeStatsConstPtr& m) { per_robot[r].push_back(*m); })));
+    subs.push_back(
+        nh.subscribe<EpisodeStats>("/robots3/robot_" + std::to_string(r) + "/episode_stats", 10000,
+                                   boost::function<void(const EpisodeStatsConstPtr&)>(
+                                       [&, r](const EpisodeStatsConstPtr& m) { per_robot[r].push_back(*m); })));
 
   ASSERT_TRUE(spinUntil([&] { return !all.empty() && all.back().solved; }, 120.0))
       << "no solved episode; episodes seen: " << all.size();

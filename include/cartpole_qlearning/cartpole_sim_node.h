@@ -77,7 +77,7 @@ private:
   bool publish_clock_ = false;     // lockstep: drive /clock (one lockstep instance per master)
   bool publish_tf_ = true;
   double tf_rate_ = 30.0;  // [Hz] lockstep: TF at most this often (wall clock)
-  double track_y_ = 0.0;  // [m] where the track lies along world y (several robots side by side)
+  double track_y_ = 0.0;   // [m] where the track lies along world y (several robots side by side)
   std::string world_frame_ = "world";
   std::string cart_frame_ = "cart";
   std::string pole_frame_ = "pole";

@@ -57,9 +57,9 @@ private:
     std::unique_ptr<ControllerProtocol> protocol;
     ros::Subscriber state_sub;
     ros::Publisher command_pub;
-    ros::Publisher stats_pub;          // only for a robot in a namespace of its own
-    ros::ServiceClient reset_client;   // used by the reset thread only
-    ros::Time held_stamp;              // a new state waiting for its round
+    ros::Publisher stats_pub;         // only for a robot in a namespace of its own
+    ros::ServiceClient reset_client;  // used by the reset thread only
+    ros::Time held_stamp;             // a new state waiting for its round
     CartPoleState held_state;
     std::chrono::steady_clock::time_point last_state_at;
     std::chrono::steady_clock::time_point last_episode_end;
@@ -111,7 +111,7 @@ private:
   std::string load_on_start_;
   std::uint64_t checkpoint_every_ = 100;
   bool save_on_shutdown_ = true;
-  double sim_timeout_ = 2.0;  // [s] wall
+  double sim_timeout_ = 2.0;                          // [s] wall
   std::string reset_service_ = "cartpole_sim/reset";  // "": a robot that cannot be reset on command
   std::vector<std::string> robot_names_{""};
   bool sync_ = true;

@@ -32,10 +32,10 @@ struct EpisodeSummary
   bool truncated = false;
   bool solved = false;  // a full window whose mean return reaches solved_mean_return
   std::uint64_t total_steps = 0;
-  std::size_t robot = 0;                   // the robot whose episode this was
-  std::uint64_t robot_episode = 0;         // 1-based count of that robot's episodes
-  double robot_mean_return_window = 0.0;   // over that robot's last solved_window episodes
-  std::uint64_t robot_total_steps = 0;     // that robot's steps over all its episodes
+  std::size_t robot = 0;                  // the robot whose episode this was
+  std::uint64_t robot_episode = 0;        // 1-based count of that robot's episodes
+  double robot_mean_return_window = 0.0;  // over that robot's last solved_window episodes
+  std::uint64_t robot_total_steps = 0;    // that robot's steps over all its episodes
 };
 
 struct Decision
