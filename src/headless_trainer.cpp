@@ -49,9 +49,7 @@ TrainingResult HeadlessTrainer::run(const std::function<void(const EpisodeSummar
         continue;
       }
       const EpisodeSummary& summary = session_.lastEpisode();
-      result.episodes = summary.episode;
-      result.steps = summary.total_steps;
-      result.solved = result.solved || summary.solved;
+      result.record(summary);
       if (on_episode)
         on_episode(summary);
       if (config_.limits.reached(summary.episode, summary.solved))

@@ -52,9 +52,7 @@ TrainingResult LockstepLoopback::run(const std::function<void(const EpisodeSumma
       if (reaction.episode_ended)
       {
         const EpisodeSummary& summary = session_.lastEpisode();
-        result.episodes = summary.episode;
-        result.steps = summary.total_steps;
-        result.solved = result.solved || summary.solved;
+        result.record(summary);
         if (on_episode)
           on_episode(summary);
         if (reaction.training_finished)

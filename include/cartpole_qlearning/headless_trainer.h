@@ -22,6 +22,14 @@ struct TrainingResult
   std::uint64_t episodes = 0;  // episodes run
   std::uint64_t steps = 0;     // steps run
   double wall_s = 0.0;         // wall-clock seconds of the training loop
+
+  // Counts an episode that just ended.
+  void record(const EpisodeSummary& summary)
+  {
+    episodes = summary.episode;
+    steps = summary.total_steps;
+    solved = solved || summary.solved;
+  }
 };
 
 // The seed of robot r's start states: the run's seed for robot 0 (so one robot is today's
