@@ -41,6 +41,9 @@
 # It starts its own roscore on a free port (ROS_MASTER_URI), keeps logs and Q-tables in a
 # temporary ROS_HOME, and stops every process it started when it exits.
 set -euo pipefail
+ME=run_benchmarks.sh
+# shellcheck source-path=SCRIPTDIR source=bench_common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/bench_common.sh"
 
 ROUNDS=${BENCH_ROUNDS:-3}
 DURATION=${BENCH_DURATION:-1.5}
@@ -48,16 +51,13 @@ WARMUP=0.3
 NODELET_RUNS=${BENCH_NODELET_RUNS:-3}
 ANCHOR_SEEDS=${BENCH_ANCHOR_SEEDS:-0 1 2}
 if ! [[ "$ROUNDS" =~ ^[0-9]+$ ]] || ((ROUNDS < 2)); then
-  echo "run_benchmarks.sh: BENCH_ROUNDS=$ROUNDS is not allowed (must be a whole number >= 2)" >&2
-  exit 1
+  die "BENCH_ROUNDS=$ROUNDS is not allowed (must be a whole number >= 2)"
 fi
 if ! [[ "$NODELET_RUNS" =~ ^[0-9]+$ ]] || ((NODELET_RUNS < 1)); then
-  echo "run_benchmarks.sh: BENCH_NODELET_RUNS=$NODELET_RUNS is not allowed (must be a whole number >= 1)" >&2
-  exit 1
+  die "BENCH_NODELET_RUNS=$NODELET_RUNS is not allowed (must be a whole number >= 1)"
 fi
 if ! [[ "$ANCHOR_SEEDS" =~ ^[0-9]+( [0-9]+)*$ ]]; then
-  echo "run_benchmarks.sh: BENCH_ANCHOR_SEEDS='$ANCHOR_SEEDS' is not allowed (whole numbers, one space apart)" >&2
-  exit 1
+  die "BENCH_ANCHOR_SEEDS='$ANCHOR_SEEDS' is not allowed (whole numbers, one space apart)"
 fi
 TRAIN_TIMEOUT=${BENCH_TRAIN_TIMEOUT:-180}
 PKG=cartpole_qlearning
@@ -65,14 +65,8 @@ CPU=${BENCH_CPU-0}
 PIN=()
 if [[ -n "$CPU" && "$CPU" != none ]]; then
   PIN=(taskset -c "$CPU")
-  "${PIN[@]}" true 2>/dev/null || { echo "run_benchmarks.sh: cannot run on CPU $CPU (BENCH_CPU)" >&2; exit 1; }
+  "${PIN[@]}" true 2>/dev/null || die "cannot run on CPU $CPU (BENCH_CPU)"
 fi
-
-die()
-{
-  echo "run_benchmarks.sh: $*" >&2
-  exit 1
-}
 
 PKG_DIR=$(rospack find "$PKG" 2>/dev/null) || die "package $PKG not found: source the workspace's devel/setup.bash"
 find_exe()
@@ -100,63 +94,17 @@ elif ! /usr/bin/python3 -c 'import numpy' 2>/dev/null; then
   ANCHOR_SKIPPED="/usr/bin/python3 cannot import numpy (Debian: python3-numpy)"
 fi
 
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/cartpole_bench.XXXXXX")
-export ROS_HOME="$WORK/ros_home"
-mkdir -p "$ROS_HOME"
-
-# Every background process starts in a process group of its own (setsid), so that stopping it
-# also stops what it started (roscore's rosmaster and rosout, roslaunch's nodes).
-PIDS=()
-OK=false
-cleanup()
-{
-  local i
-  for ((i = ${#PIDS[@]} - 1; i >= 0; i--)); do
-    stop "${PIDS[i]}"
-  done
-  if $OK && [[ "${BENCH_KEEP_LOGS:-0}" != 1 ]]; then
-    rm -rf "$WORK"
-  elif $OK; then
-    echo "run_benchmarks.sh: logs kept in $WORK" >&2
-  else
-    echo "run_benchmarks.sh: did not finish; logs kept in $WORK" >&2
-  fi
-}
-trap cleanup EXIT
-trap 'exit 130' INT
-trap 'exit 143' TERM
-
-# Starts a command in the background, in its own process group; its pid is in STARTED.
-start()
-{
-  local log=$1
-  shift
-  setsid "$@" >"$WORK/$log" 2>&1 </dev/null &
-  STARTED=$!
-  PIDS+=("$STARTED")
-}
-
-# Stops one started process group and waits for it.
-stop()
-{
-  local pid=$1
-  kill -INT -- "-$pid" 2>/dev/null || true
-  for _ in $(seq 50); do
-    kill -0 -- "-$pid" 2>/dev/null || break
-    sleep 0.1
-  done
-  kill -KILL -- "-$pid" 2>/dev/null || true
-  wait "$pid" 2>/dev/null || true
-}
+make_work cartpole_bench
 
 # Runs a command to its end (at most timeout_s), in its own process group, output in a log.
 run()
 {
-  local log=$1 timeout_s=$2
+  local log=$1 timeout_s=$2 pid rc=0
   shift 2
   start "$log" timeout -s INT -k 5 "$timeout_s" "$@"
-  local rc=0
-  wait "$STARTED" || rc=$?
+  pid=$STARTED
+  wait "$pid" || rc=$?
+  forget "$pid"
   ((rc == 0)) || die "$* exited with $rc (log: $WORK/$log)"
 }
 
@@ -191,14 +139,7 @@ calc()
 }
 
 # --- The master ---------------------------------------------------------------------------------
-PORT=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-export ROS_MASTER_URI="http://127.0.0.1:$PORT"
-start roscore.log roscore -p "$PORT"
-for _ in $(seq 150); do
-  (exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null && break
-  sleep 0.1
-done
-(exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null || die "roscore did not start on port $PORT (log: $WORK/roscore.log)"
+start_master
 
 ANCHOR_COUNT=$(wc -w <<<"$ANCHOR_SEEDS")
 [[ -n "$ANCHOR_SKIPPED" ]] && ANCHOR_COUNT=0

@@ -61,6 +61,8 @@
 set -euo pipefail
 
 ME=run_fleet_benchmarks.sh
+# shellcheck source-path=SCRIPTDIR source=bench_common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/bench_common.sh"
 ROBOTS_LIST=${BENCH_ROBOTS:-1 2 4 8}
 NODELET_RUNS=${BENCH_NODELET_RUNS:-3}
 TRAIN_TIMEOUT=${BENCH_TRAIN_TIMEOUT:-120}
@@ -68,12 +70,6 @@ CPU=${BENCH_CPU:-none}
 SAMPLE_PERIOD=0.2 # s, the profile's sampling period (at episode ends)
 WARM=0.5          # s after the first episode end before the profile window may start
 PKG=cartpole_qlearning
-
-die()
-{
-  echo "$ME: $*" >&2
-  exit 1
-}
 
 [[ "$ROBOTS_LIST" =~ ^[1-9][0-9]*( [1-9][0-9]*)*$ ]] ||
   die "BENCH_ROBOTS='$ROBOTS_LIST' is not allowed (whole numbers >= 1, one space apart)"
@@ -92,89 +88,11 @@ TRAIN_HEADLESS=$(catkin_find --first-only --libexec "$PKG" train_headless 2>/dev
 /usr/bin/python3 -c "import genpy.dynamic, rospy" 2>/dev/null ||
   die "python3 cannot import rospy and genpy (the profile's helper needs them; Debian: python3-rospy)"
 
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/cartpole_fleet_bench.XXXXXX")
-export ROS_HOME="$WORK/ros_home"
+make_work cartpole_fleet_bench
 export ROS_LOG_DIR="$ROS_HOME/log"
-mkdir -p "$ROS_HOME" "$WORK/tmp"
+mkdir -p "$WORK/tmp"
 RESULTS="$WORK/results.txt"
 : >"$RESULTS"
-
-# Every background process starts in a process group of its own (setsid), so that stopping it
-# also stops what it started (roscore's rosmaster and rosout). roslaunch starts each node in a
-# session of its own, so on the way out the descendants of a started process are stopped by pid
-# too, should roslaunch not have stopped them.
-PIDS=()
-OK=false
-
-# The pids of every descendant of a process.
-descendants()
-{
-  ps -eo pid=,ppid= | awk -v root="$1" '{ parent[$1] = $2 }
-    END { n = 1; q[1] = root; for (i = 1; i <= n; i++) for (p in parent) if (parent[p] == q[i]) { q[++n] = p; print p } }'
-}
-
-# True while a process exists and is not a zombie.
-alive()
-{
-  local state
-  state=$(ps -o stat= -p "$1" 2>/dev/null) || return 1
-  [[ "$state" != Z* ]]
-}
-
-# Stops one started process group (and every descendant of its leader) and waits for it.
-stop()
-{
-  local pid=$1 d others
-  others=$(descendants "$pid")
-  kill -INT -- "-$pid" 2>/dev/null || true
-  for _ in $(seq 50); do
-    alive "$pid" || break
-    sleep 0.1
-  done
-  kill -KILL -- "-$pid" 2>/dev/null || true
-  for d in $others; do
-    alive "$d" && kill -KILL "$d" 2>/dev/null
-  done
-  wait "$pid" 2>/dev/null || true
-}
-
-# Drops a pid that has been waited for from the ones to stop on the way out.
-forget()
-{
-  local i
-  for i in "${!PIDS[@]}"; do
-    [[ "${PIDS[i]}" == "$1" ]] && unset 'PIDS[i]'
-  done
-  PIDS=("${PIDS[@]}")
-}
-
-cleanup()
-{
-  local i
-  for ((i = ${#PIDS[@]} - 1; i >= 0; i--)); do
-    stop "${PIDS[i]}"
-  done
-  if $OK && [[ "${BENCH_KEEP_LOGS:-0}" != 1 ]]; then
-    rm -rf "$WORK"
-  elif $OK; then
-    echo "$ME: logs kept in $WORK" >&2
-  else
-    echo "$ME: did not finish; logs kept in $WORK" >&2
-  fi
-}
-trap cleanup EXIT
-trap 'exit 130' INT
-trap 'exit 143' TERM
-
-# Starts a command in the background, in its own process group; its pid is in STARTED.
-start()
-{
-  local log=$1
-  shift
-  setsid "$@" >"$WORK/$log" 2>&1 </dev/null &
-  STARTED=$!
-  PIDS+=("$STARTED")
-}
 
 # --- The profiling helper -----------------------------------------------------------------------
 # usage: fleet_profile.py OUT PIDFILE ROBOTS PERIOD WARM
@@ -356,14 +274,7 @@ os._exit(0)
 EOF
 
 # --- The master ---------------------------------------------------------------------------------
-PORT=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-export ROS_MASTER_URI="http://127.0.0.1:$PORT"
-start roscore.log roscore -p "$PORT"
-for _ in $(seq 150); do
-  (exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null && break
-  sleep 0.1
-done
-(exec 3<>"/dev/tcp/127.0.0.1/$PORT") 2>/dev/null || die "roscore did not start on port $PORT (log: $WORK/roscore.log)"
+start_master
 # rosout up too: the launches' log lines go through it
 for _ in $(seq 100); do
   rosnode list 2>/dev/null | grep -qx /rosout && break
