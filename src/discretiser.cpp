@@ -9,7 +9,6 @@ namespace cartpole_qlearning
 namespace
 {
 const char* const kDimensionNames[kStateDimensions] = {"x", "x_dot", "theta", "theta_dot"};
-constexpr unsigned kMaxBinsPerDimension = 1000;
 }  // namespace
 
 std::string DiscretiserParams::validate() const
@@ -29,6 +28,14 @@ std::string DiscretiserParams::validate() const
           << ", " << upper[d] << " are not allowed (must be finite with lower < upper)";
       return out.str();
     }
+  }
+  std::uint64_t states = 1;
+  for (const unsigned b : bins)
+    states *= b;  // at most 1000^4: no overflow
+  if (states > kMaxStates)
+  {
+    out << "bins give " << states << " states, more than the " << kMaxStates << " allowed";
+    return out.str();
   }
   return "";
 }

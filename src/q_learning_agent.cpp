@@ -34,6 +34,9 @@ std::string AgentParams::validate() const
     return error;
   if (actions.empty())
     return "actions = [] is not allowed (must list at least one effort)";
+  if (actions.size() > kMaxActions)
+    return "actions lists " + std::to_string(actions.size()) + " efforts, which is not allowed (at most " +
+           std::to_string(kMaxActions) + ")";
   for (std::size_t i = 0; i < actions.size(); ++i)
   {
     if (!std::isfinite(actions[i]))

@@ -229,8 +229,9 @@ QTable parseQTable(const std::string& text)
   const std::vector<double> upper = readNumbers(required(root, "upper_bounds"), "upper_bounds", kStateDimensions);
   for (std::size_t i = 0; i < kStateDimensions; ++i)
   {
-    if (bins[i] != std::floor(bins[i]) || bins[i] < 1)
-      refuse("bins[" + std::to_string(i) + "] is not a whole number >= 1");
+    if (bins[i] != std::floor(bins[i]) || bins[i] < 1 || bins[i] > kMaxBinsPerDimension)
+      refuse("bins[" + std::to_string(i) + "] is not a whole number in [1, " + std::to_string(kMaxBinsPerDimension) +
+             "]");
     discretiser.bins[i] = static_cast<unsigned>(bins[i]);
     discretiser.lower[i] = lower[i];
     discretiser.upper[i] = upper[i];
@@ -239,8 +240,9 @@ QTable parseQTable(const std::string& text)
   if (!invalid.empty())
     refuse("invalid discretisation: " + invalid);
   const std::vector<double> actions = readNumbers(required(root, "actions"), "actions", 0);
-  if (actions.empty())
-    refuse("actions is empty");
+  if (actions.empty() || actions.size() > kMaxActions)
+    refuse("actions has " + std::to_string(actions.size()) + " entries (allowed: 1 to " + std::to_string(kMaxActions) +
+           ")");
 
   QTable table(discretiser, actions);
   table.episodes = readCount(required(root, "episodes"), "episodes");
@@ -336,6 +338,14 @@ QTable loadQTableFile(const std::string& path)
   std::ifstream in(path, std::ios::binary);
   if (!in)
     refuse(systemError("cannot open", path));
+  // The largest table allowed (kMaxStates rows) is written in well under this.
+  constexpr std::streamoff kMaxFileBytes = std::streamoff(1) << 30;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size > kMaxFileBytes)
+    refuse(path + ": " + std::to_string(size) + " bytes, more than a Q-table file may have (" +
+           std::to_string(kMaxFileBytes) + ")");
+  in.seekg(0, std::ios::beg);
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad())
@@ -355,24 +365,40 @@ std::string resolvePathUnder(const std::string& directory, const std::string& pa
   if (path.empty())
     refuse("the path is empty");
   std::error_code ec;
+  // The directory itself is the user's choice, links and all; below it nothing may lead out.
   const fs::path base = fs::weakly_canonical(fs::absolute(directory), ec);
   if (ec)
     refuse("cannot resolve directory " + directory + ": " + ec.message());
+  const std::string outside = " (refused: paths must stay inside " + base.string() + ")";
   const fs::path given(path);
-  const fs::path resolved = fs::weakly_canonical(given.is_absolute() ? given : base / given, ec);
-  if (ec)
-    refuse("cannot resolve " + path + ": " + ec.message());
-  // Compare whole components: /data/qtables2 is not inside /data/qtables.
-  auto b = base.begin();
-  auto r = resolved.begin();
-  for (; b != base.end() && !b->empty(); ++b, ++r)
+  // No "..": resolving it means following whatever the components before it are, and
+  // weakly_canonical stops resolving at the first one missing ("nope/../link/t.yaml").
+  for (const fs::path& part : given)
   {
-    if (r == resolved.end() || *r != *b)
-      refuse(path + " is outside " + base.string() + " (refused: paths must stay inside that directory)");
+    if (part == "..")
+      refuse(path + " contains '..'" + outside);
   }
-  if (r == resolved.end() || r->empty())
+  fs::path relative = given.lexically_normal();
+  if (given.is_absolute())
+  {
+    relative = relative.lexically_relative(base);
+    if (relative.empty() || *relative.begin() == "..")
+      refuse(path + " is outside " + base.string() + outside);
+  }
+  if (relative.empty() || relative == "." || relative.filename().empty())
     refuse(path + " names the directory " + base.string() + " itself, not a file in it");
-  return resolved.string();
+  // No symbolic link on the way, to a directory or to the file: a link can lead anywhere.
+  fs::path walk = base;
+  for (const fs::path& part : relative)
+  {
+    walk /= part;
+    const fs::file_status status = fs::symlink_status(walk, ec);
+    if (ec || !fs::exists(status))
+      break;  // nothing exists below a missing component
+    if (fs::is_symlink(status))
+      refuse(path + ": " + walk.string() + " is a symbolic link" + outside);
+  }
+  return (base / relative).string();
 }
 
 }  // namespace cartpole_qlearning

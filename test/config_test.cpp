@@ -76,6 +76,13 @@ TEST(Config, BadValuesNameTheKeyTheValueAndTheRange)
   EXPECT_NE(std::string::npos,
             errorOf("learning: {gamma: 1.5}").find("learning/gamma = 1.5 is not allowed (must be in [0, 1])"));
   EXPECT_NE(std::string::npos, errorOf("physics: {mass_pole: -1}").find("physics/mass_pole = -1"));
+  // Too many bins: refused with the value given (checked before any conversion), and too many
+  // states in all before anything is allocated.
+  const std::string huge_bins = errorOf("learning: {bins: [10000000000, 1, 1, 1]}");
+  EXPECT_NE(std::string::npos, huge_bins.find("1e+10")) << huge_bins;
+  EXPECT_NE(std::string::npos, huge_bins.find("[1, 1000]")) << huge_bins;
+  const std::string many_states = errorOf("learning: {bins: [1000, 1000, 1000, 1000]}");
+  EXPECT_NE(std::string::npos, many_states.find("1000000000000 states")) << many_states;
   EXPECT_NE(std::string::npos, errorOf("physics: {integrator: verlet}").find("physics/integrator = 'verlet'"));
   EXPECT_NE(std::string::npos, errorOf("task: {max_episode_steps: 0}").find("task/max_episode_steps = 0"));
   EXPECT_NE(std::string::npos, errorOf("learning: {bins: [1, 1, 6]}").find("learning/bins"));

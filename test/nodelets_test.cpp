@@ -1,7 +1,6 @@
 // Both nodes as nodelets in one manager with one worker thread (their lockstep topics on the
 // nodelets' shared lockstep thread, passing pointers): training solves, the table is
 // train_headless's byte for byte, and the manager outlives the finished training.
-#include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/Reset.h"
 
 #include "ros_test_support.h"
@@ -23,26 +22,19 @@ TEST(Nodelets, TrainingOnOneWorkerThreadSolvesWithTheHeadlessTable)
   ros::NodeHandle nh;
   std::string dir;
   ASSERT_TRUE(ros::param::get("~q_table_dir", dir));
-  std::uint32_t last_episode = 0;
-  bool solved = false;
-  ros::Subscriber sub = nh.subscribe<cartpole_qlearning::EpisodeStats>(
-      "/cartpole/episode_stats", 1000,
-      boost::function<void(const cartpole_qlearning::EpisodeStatsConstPtr&)>(
-          [&](const cartpole_qlearning::EpisodeStatsConstPtr& m) {
-            last_episode = m->episode;
-            solved = solved || m->solved;
-          }));
-  // Episode after episode: every reset call returned although the sim's service and the
-  // controller share the manager's one worker thread.
-  ASSERT_TRUE(spinUntil([&] { return solved; }, 60.0)) << "training stalled at episode " << last_episode;
-
-  const std::string trained = dir + "/q_table.yaml";
-  ASSERT_TRUE(spinUntil([&] { return fs::exists(trained); }, 10.0)) << trained;
+  // Training there takes well under a second, maybe less than this node needs to subscribe to
+  // episode_stats: what is awaited is the final table, which must be train_headless's.
   const std::string headless = dir + "/headless.yaml";
   const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " +
                               CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
-  EXPECT_EQ(readFile(headless), readFile(trained)) << "nodelet training and train_headless differ for seed 0";
+  const std::string expected = readFile(headless);
+  const std::string trained = dir + "/q_table.yaml";
+  // Episode after episode: every reset call returned although the sim's service and the
+  // controller share the manager's one worker thread.
+  EXPECT_TRUE(spinUntil([&] { return fs::exists(trained) && readFile(trained) == expected; }, 60.0))
+      << "nodelet training did not write train_headless's table for seed 0 (" << trained
+      << (fs::exists(trained) ? " differs)" : " was not written: training stalled?)");
 
   // The controller stopped acting but did not end its manager: the sim still serves.
   cartpole_qlearning::Reset reset;

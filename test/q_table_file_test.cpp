@@ -233,6 +233,30 @@ TEST_F(QTableFileTest, WrongShapeIsRefused)
   }
 }
 
+TEST_F(QTableFileTest, AHeaderClaimingAHugeTableIsRefusedBeforeAnythingIsAllocated)
+{
+  // A few hundred bytes asking for 10^12 states: refused with a message, not std::bad_alloc.
+  saveQTableFile(awkwardTable(), path("t.yaml"));
+  std::string text = readFile(path("t.yaml"));
+  const std::size_t bins = text.find("bins: [");
+  text.replace(bins, text.find('\n', bins) - bins, "bins: [1000, 1000, 1000, 1000]");
+  write(path("huge.yaml"), text);
+  try
+  {
+    loadQTableFile(path("huge.yaml"));
+    FAIL() << "a table of 10^12 states was accepted";
+  }
+  catch (const QTableFileError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("1000000000000 states")) << e.what();
+  }
+  std::string wide = readFile(path("t.yaml"));
+  const std::size_t b = wide.find("bins: [");
+  wide.replace(b, wide.find('\n', b) - b, "bins: [10000000000, 1, 1, 1]");
+  write(path("wide.yaml"), wide);
+  EXPECT_THROW(loadQTableFile(path("wide.yaml")), QTableFileError);
+}
+
 TEST_F(QTableFileTest, ATableOfAnotherShapeIsRefusedByTheSessionAndTheLiveTableIsUntouched)
 {
   TrainingSession session(TaskParams(), AgentParams(), 0);
@@ -264,7 +288,7 @@ TEST_F(QTableFileTest, RelativePathsResolveUnderTheDirectory)
 {
   const std::string base = fs::weakly_canonical(dir_).string();
   EXPECT_EQ(base + "/q.yaml", resolvePathUnder(dir_.string(), "q.yaml"));
-  EXPECT_EQ(base + "/runs/q.yaml", resolvePathUnder(dir_.string(), "runs/./x/../q.yaml"));
+  EXPECT_EQ(base + "/runs/q.yaml", resolvePathUnder(dir_.string(), "runs/./q.yaml"));
   EXPECT_EQ(base + "/abs.yaml", resolvePathUnder(dir_.string(), base + "/abs.yaml"));
 }
 
@@ -272,14 +296,25 @@ TEST_F(QTableFileTest, PathsEscapingTheDirectoryAreRefused)
 {
   fs::create_directories(dir_ / "tables");
   const std::string tables = (dir_ / "tables").string();
-  for (const std::string& escape : {std::string("../q.yaml"), std::string("a/../../q.yaml"), std::string("/etc/passwd"),
-                                    (dir_ / "tables2" / "q.yaml").string(), std::string(".."), std::string(".")})
+  for (const std::string& escape :
+       {std::string("../q.yaml"), std::string("a/../../q.yaml"), std::string("runs/x/../q.yaml"),
+        std::string("/etc/passwd"), (dir_ / "tables2" / "q.yaml").string(), std::string(".."), std::string("."),
+        std::string("runs/")})
   {
     EXPECT_THROW(resolvePathUnder(tables, escape), QTableFileError) << escape;
   }
-  // Through a symbolic link that points outside.
+  // Through a symbolic link that points outside, also behind a missing directory and "..",
+  // where resolving stops at the missing one ("nope/../out/q.yaml" once wrote outside).
   fs::create_directory_symlink(dir_, dir_ / "tables" / "out");
   EXPECT_THROW(resolvePathUnder(tables, "out/q.yaml"), QTableFileError);
+  EXPECT_THROW(resolvePathUnder(tables, "nope/../out/q.yaml"), QTableFileError);
+  // Any link on the way is refused, even one that stays inside today: it can be changed.
+  fs::create_directories(dir_ / "tables" / "runs");
+  fs::create_directory_symlink(dir_ / "tables" / "runs", dir_ / "tables" / "alias");
+  EXPECT_THROW(resolvePathUnder(tables, "alias/q.yaml"), QTableFileError);
+  fs::create_symlink(dir_ / "elsewhere.yaml", dir_ / "tables" / "runs" / "link.yaml");
+  EXPECT_THROW(resolvePathUnder(tables, "runs/link.yaml"), QTableFileError);
+  EXPECT_NO_THROW(resolvePathUnder(tables, "runs/new/q.yaml"));
   EXPECT_THROW(resolvePathUnder(tables, ""), QTableFileError);
   EXPECT_FALSE(fs::exists(dir_ / "q.yaml"));
 }

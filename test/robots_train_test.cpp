@@ -38,21 +38,25 @@ TEST(RobotsTrain, ThreeRobotsWriteTheHeadlessTableForThreeRobots)
                                    boost::function<void(const EpisodeStatsConstPtr&)>(
                                        [&, r](const EpisodeStatsConstPtr& m) { per_robot[r].push_back(*m); })));
 
-  ASSERT_TRUE(spinUntil([&] { return !all.empty() && all.back().solved; }, 120.0))
-      << "no solved episode; episodes seen: " << all.size();
-  const std::string trained = dir + "/q_table.yaml";
-  ASSERT_TRUE(spinUntil([&] { return fs::exists(trained); }, 10.0)) << trained;
+  // The table train_headless writes for three robots; training over ROS must end with it (the
+  // checkpoints on the way are other tables). As nodelets, training may be over before this
+  // node's subscriptions are up, so the file is what is awaited.
   const std::string headless = dir + "/headless.yaml";
   const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --robots 3 --quiet --config " +
                               CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
-  EXPECT_EQ(readFile(headless), readFile(trained)) << "robots:=3 and train_headless --robots 3 differ for seed 0";
+  const std::string expected = readFile(headless);
+  const std::string trained = dir + "/q_table.yaml";
+  const bool same = spinUntil([&] { return fs::exists(trained) && readFile(trained) == expected; }, 120.0);
+  EXPECT_TRUE(same) << "robots:=3 did not write train_headless --robots 3's table for seed 0 (" << trained
+                    << (fs::exists(trained) ? " differs)" : " was not written)");
 
   // The learner's topic numbers every episode; each robot's numbers its own, and names it.
   bool check_episode_stats = true;
   ros::param::get("~check_episode_stats", check_episode_stats);
-  if (!check_episode_stats)
+  if (!check_episode_stats || !same)
     return;
+  ASSERT_TRUE(spinUntil([&] { return !all.empty() && all.back().solved; }, 10.0)) << "no solved episode_stats";
   spinUntil([] { return false; }, 0.5);
   std::uint64_t robot_episodes = 0;
   for (std::size_t r = 0; r < 3; ++r)

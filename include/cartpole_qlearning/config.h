@@ -124,8 +124,9 @@ public:
       fail(name, listText(list), "must list 4 values: x, x_dot, theta, theta_dot");
     for (std::size_t i = 0; i < kStateDimensions; ++i)
     {
-      if (whole && (list[i] != std::floor(list[i]) || list[i] < 1))
-        fail(name, listText(list), "must be whole numbers >= 1");
+      // Checked before the conversion: a value out of the type's range would be undefined.
+      if (whole && (list[i] != std::floor(list[i]) || list[i] < 1 || list[i] > kMaxBinsPerDimension))
+        fail(name, listText(list), "must be whole numbers in [1, " + std::to_string(kMaxBinsPerDimension) + "]");
       values[i] = static_cast<T>(list[i]);
     }
   }

@@ -5,11 +5,17 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 
 namespace cartpole_qlearning
 {
 constexpr std::size_t kStateDimensions = 4;
+constexpr unsigned kMaxBinsPerDimension = 1000;
+// The most states a table may have (all dimensions' bins multiplied): a config or a file that
+// asks for more is refused before anything is allocated (10 million states of 2 actions take
+// 160 MB).
+constexpr std::uint64_t kMaxStates = 10000000;
 
 struct DiscretiserParams
 {

@@ -10,6 +10,9 @@
 
 namespace cartpole_qlearning
 {
+// The most actions (table columns) a config or a file may have.
+constexpr std::size_t kMaxActions = 100;
+
 class QTable
 {
 public:
