@@ -462,7 +462,7 @@ bool QLearningControllerNode::save(const std::string& path, std::string& message
               std::to_string(session_->table().steps) + " steps of training to " + resolved;
     return true;
   }
-  catch (const QTableFileError& e)
+  catch (const std::exception& e)  // QTableFileError, or anything else: never out of a service
   {
     message = std::string("nothing written: ") + e.what();
     return false;
@@ -497,7 +497,7 @@ bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::R
                        " steps of training)";
     ROS_INFO("qlearning_controller: load_q_table: %s", response.message.c_str());
   }
-  catch (const QTableFileError& e)
+  catch (const std::exception& e)  // QTableFileError, or anything else: never out of a service
   {
     response.success = false;
     response.message = std::string("refused, the table in use is unchanged: ") + e.what();

@@ -48,7 +48,7 @@ std::string defaultConfigPath()
 }
 }  // namespace
 
-int main(int argc, char** argv)
+int run(int argc, char** argv)
 {
   using namespace cartpole_qlearning;
   std::string config_path;
@@ -167,4 +167,18 @@ int main(int argc, char** argv)
               static_cast<unsigned long long>(result.episodes), static_cast<unsigned long long>(result.steps),
               result.wall_s);
   return status;
+}
+
+int main(int argc, char** argv)
+{
+  // What the checks above did not foresee still ends with a message and exit 2, not an abort.
+  try
+  {
+    return run(argc, argv);
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << "train_headless: " << e.what() << "\n";
+    return 2;
+  }
 }
