@@ -24,6 +24,7 @@ DEBIAN_PACKAGES=(
   libroscpp-dev libroslib-dev libsensor-msgs-dev libstd-msgs-dev libgeometry-msgs-dev
   libros-rosgraph-msgs-dev libtf2-ros-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev libeigen3-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev catkin-lint rviz
+  clang-14 libclang-rt-14-dev
 )
 
 install_dependencies() {

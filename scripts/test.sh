@@ -19,6 +19,12 @@ fi
 trap - EXIT
 # run_tests keeps going past failing tests; the results files say what failed.
 catkin_make run_tests -DCMAKE_BUILD_TYPE=Release >>"$CARTPOLE_WS/test.log" 2>&1 || true
+# The fuzzers of test/fuzz/ (table file and config parsers, ASan + UBSan), 30 s each; their
+# verdicts join the results (a crash is a failed test). FUZZ_SECONDS=0 skips them.
+if [ "${FUZZ_SECONDS:-30}" -gt 0 ]; then
+  echo "[test] fuzzing the table file and config parsers, ${FUZZ_SECONDS:-30} s each"
+  bash "$CARTPOLE_SRC/scripts/fuzz.sh" "${FUZZ_SECONDS:-30}" build/test_results/cartpole_qlearning || true
+fi
 if ! ls build/test_results/cartpole_qlearning/*.xml >/dev/null 2>&1; then
   tail -n 60 "$CARTPOLE_WS/test.log"
   echo "[test] no test results were produced (the build of the tests failed?)"

@@ -128,7 +128,7 @@ private:
     return out.c_str();
   }
 
-  static void collect(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& keys)
+  void collect(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& keys) const
   {
     if (!node.IsMap())
     {
@@ -136,7 +136,13 @@ private:
       return;
     }
     for (const auto& entry : node)
-      collect(entry.second, (prefix.empty() ? "" : prefix + "/") + entry.first.as<std::string>(), keys);
+    {
+      // A key that is not a plain scalar (a list, a map, a null) names no parameter (found by
+      // test/fuzz/config_fuzzer.cpp: it used to escape as a YAML exception).
+      if (!entry.first.IsScalar())
+        throw ConfigError(origin_ + ": a key under '" + (prefix.empty() ? "/" : prefix) + "' is not a plain name");
+      collect(entry.second, (prefix.empty() ? "" : prefix + "/") + entry.first.Scalar(), keys);
+    }
   }
 
   YAML::Node root_;

@@ -81,6 +81,10 @@ TEST(Config, BadValuesNameTheKeyTheValueAndTheRange)
   const std::string huge_bins = errorOf("learning: {bins: [10000000000, 1, 1, 1]}");
   EXPECT_NE(std::string::npos, huge_bins.find("1e+10")) << huge_bins;
   EXPECT_NE(std::string::npos, huge_bins.find("[1, 1000]")) << huge_bins;
+  // A key that is not a plain name (found by test/fuzz/config_fuzzer.cpp: a YAML exception
+  // escaped the reader).
+  EXPECT_FALSE(errorOf("learning: {bins: [1, 1, 3, 4], ! ctions: [-1,10 00 ,]}\ntask: {reward: dees}\n").empty());
+  EXPECT_FALSE(errorOf("learning: {[1, 2]: 3}").empty());
   const std::string many_states = errorOf("learning: {bins: [1000, 1000, 1000, 1000]}");
   EXPECT_NE(std::string::npos, many_states.find("1000000000000 states")) << many_states;
   EXPECT_NE(std::string::npos, errorOf("physics: {integrator: verlet}").find("physics/integrator = 'verlet'"));

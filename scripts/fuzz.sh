@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets of test/fuzz/ (the Q-table file parser, the config reader) with
+# clang-14, AddressSanitizer and UndefinedBehaviorSanitizer, and runs each for a bounded time
+# from the seed corpus in test/fuzz/corpus/. Debian: clang-14 libclang-rt-14-dev libyaml-cpp-dev
+# libeigen3-dev (scripts/setup.sh installs them).
+#
+# usage: bash scripts/fuzz.sh [SECONDS_EACH (default 60)] [RESULTS_DIR]
+#   RESULTS_DIR: also write one JUnit file per target there (for catkin_test_results).
+#   FUZZ_TARGETS: which targets (default "q_table config"); FUZZ_WORK: the work directory.
+# Prints per target: runs, seconds, corpus size and coverage, and exits 1 if any target found a
+# crash (its reproducer is kept under the work directory it names).
+set -euo pipefail
+SECONDS_EACH=${1:-60}
+RESULTS=${2:-}
+[[ "$SECONDS_EACH" =~ ^[0-9]+$ ]] || { echo "fuzz.sh: SECONDS_EACH=$SECONDS_EACH must be a whole number" >&2; exit 2; }
+SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+CXX=${FUZZ_CXX:-clang++-14}
+command -v "$CXX" >/dev/null || { echo "fuzz.sh: $CXX not found (Debian: clang-14 libclang-rt-14-dev)" >&2; exit 2; }
+WORK=${FUZZ_WORK:-$(mktemp -d "${TMPDIR:-/tmp}/cartpole_fuzz.XXXXXX")}
+mkdir -p "$WORK"
+
+# The core's sources, as CMakeLists.txt lists them for the core library.
+mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_core/,/^)/p' "$SRC/CMakeLists.txt" | grep -o 'src/[a-z_]*\.cpp')
+FLAGS=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
+  -I "$SRC/include" -isystem /usr/include/eigen3)
+status=0
+for target in ${FUZZ_TARGETS:-q_table config}; do
+  exe="$WORK/${target}_fuzzer"
+  echo "[fuzz] building $target (${#CORE[@]} core sources, ASan + UBSan)"
+  "$CXX" "${FLAGS[@]}" "$SRC/test/fuzz/${target}_fuzzer.cpp" "${CORE[@]/#/$SRC/}" -lyaml-cpp -o "$exe"
+  corpus="$WORK/corpus_$target"
+  mkdir -p "$corpus"
+  cp -n "$SRC/test/fuzz/corpus/$target/"* "$corpus/" 2>/dev/null || true
+  log="$WORK/$target.log"
+  echo "[fuzz] running $target for $SECONDS_EACH s (log $log)"
+  rc=0
+  (cd "$WORK" && ASAN_OPTIONS=detect_leaks=1 "$exe" -max_total_time="$SECONDS_EACH" -max_len=65536 -timeout=10 \
+    -rss_limit_mb=2048 -print_final_stats=1 "$corpus" >"$log" 2>&1) || rc=$?
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
+  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1 | grep -o '[0-9]*' || echo 0)
+  files=$(find "$corpus" -type f | wc -l)
+  if ((rc == 0)); then
+    echo "[fuzz] $target: ok, $runs runs in $SECONDS_EACH s, corpus $files files, coverage $cov edges"
+  else
+    status=1
+    echo "[fuzz] $target: FOUND A PROBLEM (exit $rc) after $runs runs; reproducer and log in $WORK:"
+    grep -E 'ERROR|SUMMARY|runtime error|terminate|Test unit written' "$log" | head -n 8
+  fi
+  if [[ -n "$RESULTS" ]]; then
+    mkdir -p "$RESULTS"
+    {
+      echo "<?xml version=\"1.0\" encoding=\"UTF-8\"?>"
+      echo "<testsuite name=\"fuzz_$target\" tests=\"1\" failures=\"$((rc == 0 ? 0 : 1))\" errors=\"0\">"
+      echo "  <testcase classname=\"fuzz\" name=\"${target}_fuzzer_${SECONDS_EACH}s\">"
+      ((rc == 0)) || echo "    <failure message=\"libFuzzer exit $rc after $runs runs; see $log\"/>"
+      echo "  </testcase>"
+      echo "</testsuite>"
+    } >"$RESULTS/fuzz-$target.xml"
+  fi
+done
+exit $status
