@@ -77,7 +77,7 @@ build() {
   cd "$CARTPOLE_WS"
   local args=(-DCMAKE_BUILD_TYPE=Release)
   [ -x /usr/bin/python3 ] && args+=(-DPYTHON_EXECUTABLE=/usr/bin/python3)
-  say "building (catkin_make, Release); log in $CARTPOLE_WS/build.log"
+  say "building (catkin_make, Release; about 1 to 3 minutes from scratch on 2 cores); log in $CARTPOLE_WS/build.log"
   if ! catkin_make "${args[@]}" "$@" >"$CARTPOLE_WS/build.log" 2>&1; then
     tail -n 40 "$CARTPOLE_WS/build.log" >&2
     echo "[setup] the build failed (full log: $CARTPOLE_WS/build.log)" >&2
@@ -88,7 +88,13 @@ build() {
 
 install_dependencies
 choose_workspace
-build "$@"
+# Arguments are catkin_make's only when this script is run; sourced by train.sh or test.sh, the
+# positional parameters are theirs (roslaunch's seed:=3, --screen) and must not reach make.
+if [ "${BASH_SOURCE[0]}" = "$0" ]; then
+  build "$@"
+else
+  build
+fi
 # setup.bash scripts read unset variables; relax -u style checks while sourcing.
 set +e
 # shellcheck disable=SC1091

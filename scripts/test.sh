@@ -9,7 +9,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 set -eo pipefail
 cd "$CARTPOLE_WS"
 rm -rf build/test_results/cartpole_qlearning
-echo "[test] catkin_make tests, then run_tests (log in $CARTPOLE_WS/test.log)"
+echo "[test] catkin_make tests (about 2 to 4 minutes), then run_tests (about 5 to 8 minutes); log in $CARTPOLE_WS/test.log"
 # A test that does not compile is a failure, not a test fewer.
 if ! catkin_make tests -DCMAKE_BUILD_TYPE=Release >"$CARTPOLE_WS/test.log" 2>&1; then
   grep -E "error|Error" "$CARTPOLE_WS/test.log" | head -n 20

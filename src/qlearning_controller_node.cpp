@@ -98,7 +98,8 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
     }
     catch (const QTableFileError& e)
     {
-      refuseParameter(pnh_, "load_on_start", "'" + load_on_start_ + "'", e.what());
+      throw ConfigError("cannot start from the table '" + load_on_start_ +
+                        "' (~load_on_start, which the launch files' q_table or load argument sets): " + e.what());
     }
     ROS_INFO("qlearning_controller: loaded %s (%llu episodes, %llu steps of training)", path.c_str(),
              static_cast<unsigned long long>(session_->table().episodes),
@@ -219,6 +220,7 @@ void QLearningControllerNode::readParameters()
     priv.fail("q_table_path", "'" + q_table_path_ + "'", e.what());
   }
   priv.read("load_on_start", load_on_start_);
+  priv.read("evaluation_episodes", evaluation_episodes_, 0);
   priv.read("checkpoint_every", checkpoint_every_, 0);
   priv.read("save_on_shutdown", save_on_shutdown_);
   priv.read("shutdown_when_finished", shutdown_when_finished_);
@@ -421,7 +423,22 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
   }
 
   if (!learning_)
+  {
+    // Evaluation: every episode said, and after ~evaluation_episodes a one-line verdict.
+    evaluated_balanced_ += s.truncated && !s.terminated;
+    ROS_INFO("qlearning_controller: evaluation episode %llu: %u steps, return %.1f, %s",
+             static_cast<unsigned long long>(s.episode), s.steps, s.episode_return,
+             s.terminated ? "fell" : "balanced to the step limit");
+    if (evaluation_episodes_ == 0 || s.episode < evaluation_episodes_)
+      return;
+    ROS_INFO("qlearning_controller: EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f",
+             static_cast<unsigned long long>(s.episode), static_cast<unsigned long long>(evaluated_balanced_),
+             config_.task.max_episode_steps, s.mean_return_window);
+    finished_training_ = true;
+    if (shutdown_when_finished_ && shutdown_)
+      shutdown_();
     return;
+  }
   if (training_finished)
   {
     finished_training_ = true;

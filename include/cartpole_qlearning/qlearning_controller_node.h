@@ -109,6 +109,8 @@ private:
   std::string q_table_dir_;
   std::string q_table_path_ = "q_table.yaml";
   std::string load_on_start_;
+  std::uint64_t evaluation_episodes_ = 10;  // evaluate: the verdict after this many episodes (0: never)
+  std::uint64_t evaluated_balanced_ = 0;
   std::uint64_t checkpoint_every_ = 100;
   bool save_on_shutdown_ = true;
   double sim_timeout_ = 2.0;                          // [s] wall
