@@ -147,15 +147,12 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
     ControllerProtocolParams params = protocol_params_;
     params.robot = r;
     robot.protocol = std::make_unique<ControllerProtocol>(*session_, params);
-    ros::NodeHandle robot_nh = robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name);
-    robot.command_pub = robot_nh.advertise<sensor_msgs::JointState>("joint_command", 10);
+    robot.nh = robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name);
+    robot.command_pub = robot.nh.advertise<sensor_msgs::JointState>("joint_command", 10);
     if (!robot.name.empty())
-      robot.stats_pub = robot_nh.advertise<EpisodeStats>("episode_stats", 100);
-    if (protocol_params_.reset_service)
-      // Persistent: a new connection per episode would cost a master lookup and a TCP set-up.
-      robot.reset_client = robot_nh.serviceClient<Reset>(reset_service_, true);
+      robot.stats_pub = robot.nh.advertise<EpisodeStats>("episode_stats", 100);
     robot.last_state_at = robot.last_episode_end = now;
-    ros::NodeHandle state_nh(robot_nh);
+    ros::NodeHandle state_nh(robot.nh);
     if (state_queue != nullptr)
       state_nh.setCallbackQueue(state_queue);
     // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
@@ -431,9 +428,10 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
              s.terminated ? "fell" : "balanced to the step limit");
     if (evaluation_episodes_ == 0 || s.episode < evaluation_episodes_)
       return;
-    ROS_INFO("qlearning_controller: EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f",
-             static_cast<unsigned long long>(s.episode), static_cast<unsigned long long>(evaluated_balanced_),
-             config_.task.max_episode_steps, s.mean_return_window);
+    ROS_INFO(
+        "qlearning_controller: EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f",
+        static_cast<unsigned long long>(s.episode), static_cast<unsigned long long>(evaluated_balanced_),
+        config_.task.max_episode_steps, s.mean_return_window);
     finished_training_ = true;
     if (shutdown_when_finished_ && shutdown_)
       shutdown_();
@@ -592,11 +590,11 @@ void QLearningControllerNode::resetLoop()
       reset_pending_[r] = false;
     }
     Robot& robot = robots_[r];
-    // A persistent client made before its service existed, or whose sim restarted, is not
-    // valid: connect again first.
+    // Connected when first needed (the sim may come up after this node), and again after its
+    // sim restarted. Persistent: a new connection per episode would cost a master lookup and a
+    // TCP set-up.
     if (!robot.reset_client.isValid())
-      robot.reset_client =
-          (robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name)).serviceClient<Reset>(reset_service_, true);
+      robot.reset_client = robot.nh.serviceClient<Reset>(reset_service_, true);
     Reset reset;  // empty state: a random start
     if (robot.reset_client.call(reset) && reset.response.success)
     {

@@ -53,7 +53,8 @@ private:
   // One robot the learner serves.
   struct Robot
   {
-    std::string name;  // its namespace relative to the learner's ("" : the learner's own)
+    std::string name;    // its namespace relative to the learner's ("" : the learner's own)
+    ros::NodeHandle nh;  // in that namespace
     std::unique_ptr<ControllerProtocol> protocol;
     ros::Subscriber state_sub;
     ros::Publisher command_pub;
