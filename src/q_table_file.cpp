@@ -2,23 +2,14 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <locale>
 #include <sstream>
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 namespace cartpole_qlearning
 {
-namespace fs = std::filesystem;
-
 namespace
 {
 constexpr const char* kFormatName = "cartpole_qlearning/q_table";
@@ -164,10 +155,6 @@ std::uint64_t readCount(const YAML::Node& node, const std::string& where)
   }
 }
 
-std::string systemError(const std::string& what, const std::string& path)
-{
-  return what + " " + path + ": " + std::strerror(errno);
-}
 }  // namespace
 
 std::string formatQTable(const QTable& table)
@@ -276,129 +263,37 @@ QTable parseQTable(const std::string& text)
 
 void saveQTableFile(const QTable& table, const std::string& path)
 {
-  const std::string text = formatQTable(table);
-  const fs::path target(path);
-  std::error_code ec;
-  if (target.has_parent_path())
-  {
-    fs::create_directories(target.parent_path(), ec);
-    if (ec)
-      refuse("cannot create directory " + target.parent_path().string() + ": " + ec.message());
-  }
-  if (fs::is_directory(target, ec))
-    refuse("cannot save to " + path + ": it is a directory");
-
-  std::string temp = path + ".tmp.XXXXXX";
-  const int fd = ::mkstemp(&temp[0]);
-  if (fd < 0)
-    refuse(systemError("cannot create a temporary file beside", path));
-  std::size_t written = 0;
-  while (written < text.size())
-  {
-    const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
-    if (n < 0)
-    {
-      if (errno == EINTR)
-        continue;
-      const std::string error = systemError("cannot write", temp);
-      ::close(fd);
-      ::unlink(temp.c_str());
-      refuse(error);
-    }
-    written += static_cast<std::size_t>(n);
-  }
-  // The data must be on disk before the rename makes it the table; else a crash could leave an
-  // empty file under the final name.
-  if (::fsync(fd) != 0 || ::fchmod(fd, 0644) != 0)
-  {
-    const std::string error = systemError("cannot flush", temp);
-    ::close(fd);
-    ::unlink(temp.c_str());
-    refuse(error);
-  }
-  ::close(fd);
-  if (std::rename(temp.c_str(), path.c_str()) != 0)
-  {
-    const std::string error = systemError("cannot rename the temporary file to", path);
-    ::unlink(temp.c_str());
-    refuse(error);
-  }
-  // Make the rename itself durable.
-  const std::string directory = target.has_parent_path() ? target.parent_path().string() : ".";
-  const int dir_fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY);
-  if (dir_fd >= 0)
-  {
-    ::fsync(dir_fd);
-    ::close(dir_fd);
-  }
+  writeFileAtomically(path, formatQTable(table));
 }
 
-QTable loadQTableFile(const std::string& path)
+void saveQTableUnder(const QTable& table, const std::string& directory, const std::string& path)
 {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    refuse(systemError("cannot open", path));
-  // The largest table allowed (kMaxStates rows) is written in well under this.
-  constexpr std::streamoff kMaxFileBytes = std::streamoff(1) << 30;
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size > kMaxFileBytes)
-    refuse(path + ": " + std::to_string(size) + " bytes, more than a Q-table file may have (" +
-           std::to_string(kMaxFileBytes) + ")");
-  in.seekg(0, std::ios::beg);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad())
-    refuse(systemError("cannot read", path));
+  writeFileUnder(directory, path, formatQTable(table));
+}
+
+namespace
+{
+QTable parseQTableFrom(const std::string& text, const std::string& shown)
+{
   try
   {
-    return parseQTable(text.str());
+    return parseQTable(text);
   }
   catch (const QTableFileError& e)
   {
-    refuse(path + ": " + e.what());
+    refuse(shown + ": " + e.what());
   }
 }
+}  // namespace
 
-std::string resolvePathUnder(const std::string& directory, const std::string& path)
+QTable loadQTableFile(const std::string& path)
 {
-  if (path.empty())
-    refuse("the path is empty");
-  std::error_code ec;
-  // The directory itself is the user's choice, links and all; below it nothing may lead out.
-  const fs::path base = fs::weakly_canonical(fs::absolute(directory), ec);
-  if (ec)
-    refuse("cannot resolve directory " + directory + ": " + ec.message());
-  const std::string outside = " (refused: paths must stay inside " + base.string() + ")";
-  const fs::path given(path);
-  // No "..": resolving it means following whatever the components before it are, and
-  // weakly_canonical stops resolving at the first one missing ("nope/../link/t.yaml").
-  for (const fs::path& part : given)
-  {
-    if (part == "..")
-      refuse(path + " contains '..'" + outside);
-  }
-  fs::path relative = given.lexically_normal();
-  if (given.is_absolute())
-  {
-    relative = relative.lexically_relative(base);
-    if (relative.empty() || *relative.begin() == "..")
-      refuse(path + " is outside " + base.string() + outside);
-  }
-  if (relative.empty() || relative == "." || relative.filename().empty())
-    refuse(path + " names the directory " + base.string() + " itself, not a file in it");
-  // No symbolic link on the way, to a directory or to the file: a link can lead anywhere.
-  fs::path walk = base;
-  for (const fs::path& part : relative)
-  {
-    walk /= part;
-    const fs::file_status status = fs::symlink_status(walk, ec);
-    if (ec || !fs::exists(status))
-      break;  // nothing exists below a missing component
-    if (fs::is_symlink(status))
-      refuse(path + ": " + walk.string() + " is a symbolic link" + outside);
-  }
-  return (base / relative).string();
+  return parseQTableFrom(readFile(path), path);
+}
+
+QTable loadQTableUnder(const std::string& directory, const std::string& path)
+{
+  return parseQTableFrom(readFileUnder(directory, path), resolvePathUnder(directory, path));
 }
 
 }  // namespace cartpole_qlearning

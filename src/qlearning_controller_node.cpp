@@ -92,7 +92,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
     try
     {
       path = resolve(load_on_start_);
-      const std::string mismatch = session_->replaceTable(loadQTableFile(path));
+      const std::string mismatch = session_->replaceTable(loadQTableUnder(q_table_dir_, load_on_start_));
       if (!mismatch.empty())
         throw QTableFileError(path + " does not fit this controller: " + mismatch);
     }
@@ -472,7 +472,7 @@ bool QLearningControllerNode::save(const std::string& path, std::string& message
   try
   {
     const std::string resolved = resolve(path);
-    saveQTableFile(session_->table(), resolved);
+    saveQTableUnder(session_->table(), q_table_dir_, path.empty() ? q_table_path_ : path);
     message = "saved " + std::to_string(session_->table().episodes) + " episodes, " +
               std::to_string(session_->table().steps) + " steps of training to " + resolved;
     return true;
@@ -501,7 +501,7 @@ bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::R
   try
   {
     const std::string path = resolve(request.path);
-    QTable table = loadQTableFile(path);
+    QTable table = loadQTableUnder(q_table_dir_, request.path.empty() ? q_table_path_ : request.path);
     const std::uint64_t episodes = table.episodes;
     const std::uint64_t steps = table.steps;
     const std::string mismatch = session_->replaceTable(std::move(table));

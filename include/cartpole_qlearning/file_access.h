@@ -1,0 +1,52 @@
+// Reading and writing the package's files safely.
+//
+// Writes are atomic and durable: a temporary file beside the target, written, flushed to disk,
+// renamed over the target, and the directory flushed, so a crash at any moment (kill -9, power
+// loss) leaves either the old file whole or the new one whole.
+//
+// Paths that users give over services or launch arguments are taken under a directory and
+// opened component by component relative to it (openat with O_NOFOLLOW): no symbolic link is
+// followed anywhere below the directory and ".." is refused, with no gap between a check and
+// the open in which a link could be swapped in.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace cartpole_qlearning
+{
+// Anything wrong with a path or a file; the message says what, and nothing was changed.
+class FileError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
+// The largest file read: a table of the most states allowed is written in well under this.
+constexpr std::uint64_t kMaxFileBytes = std::uint64_t(1) << 30;
+
+// Checks a user-given path lexically and returns it relative to the directory: a relative path
+// is taken from the directory; an absolute one must lie inside it; ".." components, an empty
+// path and the directory itself are refused. The directory is the user's own choice (links in
+// it are fine). Throws FileError. Touches no file.
+std::string relativePathUnder(const std::string& directory, const std::string& path);
+
+// relativePathUnder, joined to the directory's absolute form: what messages show.
+std::string resolvePathUnder(const std::string& directory, const std::string& path);
+
+// The whole file `path` (relative, below the directory), refusing symbolic links on the way,
+// anything but a regular file and files over max_bytes. Throws FileError.
+std::string readFileUnder(const std::string& directory, const std::string& path,
+                          std::uint64_t max_bytes = kMaxFileBytes);
+
+// Writes `text` atomically to `path` below the directory, creating the directory and any
+// missing folders on the way (never through a symbolic link). Throws FileError.
+void writeFileUnder(const std::string& directory, const std::string& path, const std::string& text);
+
+// The same for a path of the caller's own (a command-line argument): links are followed as the
+// shell would. Throws FileError.
+std::string readFile(const std::string& path, std::uint64_t max_bytes = kMaxFileBytes);
+void writeFileAtomically(const std::string& path, const std::string& text);
+
+}  // namespace cartpole_qlearning

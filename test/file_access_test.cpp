@@ -1,0 +1,187 @@
+// Paths under the table directory (no "..", no symbolic links, nothing written outside) and
+// atomic saves (a process killed mid-save leaves the old file or the new one, whole).
+#include "cartpole_qlearning/file_access.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+using namespace cartpole_qlearning;
+namespace fs = std::filesystem;
+
+namespace
+{
+class FileAccessTest : public ::testing::Test
+{
+protected:
+  void SetUp() override
+  {
+    dir_ = fs::temp_directory_path() / ("file_access_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "tables");
+    tables_ = (dir_ / "tables").string();
+  }
+  void TearDown() override
+  {
+    fs::remove_all(dir_);
+  }
+  static void write(const fs::path& file, const std::string& text)
+  {
+    std::ofstream(file) << text;
+  }
+  // Every file below the test directory, as "relative/path".
+  std::vector<std::string> files() const
+  {
+    std::vector<std::string> found;
+    for (const auto& entry : fs::recursive_directory_iterator(dir_))
+    {
+      if (!entry.is_directory())
+        found.push_back(fs::relative(entry.path(), dir_).string());
+    }
+    std::sort(found.begin(), found.end());
+    return found;
+  }
+
+  fs::path dir_;
+  std::string tables_;
+};
+
+TEST_F(FileAccessTest, RelativePathsResolveUnderTheDirectory)
+{
+  const std::string base = fs::weakly_canonical(tables_).string();
+  EXPECT_EQ(base + "/q.yaml", resolvePathUnder(tables_, "q.yaml"));
+  EXPECT_EQ(base + "/runs/q.yaml", resolvePathUnder(tables_, "runs/./q.yaml"));
+  EXPECT_EQ(base + "/abs.yaml", resolvePathUnder(tables_, base + "/abs.yaml"));
+  EXPECT_EQ("runs/q.yaml", relativePathUnder(tables_, base + "/runs/q.yaml"));
+}
+
+TEST_F(FileAccessTest, PathsLeavingTheDirectoryAreRefusedBeforeAnythingIsTouched)
+{
+  for (const std::string& escape :
+       {std::string("../q.yaml"), std::string("a/../../q.yaml"), std::string("runs/x/../q.yaml"),
+        std::string("nope/../out/q.yaml"), std::string("/etc/passwd"), (dir_ / "tables2" / "q.yaml").string(),
+        std::string(".."), std::string("."), std::string("runs/"), std::string("")})
+  {
+    EXPECT_THROW(relativePathUnder(tables_, escape), FileError) << escape;
+    EXPECT_THROW(writeFileUnder(tables_, escape, "x"), FileError) << escape;
+    EXPECT_THROW(readFileUnder(tables_, escape), FileError) << escape;
+  }
+  EXPECT_EQ(std::vector<std::string>{}, files());
+}
+
+TEST_F(FileAccessTest, SymbolicLinksAnywhereBelowTheDirectoryAreRefusedAndNothingIsWrittenOutside)
+{
+  write(dir_ / "secret.yaml", "outside");
+  // A link to a directory outside, one to a directory inside (it could be changed at any
+  // moment), and one to a file outside.
+  fs::create_directory_symlink(dir_, dir_ / "tables" / "out");
+  fs::create_directories(dir_ / "tables" / "runs");
+  fs::create_directory_symlink(dir_ / "tables" / "runs", dir_ / "tables" / "alias");
+  fs::create_symlink(dir_ / "secret.yaml", dir_ / "tables" / "runs" / "link.yaml");
+  const auto before = files();
+
+  for (const std::string& path :
+       {std::string("out/secret.yaml"), std::string("out/new.yaml"), std::string("alias/q.yaml"),
+        std::string("runs/link.yaml"), std::string("out/tables/runs/q.yaml"),
+        (dir_ / "tables" / "out" / "secret.yaml").string()})
+  {
+    try
+    {
+      writeFileUnder(tables_, path, "written");
+      ADD_FAILURE() << path << " was written";
+    }
+    catch (const FileError& e)
+    {
+      EXPECT_NE(std::string::npos, std::string(e.what()).find("symbolic link")) << path << ": " << e.what();
+    }
+    EXPECT_THROW(readFileUnder(tables_, path), FileError) << path;
+  }
+  EXPECT_EQ(before, files());
+  EXPECT_EQ("outside", readFile((dir_ / "secret.yaml").string()));
+  // The directory itself may be reached through a link of the user's choosing.
+  fs::create_directory_symlink(dir_ / "tables", dir_ / "chosen");
+  writeFileUnder((dir_ / "chosen").string(), "runs/new/q.yaml", "fine");
+  EXPECT_EQ("fine", readFileUnder(tables_, "runs/new/q.yaml"));
+}
+
+TEST_F(FileAccessTest, MissingDirectoriesAreCreatedAndAFileInTheWayIsReported)
+{
+  const std::string fresh = (dir_ / "fresh" / "deep").string();
+  writeFileUnder(fresh, "runs/a/b.yaml", "text");
+  EXPECT_EQ("text", readFileUnder(fresh, "runs/a/b.yaml"));
+  write(dir_ / "tables" / "blocker", "a file");
+  EXPECT_THROW(writeFileUnder(tables_, "blocker/q.yaml", "x"), FileError);
+  fs::create_directories(dir_ / "tables" / "folder");
+  EXPECT_THROW(writeFileUnder(tables_, "folder", "x"), FileError);
+  EXPECT_THROW(readFileUnder(tables_, "folder"), FileError);
+  EXPECT_THROW(readFileUnder(tables_, "missing.yaml"), FileError);
+}
+
+TEST_F(FileAccessTest, AFifoOrAnOversizedFileIsRefusedWithoutHanging)
+{
+  ASSERT_EQ(0, ::mkfifo((dir_ / "tables" / "pipe.yaml").c_str(), 0644));
+  try
+  {
+    readFileUnder(tables_, "pipe.yaml");
+    ADD_FAILURE() << "a FIFO was read";
+  }
+  catch (const FileError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("not a regular file")) << e.what();
+  }
+  write(dir_ / "tables" / "big.yaml", std::string(100, 'x'));
+  EXPECT_THROW(readFileUnder(tables_, "big.yaml", 99), FileError);
+  EXPECT_EQ(100u, readFileUnder(tables_, "big.yaml", 100).size());
+}
+
+TEST_F(FileAccessTest, AProcessKilledMidSaveLeavesTheOldFileOrTheNewOneWhole)
+{
+  // Large versions, so that a kill at a random moment mostly lands inside a write or an fsync.
+  const std::string path = (dir_ / "tables" / "q.yaml").string();
+  const auto version = [](char c) { return "version " + std::string(1, c) + "\n" + std::string(8 << 20, c); };
+  writeFileAtomically(path, version('a'));
+  std::mt19937 random(7);
+  int interrupted = 0;
+  constexpr int kTrials = 12;
+  for (int trial = 0; trial < kTrials; ++trial)
+  {
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0)
+    {
+      for (char c = 'b';; c = c == 'z' ? 'b' : static_cast<char>(c + 1))
+        writeFileAtomically(path, version(c));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20 + random() % 180));
+    ::kill(child, SIGKILL);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    const std::string text = readFile(path);
+    ASSERT_EQ(version(text.at(8)), text) << "trial " << trial << ": the file is not one whole version";
+    // A temporary file left behind: this kill interrupted a save.
+    for (const auto& entry : fs::directory_iterator(dir_ / "tables"))
+    {
+      if (entry.path().filename() != "q.yaml")
+      {
+        ++interrupted;
+        fs::remove(entry.path());
+      }
+    }
+  }
+  // Otherwise the test proved nothing: every kill fell between two saves.
+  EXPECT_GT(interrupted, kTrials / 3) << "only " << interrupted << " of " << kTrials << " kills landed mid-save";
+}
+
+}  // namespace
