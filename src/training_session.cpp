@@ -109,4 +109,21 @@ std::string TrainingSession::replaceTable(QTable table)
   return agent_.replaceTable(std::move(table));
 }
 
+std::string TrainingSession::resume(QTable table, const std::vector<double>& recent_returns)
+{
+  const std::uint64_t episodes = table.episodes;
+  const std::uint64_t steps = table.steps;
+  const std::string mismatch = replaceTable(std::move(table));
+  if (!mismatch.empty())
+    return mismatch;
+  last_ = EpisodeSummary();
+  last_.episode = episodes;
+  last_.total_steps = steps;
+  returns_ = ReturnWindow(task_.params().solved_window);
+  for (double value : recent_returns)
+    returns_.push(value);
+  last_.mean_return_window = returns_.mean();
+  return "";
+}
+
 }  // namespace cartpole_qlearning

@@ -63,6 +63,11 @@ public:
   {
     return values_.size() == size_;
   }
+  // Oldest first.
+  std::vector<double> values() const
+  {
+    return {values_.begin(), values_.end()};
+  }
 
 private:
   unsigned size_;
@@ -130,6 +135,15 @@ public:
   // Installs a loaded table (checked against this agent's shape; on a mismatch returns what
   // differs and changes nothing). The schedules resume from the table's episode count.
   std::string replaceTable(QTable table);
+  // Continues a run from its checkpoint: the table (checked as replaceTable does; on a mismatch
+  // returns what differs and changes nothing), the session's episode and step counts from the
+  // table's, and the solved window from the returns the checkpoint recorded (oldest first).
+  std::string resume(QTable table, const std::vector<double>& recent_returns);
+  // The solved window's returns, oldest first: what a checkpoint records for resume().
+  std::vector<double> recentReturns() const
+  {
+    return returns_.values();
+  }
 
 private:
   // One robot's episode.
