@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/qlearning_controller_node.h"
 
 #include "cartpole_qlearning/Reset.h"
+#include "cartpole_qlearning/launch_control.h"
 #include "cartpole_qlearning/q_table_file.h"
 #include "cartpole_qlearning/ros_parameter_source.h"
 
@@ -11,19 +12,24 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <ctime>
+#include <filesystem>
 #include <sstream>
 
 namespace cartpole_qlearning
 {
 namespace
 {
-std::string defaultTableDirectory()
+// $ROS_HOME/cartpole_qlearning/<namespace>: instances in different namespaces never write
+// each other's tables.
+std::string defaultTableDirectory(const std::string& name_space)
 {
   const char* ros_home = std::getenv("ROS_HOME");
-  if (ros_home != nullptr && *ros_home != '\0')
-    return std::string(ros_home) + "/cartpole_qlearning";
   const char* home = std::getenv("HOME");
-  return std::string(home != nullptr ? home : ".") + "/.ros/cartpole_qlearning";
+  const std::string base = ros_home != nullptr && *ros_home != '\0'
+                               ? std::string(ros_home) + "/cartpole_qlearning"
+                               : std::string(home != nullptr ? home : ".") + "/.ros/cartpole_qlearning";
+  return name_space == "/" ? base : base + name_space;
 }
 
 // ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
@@ -109,6 +115,8 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   {
     ROS_WARN("qlearning_controller: evaluating a table of zeros (set ~load_on_start to a trained table)");
   }
+  if (learning_)
+    openRun();
 
   started_ = last_episode_end_ = last_progress_ = std::chrono::steady_clock::now();
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
@@ -178,9 +186,9 @@ QLearningControllerNode::~QLearningControllerNode()
   if (learning_ && save_on_shutdown_ && !finished_training_)
   {
     std::string message;
-    save("", message);
+    checkpoint("", message);
     // ROS may be shut down already: say it on the console too.
-    std::printf("qlearning_controller: on shutdown: %s\n", message.c_str());
+    std::printf("qlearning_controller: on shutdown: %s (the default table is left as it was)\n", message.c_str());
   }
 }
 
@@ -203,7 +211,7 @@ void QLearningControllerNode::readParameters()
   learning_ = mode == "train";
   priv.read("seed", seed_, 0);
 
-  q_table_dir_ = defaultTableDirectory();
+  q_table_dir_ = defaultTableDirectory(nh_.getNamespace());
   priv.read("q_table_dir", q_table_dir_);
   if (q_table_dir_.empty())
     priv.fail("q_table_dir", "''", "must name a directory");
@@ -217,6 +225,10 @@ void QLearningControllerNode::readParameters()
     priv.fail("q_table_path", "'" + q_table_path_ + "'", e.what());
   }
   priv.read("load_on_start", load_on_start_);
+  priv.read("run_id", run_id_);
+  // Set by the controller itself (openRun), for a respawn of it to find.
+  priv.know("run/id");
+  priv.know("run/folder");
   priv.read("evaluation_episodes", evaluation_episodes_, 0);
   priv.read("checkpoint_every", checkpoint_every_, 0);
   priv.read("save_on_shutdown", save_on_shutdown_);
@@ -379,10 +391,20 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
   last_episode_end_ = robot.last_episode_end = std::chrono::steady_clock::now();
 
   // When training ends here, the table is saved before episode_stats says so: whoever acts on
-  // the last message finds the final file.
+  // the last message finds the final file. Into the run's folder; a solved run also replaces the
+  // default table (the one evaluate.launch loads), an unsolved one leaves it as it was.
   std::string saved;
+  bool saved_ok = true;
   if (training_finished)
-    save("", saved);
+  {
+    saved_ok = checkpoint(s.solved ? "solved" : "max_episodes", saved);
+    std::string published;
+    if (saved_ok && s.solved)
+      saved += save("", published) ? "; the default table: " + published : "; BUT NOT the default table: " + published;
+    else if (saved_ok)
+      saved += "; the default table " + resolve("") +
+               " is left as it was (this run did not solve: ~save_q_table saves it there if you want it)";
+  }
 
   EpisodeStats stats;
   stats.header.stamp = stamp;
@@ -433,14 +455,13 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
         static_cast<unsigned long long>(s.episode), static_cast<unsigned long long>(evaluated_balanced_),
         config_.task.max_episode_steps, s.mean_return_window);
     finished_training_ = true;
-    if (shutdown_when_finished_ && shutdown_)
-      shutdown_();
+    endWhenFinished();
     return;
   }
   if (training_finished)
   {
     finished_training_ = true;
-    if (saved.rfind("nothing written", 0) == 0)
+    if (!saved_ok)
     {
       // Keep the trained table alive: the user can still save it elsewhere with ~save_q_table.
       ROS_ERROR(
@@ -453,18 +474,119 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
              s.solved ? "SOLVED" : "NOT solved, max_episodes reached", static_cast<unsigned long long>(s.episode),
              static_cast<unsigned long long>(s.total_steps), secondsSince(started_), config_.task.solved_window,
              s.mean_return_window, saved.c_str());
-    if (shutdown_when_finished_ && shutdown_)
-      shutdown_();
+    endWhenFinished();
     return;
   }
   if (checkpoint_every_ > 0 && s.episode % checkpoint_every_ == 0)
   {
     std::string message;
-    if (save("", message))
-      ROS_DEBUG("qlearning_controller: checkpoint: %s", message.c_str());
+    if (checkpoint("", message))
+      ROS_INFO("qlearning_controller: checkpoint: %s", message.c_str());
     else
       ROS_WARN("qlearning_controller: checkpoint failed: %s", message.c_str());
   }
+}
+
+void QLearningControllerNode::endWhenFinished()
+{
+  if (!shutdown_when_finished_)
+    return;
+  if (endParentLaunch())
+  {
+    ROS_INFO("qlearning_controller: done; ending the launch");
+    return;
+  }
+  if (shutdown_)
+    shutdown_();
+}
+
+void QLearningControllerNode::openRun()
+{
+  run_.run_id = run_id_;
+  run_.name_space = nh_.getNamespace();
+  run_.seed = seed_;
+  std::string stored_id;
+  if (!run_id_.empty() && pnh_.getParam("run/id", stored_id) && stored_id == run_id_ &&
+      pnh_.getParam("run/folder", run_folder_) && !run_folder_.empty())
+  {
+    resumeRun();
+    return;
+  }
+  const std::time_t now = std::time(nullptr);
+  run_.started = localTimeText(now);
+  const std::string name = runFolderName(now, nh_.getNamespace(), seed_);
+  run_folder_ = name;
+  std::error_code ec;
+  for (int n = 2; std::filesystem::exists(std::filesystem::symlink_status(resolve(run_folder_), ec)); ++n)
+    run_folder_ = name + "_" + std::to_string(n);
+  if (!run_id_.empty())
+  {
+    pnh_.setParam("run/id", run_id_);
+    pnh_.setParam("run/folder", run_folder_);
+  }
+  ROS_INFO("qlearning_controller: run %s: checkpoints go to %s", run_folder_.c_str(),
+           resolve(run_folder_ + "/" + kRunTableFile).c_str());
+}
+
+void QLearningControllerNode::resumeRun()
+{
+  const std::string table_path = run_folder_ + "/" + kRunTableFile;
+  RunRecord record;
+  QTable table;
+  try
+  {
+    record = parseRunRecord(readFileUnder(q_table_dir_, run_folder_ + "/" + kRunRecordFile, 1 << 20));
+    table = loadQTableUnder(q_table_dir_, table_path);
+  }
+  catch (const FileError& e)
+  {
+    // Killed before its first checkpoint (or the checkpoint is unusable): the run starts over.
+    run_.started = localTimeText(std::time(nullptr));
+    ROS_WARN("qlearning_controller: restarted; run %s has no checkpoint to go on from (%s): starting it over",
+             run_folder_.c_str(), e.what());
+    return;
+  }
+  // A crash between the table's save and the record's leaves the record one checkpoint behind:
+  // the table wins, and the solved window starts empty.
+  const bool record_matches = record.episodes == table.episodes && record.steps == table.steps;
+  const std::string mismatch =
+      session_->resume(std::move(table), record_matches ? record.recent_returns : std::vector<double>());
+  if (!mismatch.empty())
+    throw ConfigError("restarted, but the checkpoint " + resolve(table_path) +
+                      " does not fit this controller's configuration: " + mismatch);
+  run_ = record;
+  const EpisodeSummary& s = session_->lastEpisode();
+  ROS_WARN("qlearning_controller: restarted; run %s goes on from its checkpoint: episode %llu, %llu steps%s",
+           run_folder_.c_str(), static_cast<unsigned long long>(s.episode),
+           static_cast<unsigned long long>(s.total_steps),
+           record_matches ? "" : " (its record was one checkpoint behind: the solved window starts empty)");
+  if (!record.finished.empty())
+  {
+    finished_training_ = true;
+    ROS_INFO("qlearning_controller: run %s has finished already (%s); nothing left to do", run_folder_.c_str(),
+             record.finished.c_str());
+    endWhenFinished();
+  }
+}
+
+bool QLearningControllerNode::checkpoint(const std::string& finished, std::string& message)
+{
+  if (!save(run_folder_ + "/" + kRunTableFile, message))
+    return false;
+  run_.episodes = session_->table().episodes;
+  run_.steps = session_->table().steps;
+  run_.recent_returns = session_->recentReturns();
+  run_.finished = finished;
+  try
+  {
+    writeFileUnder(q_table_dir_, run_folder_ + "/" + kRunRecordFile, formatRunRecord(run_));
+  }
+  catch (const std::exception& e)
+  {
+    message += ", but not its run record (a restart would start the run over): " + std::string(e.what());
+    return false;
+  }
+  return true;
 }
 
 bool QLearningControllerNode::save(const std::string& path, std::string& message)

@@ -13,6 +13,7 @@
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
 #include "cartpole_qlearning/robot_rounds.h"
+#include "cartpole_qlearning/training_run.h"
 #include "cartpole_qlearning/training_session.h"
 #include "cartpole_qlearning/wall_throttle.h"
 
@@ -36,9 +37,10 @@ class QLearningControllerNode
 public:
   // nh: the learner's namespace (topics of its own robot; physics, task, learning and training
   // parameters); pnh: the node's private namespace (controller parameters and services).
-  // shutdown is called when training ends (solved or max_episodes) if ~shutdown_when_finished,
-  // whose default is shutdown_by_default: the executable ends there; a nodelet ends its manager
-  // only when asked. state_queue: where the joint_states callbacks queue (nullptr: nh's queue);
+  // When training ends (solved or max_episodes) and ~shutdown_when_finished (default:
+  // shutdown_by_default), the controller ends the roslaunch that started it, as Ctrl-C would
+  // (launch_control.h); when no roslaunch started it, it calls shutdown: the executable ends
+  // there; a nodelet ends its manager only when asked. state_queue: where the joint_states callbacks queue (nullptr: nh's queue);
   // a nodelet passes the queue its lockstep thread serves.
   // Throws ConfigError naming a bad parameter, QTableFileError for a bad ~load_on_start file.
   QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::function<void()> shutdown,
@@ -68,6 +70,14 @@ private:
   };
 
   void readParameters();
+  // Training: starts this run's folder, or continues it when this process is a respawn of the
+  // controller that started it (the same ~run_id).
+  void openRun();
+  void resumeRun();
+  // Saves the table and the run record into the run's folder; returns the message to log.
+  bool checkpoint(const std::string& finished, std::string& message);
+  // Training or evaluation is over: ends the launch (or the node) when ~shutdown_when_finished.
+  void endWhenFinished();
   void setUpRobots(ros::CallbackQueue* state_queue);
   void onJointState(std::size_t robot, const sensor_msgs::JointStateConstPtr& msg);
   bool onSave(SaveQTable::Request& request, SaveQTable::Response& response);
@@ -110,6 +120,9 @@ private:
   std::string q_table_dir_;
   std::string q_table_path_ = "q_table.yaml";
   std::string load_on_start_;
+  std::string run_id_;      // ~run_id: the launch's own id (train.launch: $(anon run))
+  std::string run_folder_;  // this run's folder, relative to q_table_dir_ ("" when evaluating)
+  RunRecord run_;
   std::uint64_t evaluation_episodes_ = 10;  // evaluate: the verdict after this many episodes (0: never)
   std::uint64_t evaluated_balanced_ = 0;
   std::uint64_t checkpoint_every_ = 100;
