@@ -40,9 +40,9 @@ public:
   // When training ends (solved or max_episodes) and ~shutdown_when_finished (default:
   // shutdown_by_default), the controller ends the roslaunch that started it, as Ctrl-C would
   // (launch_control.h); when no roslaunch started it, it calls shutdown: the executable ends
-  // there; a nodelet ends its manager only when asked. state_queue: where the joint_states callbacks queue (nullptr: nh's queue);
-  // a nodelet passes the queue its lockstep thread serves.
-  // Throws ConfigError naming a bad parameter, QTableFileError for a bad ~load_on_start file.
+  // there; a nodelet ends its manager only when asked. state_queue: where the joint_states callbacks queue (nullptr:
+  // nh's queue); a nodelet passes the queue its lockstep thread serves. Throws ConfigError naming a bad parameter,
+  // QTableFileError for a bad ~load_on_start file.
   QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::function<void()> shutdown,
                           bool shutdown_by_default, ros::CallbackQueue* state_queue = nullptr);
   // Saves the table when ~save_on_shutdown (training), and stops the reset thread.

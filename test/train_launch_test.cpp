@@ -1,0 +1,257 @@
+// train.launch as a user runs it (roslaunch, a ROS_HOME of the test's own, this test's master):
+// a solved run ends the launch cleanly (exit 0, no "REQUIRED process has died"); a shorter,
+// unsolved run afterwards leaves the solved default table byte for byte and keeps its own
+// folder; another namespace has its own tables; kill -9 of the sim or of the controller does not
+// end training: the node respawns and the controller goes on from its run's last checkpoint.
+#include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/training_run.h"
+#include "ros_test_support.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+#include <ros/master.h>
+#include <ros/network.h>
+#include <ros/ros.h>
+#include <xmlrpcpp/XmlRpcClient.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::runCommand;
+using cartpole_qlearning::test::spinUntil;
+using cartpole_qlearning::test::startProcess;
+
+namespace
+{
+std::string rosHome()
+{
+  std::string dir;
+  ros::param::get("~ros_home", dir);
+  return dir;
+}
+
+// roslaunch train.launch in the background, its output (nodes included) in a file.
+struct Launch
+{
+  pid_t pid = -1;
+  std::string log;
+
+  Launch(const std::string& name, const std::string& args)
+  {
+    log = rosHome() + "/" + name + ".log";
+    const std::string roslaunch = runCommand("command -v roslaunch").lastLine();
+    pid = startProcess("/bin/sh",
+                       {"-c", "exec " + roslaunch + " cartpole_qlearning train.launch " + args + " >" + log + " 2>&1"},
+                       {"ROS_HOME=" + rosHome(), "PYTHONUNBUFFERED=1"});
+  }
+  ~Launch()
+  {
+    if (pid > 0)
+    {
+      ::kill(pid, SIGINT);
+      waitFor(30.0);
+    }
+  }
+  // The exit status, or -1 when it did not end in time.
+  int waitFor(double seconds)
+  {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < deadline)
+    {
+      int status = 0;
+      if (::waitpid(pid, &status, WNOHANG) == pid)
+      {
+        pid = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return -1;
+  }
+  std::string output() const
+  {
+    return readFile(log);
+  }
+};
+
+std::string tables(const std::string& ns)
+{
+  return rosHome() + "/cartpole_qlearning/" + ns;
+}
+
+std::vector<fs::path> runFolders(const std::string& ns)
+{
+  std::vector<fs::path> folders;
+  if (fs::exists(tables(ns) + "/runs"))
+  {
+    for (const auto& entry : fs::directory_iterator(tables(ns) + "/runs"))
+      folders.push_back(entry.path());
+  }
+  return folders;
+}
+
+// A node's pid, asked through its XML-RPC API as rosnode does.
+int nodePid(const std::string& node)
+{
+  XmlRpc::XmlRpcValue args, result, payload;
+  args[0] = ros::this_node::getName();
+  args[1] = node;
+  if (!ros::master::execute("lookupNode", args, result, payload, false) || result.size() < 3 ||
+      result[0].getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(result[0]) != 1)
+    return -1;
+  const std::string uri = result[2];
+  std::string host;
+  std::uint32_t port = 0;
+  if (!ros::network::splitURI(uri, host, port))
+    return -1;
+  XmlRpc::XmlRpcClient client(host.c_str(), static_cast<int>(port), "/");
+  XmlRpc::XmlRpcValue pid_args, pid_result;
+  pid_args[0] = ros::this_node::getName();
+  if (!client.execute("getPid", pid_args, pid_result) || pid_result.size() < 3 ||
+      pid_result[2].getType() != XmlRpc::XmlRpcValue::TypeInt)
+    return -1;
+  return static_cast<int>(pid_result[2]);
+}
+
+// Episode numbers from ns/episode_stats, in order of arrival.
+struct Episodes
+{
+  std::vector<std::uint32_t> seen;
+  ros::Subscriber sub;
+  explicit Episodes(const std::string& ns)
+  {
+    ros::NodeHandle nh;
+    sub = nh.subscribe<cartpole_qlearning::EpisodeStats>(
+        "/" + ns + "/episode_stats", 10000,
+        boost::function<void(const cartpole_qlearning::EpisodeStatsConstPtr&)>(
+            [this](const cartpole_qlearning::EpisodeStatsConstPtr& m) { seen.push_back(m->episode); }));
+  }
+  std::uint32_t last() const
+  {
+    return seen.empty() ? 0 : seen.back();
+  }
+};
+
+TEST(TrainLaunch, ASolvedRunEndsCleanlyAndLaterUnsolvedRunsLeaveItsTable)
+{
+  // 1. Train to solved: the launch ends by itself, exit 0, and nothing looks like a crash.
+  {
+    Launch run("solved", "ns:=first");
+    const int status = run.waitFor(150.0);
+    const std::string out = run.output();
+    ASSERT_EQ(0, status) << "the solved run did not end cleanly (-1: not at all):\n" << out;
+    EXPECT_NE(std::string::npos, out.find("SOLVED after")) << out;
+    EXPECT_NE(std::string::npos, out.find("ending the launch")) << out;
+    EXPECT_EQ(std::string::npos, out.find("REQUIRED process")) << out;
+    EXPECT_EQ(std::string::npos, out.find("has died")) << out;
+  }
+  const std::string default_table = tables("first") + "/q_table.yaml";
+  ASSERT_TRUE(fs::exists(default_table)) << "the solved run did not write the default table";
+  const std::string solved = readFile(default_table);
+  ASSERT_EQ(1u, runFolders("first").size());
+  const fs::path solved_run = runFolders("first").front();
+  EXPECT_EQ(solved, readFile((solved_run / cartpole_qlearning::kRunTableFile).string()));
+  EXPECT_EQ("solved", cartpole_qlearning::parseRunRecord(readFile((solved_run / "run.yaml").string())).finished);
+
+  // 2. A short run that cannot solve: its table goes to a folder of its own, the solved default
+  //    table stays byte for byte, and the console says so.
+  {
+    Launch run("short", "ns:=first max_episodes:=5");
+    ASSERT_EQ(0, run.waitFor(90.0)) << run.output();
+    EXPECT_NE(std::string::npos, run.output().find("left as it was")) << run.output();
+  }
+  EXPECT_EQ(solved, readFile(default_table)) << "an unsolved run replaced the solved default table";
+  const std::vector<fs::path> folders = runFolders("first");
+  ASSERT_EQ(2u, folders.size());
+  const fs::path short_run = folders[0] == solved_run ? folders[1] : folders[0];
+  EXPECT_EQ(5u, cartpole_qlearning::loadQTableFile((short_run / "q_table.yaml").string()).episodes);
+
+  // 3. Another namespace: tables of its own, nothing of "first" touched.
+  {
+    Launch run("other", "ns:=second max_episodes:=3");
+    ASSERT_EQ(0, run.waitFor(90.0)) << run.output();
+  }
+  EXPECT_EQ(1u, runFolders("second").size());
+  EXPECT_EQ(2u, runFolders("first").size());
+  EXPECT_EQ(solved, readFile(default_table));
+}
+
+TEST(TrainLaunch, Kill9OfTheSimOrTheControllerDoesNotEndTraining)
+{
+  Episodes episodes("killed");
+  Launch run("killed", "ns:=killed stop_when_solved:=false max_episodes:=1000000");
+  ASSERT_TRUE(spinUntil([&] { return episodes.last() >= 150; }, 120.0))
+      << "training did not get going: " << episodes.last() << " episodes\n"
+      << run.output();
+
+  // The sim: respawned, and training goes on.
+  const int sim = nodePid("/killed/cartpole_sim");
+  ASSERT_GT(sim, 0);
+  ::kill(sim, SIGKILL);
+  std::uint32_t at_kill = episodes.last();
+  EXPECT_TRUE(
+      spinUntil([&] { return nodePid("/killed/cartpole_sim") > 0 && nodePid("/killed/cartpole_sim") != sim; }, 30.0))
+      << "the sim did not come back";
+  EXPECT_TRUE(spinUntil([&] { return episodes.last() >= at_kill + 30; }, 60.0))
+      << "training did not go on after the sim was killed: " << episodes.last() - at_kill << " episodes\n"
+      << run.output();
+
+  // The controller: back within seconds, its episodes counted on from its last checkpoint.
+  const int controller = nodePid("/killed/qlearning_controller");
+  ASSERT_GT(controller, 0);
+  ::kill(controller, SIGKILL);
+  const ros::WallTime killed = ros::WallTime::now();
+  ASSERT_EQ(1u, runFolders("killed").size());
+  const fs::path folder = runFolders("killed").front();
+  // The dead controller writes nothing more: its record is the checkpoint to go on from.
+  const std::uint64_t checkpoint =
+      cartpole_qlearning::parseRunRecord(readFile((folder / "run.yaml").string())).episodes;
+  ASSERT_GE(checkpoint, 100u);
+  const std::size_t before = episodes.seen.size();
+  ASSERT_TRUE(spinUntil(
+      [&] {
+        for (std::size_t i = before; i < episodes.seen.size(); ++i)
+        {
+          if (episodes.seen[i] == checkpoint + 1)
+            return true;
+        }
+        return false;
+      },
+      30.0))
+      << "no episode " << checkpoint + 1 << " after the controller was killed\n"
+      << run.output();
+  const double back_after = (ros::WallTime::now() - killed).toSec();
+  EXPECT_LT(back_after, 15.0) << "the controller took " << back_after << " s to come back";
+  std::cout << "controller back " << back_after << " s after kill -9, at episode " << checkpoint + 1 << "\n";
+  // Its episodes go on from there, not from 1, in the same run folder.
+  const std::uint32_t resumed_at = episodes.last();
+  EXPECT_TRUE(spinUntil([&] { return episodes.last() >= resumed_at + 20; }, 60.0));
+  for (std::size_t i = before; i < episodes.seen.size(); ++i)
+    EXPECT_GT(episodes.seen[i], checkpoint) << "episode counter restarted";
+  EXPECT_EQ(1u, runFolders("killed").size());
+  EXPECT_NE(std::string::npos, run.output().find("goes on from its checkpoint: episode " + std::to_string(checkpoint)))
+      << run.output();
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "train_launch_test");
+  ros::NodeHandle nh;
+  fs::create_directories(rosHome());
+  const int result = RUN_ALL_TESTS();
+  fs::remove_all(rosHome());
+  return result;
+}
