@@ -24,7 +24,7 @@
 namespace fs = std::filesystem;
 using namespace cartpole_qlearning;
 
-using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::spinUntil;
 
 namespace
@@ -64,6 +64,11 @@ void writeBadFiles(const std::string& dir)
   other.bins = {{1, 1, 3, 6}};
   saveQTableFile(QTable(other, {-10.0, 10.0}), dir + "/other_shape.yaml");
   std::ofstream(fs::path(dir).parent_path() / "outside.yaml") << "placeholder";
+  // A few hundred bytes whose header claims 10^12 states.
+  std::string huge = formatQTable(QTable(DiscretiserParams(), {-10.0, 10.0}));
+  const std::size_t bins = huge.find("bins: [");
+  huge.replace(bins, huge.find('\n', bins) - bins, "bins: [1000, 1000, 1000, 1000]");
+  std::ofstream(dir + "/huge_header.yaml") << huge.substr(0, 700);
 }
 
 void expectRefused(const LoadQTable::Response& response, const std::string& what)
@@ -81,19 +86,22 @@ TEST(ControllerServices, EvaluateSaveLoadRoundTripAndRefusalsKeepTheTable)
   const SaveQTable::Response first = save("eval", "");
   ASSERT_TRUE(first.success) << first.message;
   EXPECT_NE(std::string::npos, first.message.find(dir + "/q_table.yaml")) << first.message;
-  const std::string before = readFile(dir + "/q_table.yaml");
+  const std::string before = fileText(dir + "/q_table.yaml");
 
   expectRefused(load("eval", "missing.yaml"), "missing file");
   expectRefused(load("eval", "corrupt.yaml"), "corrupt file");
   const LoadQTable::Response shape = load("eval", "other_shape.yaml");
   expectRefused(shape, "other shape");
   EXPECT_NE(std::string::npos, shape.message.find("bins")) << shape.message;
+  const LoadQTable::Response huge = load("eval", "huge_header.yaml");
+  expectRefused(huge, "a header claiming 10^12 states");
+  EXPECT_NE(std::string::npos, huge.message.find("states")) << huge.message;
   const LoadQTable::Response escape = load("eval", "../outside.yaml");
   expectRefused(escape, "escaping path");
   EXPECT_NE(std::string::npos, escape.message.find("outside")) << escape.message;
 
   ASSERT_TRUE(save("eval", "after_refusals.yaml").success);
-  EXPECT_EQ(before, readFile(dir + "/after_refusals.yaml"));
+  EXPECT_EQ(before, fileText(dir + "/after_refusals.yaml"));
 
   // A real table (trained offline, here: any valid table of the right shape) loads and is used.
   QTable table(DiscretiserParams(), {-10.0, 10.0});
@@ -107,7 +115,7 @@ TEST(ControllerServices, EvaluateSaveLoadRoundTripAndRefusalsKeepTheTable)
   ASSERT_TRUE(loaded.success) << loaded.message;
   EXPECT_NE(std::string::npos, loaded.message.find("42 episodes")) << loaded.message;
   ASSERT_TRUE(save("eval", "sub/round_trip.yaml").success);
-  EXPECT_EQ(readFile(dir + "/good.yaml"), readFile(dir + "/sub/round_trip.yaml"));
+  EXPECT_EQ(fileText(dir + "/good.yaml"), fileText(dir + "/sub/round_trip.yaml"));
 }
 
 TEST(ControllerServices, EscapingSavesAreRefusedAndWriteNothing)
@@ -122,6 +130,26 @@ TEST(ControllerServices, EscapingSavesAreRefusedAndWriteNothing)
   }
   EXPECT_FALSE(fs::exists(root() + "/escaped.yaml"));
   EXPECT_FALSE(fs::exists("/tmp/escaped_cartpole_q_table.yaml"));
+
+  // Through a symbolic link to a folder outside, also behind a missing folder and "..", and
+  // through a link to a file outside: refused both ways, nothing written or read there.
+  const std::string outside = root() + "/outside_dir";
+  fs::create_directories(outside);
+  std::ofstream(outside + "/secret.yaml") << "not yours";
+  fs::remove(dir + "/link");
+  fs::create_directory_symlink(outside, dir + "/link");
+  fs::remove(dir + "/file_link.yaml");
+  fs::create_symlink(outside + "/secret.yaml", dir + "/file_link.yaml");
+  for (const std::string& path : {std::string("link/t.yaml"), std::string("nope/../link/t.yaml"),
+                                  std::string("link/secret.yaml"), std::string("file_link.yaml")})
+  {
+    const SaveQTable::Response response = save("eval", path);
+    EXPECT_FALSE(response.success) << path << ": " << response.message;
+    expectRefused(load("eval", path), path);
+  }
+  EXPECT_EQ(std::vector<fs::path>{fs::path(outside + "/secret.yaml")},
+            std::vector<fs::path>(fs::directory_iterator(outside), fs::directory_iterator()));
+  EXPECT_EQ("not yours", fileText(outside + "/secret.yaml"));
 }
 
 TEST(ControllerServices, TrainingGoesOnThroughRefusedLoads)

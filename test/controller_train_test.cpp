@@ -23,7 +23,7 @@
 namespace fs = std::filesystem;
 using cartpole_qlearning::EpisodeStats;
 
-using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::spinUntil;
 
 namespace
@@ -77,7 +77,7 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
   const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " +
                               CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
-  EXPECT_EQ(readFile(headless), readFile(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
+  EXPECT_EQ(fileText(headless), fileText(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
 
   // 3. A fresh controller in evaluate mode loads the table and balances a full 500-step episode.
   const std::size_t before = stats_.size();

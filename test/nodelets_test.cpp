@@ -14,7 +14,7 @@
 #include <string>
 
 namespace fs = std::filesystem;
-using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::spinUntil;
 
 TEST(Nodelets, TrainingOnOneWorkerThreadSolvesWithTheHeadlessTable)
@@ -28,11 +28,11 @@ TEST(Nodelets, TrainingOnOneWorkerThreadSolvesWithTheHeadlessTable)
   const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " +
                               CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
-  const std::string expected = readFile(headless);
+  const std::string expected = fileText(headless);
   const std::string trained = dir + "/q_table.yaml";
   // Episode after episode: every reset call returned although the sim's service and the
   // controller share the manager's one worker thread.
-  EXPECT_TRUE(spinUntil([&] { return fs::exists(trained) && readFile(trained) == expected; }, 60.0))
+  EXPECT_TRUE(spinUntil([&] { return fs::exists(trained) && fileText(trained) == expected; }, 60.0))
       << "nodelet training did not write train_headless's table for seed 0 (" << trained
       << (fs::exists(trained) ? " differs)" : " was not written: training stalled?)");
 

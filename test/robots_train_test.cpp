@@ -18,7 +18,7 @@
 namespace fs = std::filesystem;
 using cartpole_qlearning::EpisodeStats;
 using cartpole_qlearning::EpisodeStatsConstPtr;
-using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::spinUntil;
 
 TEST(RobotsTrain, ThreeRobotsWriteTheHeadlessTableForThreeRobots)
@@ -45,9 +45,9 @@ TEST(RobotsTrain, ThreeRobotsWriteTheHeadlessTableForThreeRobots)
   const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --robots 3 --quiet --config " +
                               CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
-  const std::string expected = readFile(headless);
+  const std::string expected = fileText(headless);
   const std::string trained = dir + "/q_table.yaml";
-  const bool same = spinUntil([&] { return fs::exists(trained) && readFile(trained) == expected; }, 120.0);
+  const bool same = spinUntil([&] { return fs::exists(trained) && fileText(trained) == expected; }, 120.0);
   EXPECT_TRUE(same) << "robots:=3 did not write train_headless --robots 3's table for seed 0 (" << trained
                     << (fs::exists(trained) ? " differs)" : " was not written)");
 

@@ -51,7 +51,7 @@ inline CommandRun runCommand(const std::string& command)
   return run;
 }
 
-inline std::string readFile(const std::string& path)
+inline std::string fileText(const std::string& path)
 {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;

@@ -19,7 +19,7 @@
 namespace fs = std::filesystem;
 
 using cartpole_qlearning::test::CommandRun;
-using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::runCommand;
 
 namespace
@@ -75,7 +75,7 @@ TEST_F(TrainHeadlessTest, SavedTableLoadsAndTheSameSeedWritesTheSameBytes)
   ASSERT_EQ(0, trainHeadless(config() + " --seed 4 --quiet --save " + b).status);
   const cartpole_qlearning::QTable table = cartpole_qlearning::loadQTableFile(a);
   EXPECT_GT(table.episodes, 0u);
-  EXPECT_EQ(readFile(a), readFile(b));
+  EXPECT_EQ(fileText(a), fileText(b));
 }
 
 TEST_F(TrainHeadlessTest, UnsolvedRunSaysSo)

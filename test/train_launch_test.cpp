@@ -26,7 +26,7 @@
 #include <unistd.h>
 
 namespace fs = std::filesystem;
-using cartpole_qlearning::test::readFile;
+using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::runCommand;
 using cartpole_qlearning::test::spinUntil;
 using cartpole_qlearning::test::startProcess;
@@ -80,7 +80,7 @@ struct Launch
   }
   std::string output() const
   {
-    return readFile(log);
+    return fileText(log);
   }
 };
 
@@ -157,11 +157,11 @@ TEST(TrainLaunch, ASolvedRunEndsCleanlyAndLaterUnsolvedRunsLeaveItsTable)
   }
   const std::string default_table = tables("first") + "/q_table.yaml";
   ASSERT_TRUE(fs::exists(default_table)) << "the solved run did not write the default table";
-  const std::string solved = readFile(default_table);
+  const std::string solved = fileText(default_table);
   ASSERT_EQ(1u, runFolders("first").size());
   const fs::path solved_run = runFolders("first").front();
-  EXPECT_EQ(solved, readFile((solved_run / cartpole_qlearning::kRunTableFile).string()));
-  EXPECT_EQ("solved", cartpole_qlearning::parseRunRecord(readFile((solved_run / "run.yaml").string())).finished);
+  EXPECT_EQ(solved, fileText((solved_run / cartpole_qlearning::kRunTableFile).string()));
+  EXPECT_EQ("solved", cartpole_qlearning::parseRunRecord(fileText((solved_run / "run.yaml").string())).finished);
 
   // 2. A short run that cannot solve: its table goes to a folder of its own, the solved default
   //    table stays byte for byte, and the console says so.
@@ -170,7 +170,7 @@ TEST(TrainLaunch, ASolvedRunEndsCleanlyAndLaterUnsolvedRunsLeaveItsTable)
     ASSERT_EQ(0, run.waitFor(90.0)) << run.output();
     EXPECT_NE(std::string::npos, run.output().find("left as it was")) << run.output();
   }
-  EXPECT_EQ(solved, readFile(default_table)) << "an unsolved run replaced the solved default table";
+  EXPECT_EQ(solved, fileText(default_table)) << "an unsolved run replaced the solved default table";
   const std::vector<fs::path> folders = runFolders("first");
   ASSERT_EQ(2u, folders.size());
   const fs::path short_run = folders[0] == solved_run ? folders[1] : folders[0];
@@ -183,7 +183,7 @@ TEST(TrainLaunch, ASolvedRunEndsCleanlyAndLaterUnsolvedRunsLeaveItsTable)
   }
   EXPECT_EQ(1u, runFolders("second").size());
   EXPECT_EQ(2u, runFolders("first").size());
-  EXPECT_EQ(solved, readFile(default_table));
+  EXPECT_EQ(solved, fileText(default_table));
 }
 
 TEST(TrainLaunch, Kill9OfTheSimOrTheControllerDoesNotEndTraining)
@@ -215,7 +215,7 @@ TEST(TrainLaunch, Kill9OfTheSimOrTheControllerDoesNotEndTraining)
   const fs::path folder = runFolders("killed").front();
   // The dead controller writes nothing more: its record is the checkpoint to go on from.
   const std::uint64_t checkpoint =
-      cartpole_qlearning::parseRunRecord(readFile((folder / "run.yaml").string())).episodes;
+      cartpole_qlearning::parseRunRecord(fileText((folder / "run.yaml").string())).episodes;
   ASSERT_GE(checkpoint, 100u);
   const std::size_t before = episodes.seen.size();
   ASSERT_TRUE(spinUntil(
