@@ -220,6 +220,16 @@ TEST(TrainLaunch, ASolvedRunEndsCleanlyAndLaterUnsolvedRunsLeaveItsTable)
   EXPECT_EQ(solved, fileText(default_table));
 }
 
+TEST(TrainLaunch, ABadParameterEndsTheLaunchInsteadOfRespawningIntoTheSameError)
+{
+  Launch run("bad", "ns:=bad max_episodes:=0");
+  ASSERT_EQ(0, run.waitFor(60.0)) << "the launch did not end:\n" << run.output();
+  const std::string out = run.output();
+  EXPECT_NE(std::string::npos, out.find("max_episodes = 0 is not allowed")) << out;
+  EXPECT_NE(std::string::npos, out.find("ending the launch")) << out;
+  EXPECT_EQ(std::string::npos, out.find("restarting process")) << out;
+}
+
 TEST(TrainLaunch, Kill9OfTheSimOrTheControllerDoesNotEndTraining)
 {
   Episodes episodes("killed");
