@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets everything up (scripts/setup.sh) and trains over ROS: roslaunch train.launch (sim and
 # controller in lockstep) until solved. Arguments go to roslaunch, e.g. seed:=3 or
-# stop_when_solved:=false. The table is saved to ~/.ros/cartpole_qlearning/q_table.yaml.
+# stop_when_solved:=false. The table is saved to ~/.ros/cartpole_qlearning/cartpole/q_table.yaml (runs/ beside it keeps each run's checkpoints).
 set -eo pipefail
 # shellcheck disable=SC1091
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
