@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <locale>
@@ -259,6 +260,18 @@ QTable parseQTable(const std::string& text)
     refuse("checksum mismatch: the file says " + (checksum.IsScalar() ? checksum.Scalar() : std::string("?")) +
            ", its contents give " + expected + " (the file is corrupt or was edited)");
   return table;
+}
+
+std::string defaultTableDirectory(const std::string& name_space)
+{
+  const char* ros_home = std::getenv("ROS_HOME");
+  const char* home = std::getenv("HOME");
+  const std::string base = ros_home != nullptr && *ros_home != '\0'
+                               ? std::string(ros_home) + "/cartpole_qlearning"
+                               : std::string(home != nullptr ? home : ".") + "/.ros/cartpole_qlearning";
+  if (name_space.empty() || name_space == "/")
+    return base;
+  return base + (name_space.front() == '/' ? "" : "/") + name_space;
 }
 
 void saveQTableFile(const QTable& table, const std::string& path)

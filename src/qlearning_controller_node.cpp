@@ -20,18 +20,6 @@ namespace cartpole_qlearning
 {
 namespace
 {
-// $ROS_HOME/cartpole_qlearning/<namespace>: instances in different namespaces never write
-// each other's tables.
-std::string defaultTableDirectory(const std::string& name_space)
-{
-  const char* ros_home = std::getenv("ROS_HOME");
-  const char* home = std::getenv("HOME");
-  const std::string base = ros_home != nullptr && *ros_home != '\0'
-                               ? std::string(ros_home) + "/cartpole_qlearning"
-                               : std::string(home != nullptr ? home : ".") + "/.ros/cartpole_qlearning";
-  return name_space == "/" ? base : base + name_space;
-}
-
 // ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
 // the learner's own namespace (N = 1), or robot_0 ... robot_<N-1> (train.launch robots:=N).
 void readRobots(const ros::NodeHandle& pnh, SectionReader& priv, std::vector<std::string>& names)

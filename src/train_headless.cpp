@@ -15,13 +15,17 @@ namespace
 {
 void usage(std::ostream& out)
 {
-  out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--save PATH] [--max-episodes N] [--quiet]\n"
+  out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--save PATH] [--ns NS] [--max-episodes N] "
+         "[--quiet]\n"
          "  --config FILE     physics, task, learning and training parameters (YAML);\n"
          "                    default: the package's config/cartpole.yaml\n"
          "  --seed N          seed of the start states and of exploration (default 0)\n"
          "  --robots N        N simulated robots feed one learner, served in lockstep rounds in robot order\n"
          "                    (as train.launch robots:=N); robot r starts from seed S + r (default 1)\n"
-         "  --save PATH       write the final Q-table there (atomic)\n"
+         "  --save PATH       write the final Q-table there (atomic); a relative PATH is taken under the\n"
+         "                    controller's table folder, $ROS_HOME/cartpole_qlearning/NS (~/.ros/...), where\n"
+         "                    evaluate.launch q_table:=PATH finds it; without --save nothing is written\n"
+         "  --ns NS           the namespace whose table folder --save uses (default cartpole)\n"
          "  --max-episodes N  override training/max_episodes\n"
          "  --quiet           no progress lines, only the result line\n";
 }
@@ -53,6 +57,7 @@ int run(int argc, char** argv)
   using namespace cartpole_qlearning;
   std::string config_path;
   std::string save_path;
+  std::string name_space = "/cartpole";
   std::uint64_t seed = 0;
   std::uint64_t max_episodes = 0;
   std::uint64_t robots = 1;
@@ -72,6 +77,17 @@ int run(int argc, char** argv)
       config_path = argv[++i];
     else if (arg == "--save" && has_value)
       save_path = argv[++i];
+    else if (arg == "--ns" && has_value)
+    {
+      name_space = argv[++i];
+      if (name_space.empty() || name_space.find("..") != std::string::npos)
+      {
+        std::cerr << "train_headless: --ns '" << name_space << "' is not allowed (must be a ROS namespace)\n";
+        return 2;
+      }
+      if (name_space.front() != '/')
+        name_space = "/" + name_space;
+    }
     else if (arg == "--seed" && has_value)
     {
       if (!parseCount(argv[++i], seed))
@@ -148,20 +164,34 @@ int run(int argc, char** argv)
     last_time = now;
   });
 
+  // The one path rule: a relative table path is under the table folder (as the controller's
+  // services and the launch files take it); an absolute one is the user's own.
+  const std::string table_dir = defaultTableDirectory(name_space);
   int status = 0;
   if (!save_path.empty())
   {
     try
     {
-      saveQTableFile(trainer.session().table(), save_path);
+      std::string written = save_path;
+      if (save_path.front() == '/')
+        saveQTableFile(trainer.session().table(), save_path);
+      else
+      {
+        saveQTableUnder(trainer.session().table(), table_dir, save_path);
+        written = resolvePathUnder(table_dir, save_path);
+      }
       if (!quiet)
-        std::printf("saved the Q-table to %s\n", save_path.c_str());
+        std::printf("saved the Q-table to %s\n", written.c_str());
     }
     catch (const QTableFileError& e)
     {
       std::cerr << "train_headless: " << e.what() << "\n";
       status = 1;
     }
+  }
+  else if (!quiet)
+  {
+    std::printf("nothing saved (--save NAME writes the table to %s/NAME)\n", table_dir.c_str());
   }
   std::printf("solved=%s episodes=%llu steps=%llu wall_s=%.3f\n", result.solved ? "true" : "false",
               static_cast<unsigned long long>(result.episodes), static_cast<unsigned long long>(result.steps),

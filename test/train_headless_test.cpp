@@ -78,6 +78,33 @@ TEST_F(TrainHeadlessTest, SavedTableLoadsAndTheSameSeedWritesTheSameBytes)
   EXPECT_EQ(fileText(a), fileText(b));
 }
 
+TEST_F(TrainHeadlessTest, ARelativeSaveGoesWhereTheControllerLooksAndNoSaveSaysSo)
+{
+  // The one path rule: relative to $ROS_HOME/cartpole_qlearning/<ns>, as the services and the
+  // launch files take q_table paths (evaluate.launch q_table:=mine.yaml then finds it).
+  const std::string home = "ROS_HOME=" + dir_.string() + " ";
+  const CommandRun saved =
+      runCommand(home + TRAIN_HEADLESS + " " + config() + " --max-episodes 3 --save runs/mine.yaml");
+  ASSERT_EQ(0, saved.status) << saved.output;
+  const std::string expected = (dir_ / "cartpole_qlearning" / "cartpole" / "runs" / "mine.yaml").string();
+  EXPECT_EQ(3u, cartpole_qlearning::loadQTableFile(expected).episodes);
+  EXPECT_NE(std::string::npos, saved.output.find("saved the Q-table to " + expected)) << saved.output;
+  const CommandRun other =
+      runCommand(home + TRAIN_HEADLESS + " " + config() + " --max-episodes 3 --ns a/b --save t.yaml");
+  ASSERT_EQ(0, other.status) << other.output;
+  EXPECT_TRUE(fs::exists(dir_ / "cartpole_qlearning" / "a" / "b" / "t.yaml"));
+  // Leaving the folder is refused, as over a service; nothing is written.
+  const CommandRun escape = runCommand(home + TRAIN_HEADLESS + " " + config() + " --max-episodes 3 --save ../x.yaml");
+  EXPECT_EQ(1, escape.status) << escape.output;
+  EXPECT_FALSE(fs::exists(dir_ / "cartpole_qlearning" / "x.yaml"));
+  // Without --save nothing is written, and it says where --save would write.
+  const CommandRun unsaved = runCommand(home + TRAIN_HEADLESS + " " + config() + " --max-episodes 3");
+  EXPECT_EQ(0, unsaved.status);
+  EXPECT_NE(std::string::npos, unsaved.output.find("nothing saved (--save NAME writes the table to " +
+                                                   (dir_ / "cartpole_qlearning" / "cartpole").string()))
+      << unsaved.output;
+}
+
 TEST_F(TrainHeadlessTest, UnsolvedRunSaysSo)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
