@@ -86,7 +86,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
     try
     {
       path = resolve(load_on_start_);
-      const std::string mismatch = session_->replaceTable(loadQTableUnder(q_table_dir_, load_on_start_));
+      const std::string mismatch = install(loadQTableUnder(q_table_dir_, load_on_start_));
       if (!mismatch.empty())
         throw QTableFileError(path + " does not fit this controller: " + mismatch);
     }
@@ -475,6 +475,18 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
   }
 }
 
+std::string QLearningControllerNode::install(QTable table)
+{
+  // Training goes on with the table's own counts: episode numbers, steps, the schedules and
+  // max_episodes all count from them, so the progress lines and the saves agree. (The solved
+  // window starts empty.) Evaluation counts its own episodes from 1.
+  const std::string mismatch =
+      learning_ ? session_->resume(std::move(table), {}) : session_->replaceTable(std::move(table));
+  // Steps per second count from here.
+  steps_at_last_episode_ = steps_at_last_progress_ = session_->lastEpisode().total_steps;
+  return mismatch;
+}
+
 void QLearningControllerNode::endWhenFinished()
 {
   if (!shutdown_when_finished_)
@@ -544,6 +556,7 @@ void QLearningControllerNode::resumeRun()
                       " does not fit this controller's configuration: " + mismatch);
   run_ = record;
   const EpisodeSummary& s = session_->lastEpisode();
+  steps_at_last_episode_ = steps_at_last_progress_ = s.total_steps;
   ROS_WARN("qlearning_controller: restarted; run %s goes on from its checkpoint: episode %llu, %llu steps%s",
            run_folder_.c_str(), static_cast<unsigned long long>(s.episode),
            static_cast<unsigned long long>(s.total_steps),
@@ -614,7 +627,7 @@ bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::R
     QTable table = loadQTableUnder(q_table_dir_, request.path.empty() ? q_table_path_ : request.path);
     const std::uint64_t episodes = table.episodes;
     const std::uint64_t steps = table.steps;
-    const std::string mismatch = session_->replaceTable(std::move(table));
+    const std::string mismatch = install(std::move(table));
     if (!mismatch.empty())
       throw QTableFileError(path + " does not fit this controller: " + mismatch);
     response.success = true;

@@ -188,6 +188,16 @@ TEST(ControllerServices, TrainingGoesOnThroughRefusedLoads)
   const QTable reloaded = loadQTableFile(dir + "/reloaded.yaml");
   EXPECT_LT(reloaded.steps, latest.steps) << "the load did not replace the live table";
   EXPECT_GE(reloaded.steps, before.steps);
+  // The episode numbers go on from the loaded table's, so episode_stats and the saves agree.
+  const std::uint64_t loaded_at = reloaded.episodes;
+  ASSERT_TRUE(spinUntil([&] { return episodes > loaded_at && episodes < latest.episodes; }, 30.0))
+      << "episode_stats says " << episodes << " after a load of a table of " << loaded_at << " episodes";
+  ASSERT_TRUE(save("train", "counted.yaml").success);
+  const std::uint64_t said = episodes;
+  const QTable counted = loadQTableFile(dir + "/counted.yaml");
+  EXPECT_GE(counted.episodes, said);
+  // (A few more may end between the last message seen here and the save.)
+  EXPECT_LE(counted.episodes, said + 20) << "the table's episodes and episode_stats disagree";
 }
 
 TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)

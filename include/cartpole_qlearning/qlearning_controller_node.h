@@ -76,6 +76,8 @@ private:
   void resumeRun();
   // Saves the table and the run record into the run's folder; returns the message to log.
   bool checkpoint(const std::string& finished, std::string& message);
+  // Puts a loaded table in place (checked; on a mismatch returns what differs, nothing changed).
+  std::string install(QTable table);
   // Training or evaluation is over: ends the launch (or the node) when ~shutdown_when_finished.
   void endWhenFinished();
   void setUpRobots(ros::CallbackQueue* state_queue);
