@@ -4,13 +4,19 @@ solving took: median, worst, and how many seeds did not solve.
 
   scripts/seed_statistics.py [--seeds 0-9] [--config FILE] [--max-episodes N]
 
-Needs the workspace sourced (rosrun finds train_headless). Standard library only.
+Finds train_headless by itself: --train-headless PATH, else rosrun when a workspace is
+sourced, else the build in $CARTPOLE_WS or ~/cartpole_ws (what scripts/train.sh and test.sh
+make). Standard library only.
 """
 import argparse
+import os
 import re
+import shutil
 import statistics
 import subprocess
 import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
 
 RESULT = re.compile(r"^solved=(true|false) episodes=(\d+) steps=(\d+) wall_s=([0-9.]+)$")
 
@@ -20,18 +26,39 @@ def seed_range(text):
     return range(int(first), int(last or first) + 1)
 
 
+def train_headless_command(explicit):
+    """The command that runs train_headless, or exits saying where it looked."""
+    if explicit:
+        return [explicit]
+    if os.environ.get("ROS_PACKAGE_PATH") and shutil.which("rosrun"):
+        found = subprocess.run(["rospack", "find", "cartpole_qlearning"], capture_output=True, text=True)
+        if found.returncode == 0:
+            return ["rosrun", "cartpole_qlearning", "train_headless"]
+    looked = []
+    for workspace in (os.environ.get("CARTPOLE_WS"), os.path.expanduser("~/cartpole_ws")):
+        if workspace:
+            candidate = os.path.join(workspace, "devel", "lib", "cartpole_qlearning", "train_headless")
+            looked.append(candidate)
+            if os.access(candidate, os.X_OK):
+                return [candidate]
+    sys.exit("train_headless not found: source your workspace's devel/setup.bash, or pass --train-headless PATH "
+             "(looked for rosrun cartpole_qlearning and in %s)" % ", ".join(looked))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seeds", type=seed_range, default=seed_range("0-9"), help="e.g. 0-9 (default) or 0-99")
     parser.add_argument("--config", help="config file (default: the package's config/cartpole.yaml)")
     parser.add_argument("--max-episodes", type=int, help="override training/max_episodes")
+    parser.add_argument("--train-headless", help="the train_headless executable (default: found, see above)")
     args = parser.parse_args()
+    trainer = train_headless_command(args.train_headless)
+    # The config beside this script unless told otherwise: no package lookup needed.
+    config = args.config or os.path.join(HERE, "..", "config", "cartpole.yaml")
 
     episodes, walls, unsolved = [], [], []
     for seed in args.seeds:
-        command = ["rosrun", "cartpole_qlearning", "train_headless", "--quiet", "--seed", str(seed)]
-        if args.config:
-            command += ["--config", args.config]
+        command = trainer + ["--quiet", "--seed", str(seed), "--config", config]
         if args.max_episodes:
             command += ["--max-episodes", str(args.max_episodes)]
         run = subprocess.run(command, capture_output=True, text=True)
