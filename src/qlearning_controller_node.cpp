@@ -361,9 +361,11 @@ void QLearningControllerNode::report(const Robot& robot, const Reaction& reactio
         "qlearning_controller: joint_states on %s carry no stamp (0): every message is taken as a new state, and "
         "commands go out unstamped",
         describe(robot).c_str());
-  if (reaction.sim_restarted)
-    ROS_WARN("qlearning_controller: %s: time went back to %.3f s: the sim restarted; starting a new episode",
-             describe(robot).c_str(), stamp.toSec());
+  if (reaction.sim_restarted && restart_warning_.ready())
+    ROS_WARN(
+        "qlearning_controller: %s: time went back to %.3f s: the sim restarted; starting a new episode. Restarts so "
+        "far: %llu",
+        describe(robot).c_str(), stamp.toSec(), static_cast<unsigned long long>(c.restarts));
   if (reaction.waiting_for_start)
     ROS_INFO(
         "qlearning_controller: %s: episode over; no reset service, so commanding 0 until the state is back inside "

@@ -148,6 +148,8 @@ private:
   std::chrono::steady_clock::time_point last_progress_;
   mutable WallThrottle bad_state_warning_{1.0};
   WallThrottle dropped_state_warning_{1.0};
+  // A replayed older stamp, sent twice, looks like a restarted sim: said at most once a second.
+  WallThrottle restart_warning_{1.0};
 
   ros::Publisher stats_pub_;
   ros::ServiceServer save_srv_;
