@@ -38,6 +38,22 @@ if [ "${FUZZ_SECONDS:-30}" -gt 0 ]; then
   echo "[test] fuzzing the table file and config parsers, ${FUZZ_SECONDS:-30} s each"
   bash "$CARTPOLE_SRC/scripts/fuzz.sh" "${FUZZ_SECONDS:-30}" build/test_results/cartpole_qlearning || true
 fi
+# The README's own check: its commands in order, in a fresh clone, home and workspace, with a
+# master of its own (scripts/first_hour.sh); one case per command. FIRST_HOUR=0 skips it.
+if [ "${FIRST_HOUR:-1}" != 0 ]; then
+  echo "[test] the README's commands in a fresh home (scripts/first_hour.sh, about 6 to 10 minutes); log in $CARTPOLE_WS/first_hour.log"
+  bash "$CARTPOLE_SRC/scripts/first_hour.sh" build/test_results/cartpole_qlearning >"$CARTPOLE_WS/first_hour.log" 2>&1 || true
+  grep -E "^\[first-hour\] (+[0-9.]+ s|[0-9]+ passed)" "$CARTPOLE_WS/first_hour.log" | grep -E "FAIL|passed" || true
+  if [ ! -s build/test_results/cartpole_qlearning/first_hour.xml ]; then
+    tail -n 30 "$CARTPOLE_WS/first_hour.log"
+    cat >build/test_results/cartpole_qlearning/first_hour-aborted.xml <<XML
+<?xml version="1.0" encoding="UTF-8"?>
+<testsuite name="first_hour" tests="1" failures="1" errors="0">
+  <testcase classname="first_hour" name="first_hour_script"><failure message="see $CARTPOLE_WS/first_hour.log"/></testcase>
+</testsuite>
+XML
+  fi
+fi
 if ! ls build/test_results/cartpole_qlearning/*.xml >/dev/null 2>&1; then
   tail -n 60 "$CARTPOLE_WS/test.log"
   echo "[test] no test results were produced (the build of the tests failed?)"
