@@ -7,7 +7,7 @@
 #
 # usage: bash scripts/first_hour.sh [RESULTS_DIR]   (one JUnit case per command goes there)
 # Needs what scripts/setup.sh installs (the first command, scripts/train.sh, runs it).
-set -uo pipefail
+set -o pipefail
 SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 README="$SRC/README.md"
 RESULTS=${1:+$(realpath -m "$1")}

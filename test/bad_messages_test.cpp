@@ -53,6 +53,9 @@
 #include <vector>
 
 namespace fs = std::filesystem;
+using cartpole_qlearning::test::callNode;
+using cartpole_qlearning::test::callNodeRaw;
+using cartpole_qlearning::test::pidOf;
 using cartpole_qlearning::test::spinUntil;
 
 namespace
@@ -343,45 +346,6 @@ private:
   std::uint64_t problem_count_ = 0;
   std::vector<std::string> problems_;
 };
-
-// Calls a node's slave API (XML-RPC) with the caller id as the only argument; its raw answer
-// (normally [1, message, value]), or a value of no type.
-XmlRpc::XmlRpcValue callNodeRaw(const std::string& node, const char* method)
-{
-  XmlRpc::XmlRpcValue request, response, payload;
-  request[0] = ros::this_node::getName();
-  request[1] = node;
-  if (!ros::master::execute("lookupNode", request, response, payload, false) ||
-      payload.getType() != XmlRpc::XmlRpcValue::TypeString)
-    return {};
-  std::string host;
-  std::uint32_t port = 0;
-  if (!ros::network::splitURI(static_cast<std::string>(payload), host, port))
-    return {};
-  XmlRpc::XmlRpcClient client(host.c_str(), static_cast<int>(port), "/");
-  XmlRpc::XmlRpcValue args, result;
-  args[0] = ros::this_node::getName();
-  const bool ok = client.execute(method, args, result);
-  client.close();
-  return ok ? result : XmlRpc::XmlRpcValue();
-}
-
-// The value of a successful answer [1, message, value], or a value of no type.
-XmlRpc::XmlRpcValue callNode(const std::string& node, const char* method)
-{
-  XmlRpc::XmlRpcValue result = callNodeRaw(node, method);
-  if (result.getType() != XmlRpc::XmlRpcValue::TypeArray || result.size() != 3 ||
-      result[0].getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(result[0]) != 1)
-    return {};
-  return result[2];
-}
-
-// The pid a node reports (getPid), or -1 when it does not answer.
-int pidOf(const std::string& node)
-{
-  XmlRpc::XmlRpcValue pid = callNode(node, "getPid");
-  return pid.getType() == XmlRpc::XmlRpcValue::TypeInt ? static_cast<int>(pid) : -1;
-}
 
 // What a node's subscription to a topic has received from this node over TCP, and how many of
 // those it dropped from its full subscriber queue (never reaching its callback), as roscpp's

@@ -21,6 +21,7 @@
 using cartpole_qlearning::EpisodeStats;
 using cartpole_qlearning::EpisodeStatsConstPtr;
 using cartpole_qlearning::test::spinUntil;
+using cartpole_qlearning::test::uriOf;
 using cartpole_qlearning::test::startProcess;
 using cartpole_qlearning::test::stopProcess;
 
@@ -50,17 +51,6 @@ struct Sims
   }
 };
 
-// The URI the master has for a node ("" when it has none).
-std::string uriOf(const std::string& node)
-{
-  XmlRpc::XmlRpcValue request, response, payload;
-  request[0] = ros::this_node::getName();
-  request[1] = node;
-  if (!ros::master::execute("lookupNode", request, response, payload, false) ||
-      payload.getType() != XmlRpc::XmlRpcValue::TypeString)
-    return "";
-  return static_cast<std::string>(payload);
-}
 }  // namespace
 
 TEST(FleetHosts, TheLearnerGoesOnWithoutALostRobotAndTakesItBack)

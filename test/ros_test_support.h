@@ -1,9 +1,13 @@
 // Helpers the rostest test nodes share.
 #pragma once
 
+#include <ros/master.h>
+#include <ros/network.h>
 #include <ros/ros.h>
+#include <xmlrpcpp/XmlRpcClient.h>
 
 #include <functional>
+#include <string>
 
 namespace cartpole_qlearning
 {
@@ -23,6 +27,51 @@ inline bool spinUntil(const std::function<bool()>& done, double timeout_s)
   }
   ros::spinOnce();
   return done();
+}
+
+// The URI the master has for a node ("" when it has none).
+inline std::string uriOf(const std::string& node)
+{
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  request[1] = node;
+  if (!ros::master::execute("lookupNode", request, response, payload, false) ||
+      payload.getType() != XmlRpc::XmlRpcValue::TypeString)
+    return "";
+  return static_cast<std::string>(payload);
+}
+
+// Calls a node's slave API (XML-RPC) with the caller id as the only argument, as rosnode does;
+// its raw answer (normally [1, message, value]), or a value of no type.
+inline XmlRpc::XmlRpcValue callNodeRaw(const std::string& node, const char* method)
+{
+  std::string host;
+  std::uint32_t port = 0;
+  if (!ros::network::splitURI(uriOf(node), host, port))
+    return {};
+  XmlRpc::XmlRpcClient client(host.c_str(), static_cast<int>(port), "/");
+  XmlRpc::XmlRpcValue args, result;
+  args[0] = ros::this_node::getName();
+  const bool ok = client.execute(method, args, result);
+  client.close();
+  return ok ? result : XmlRpc::XmlRpcValue();
+}
+
+// The value of a successful answer [1, message, value], or a value of no type.
+inline XmlRpc::XmlRpcValue callNode(const std::string& node, const char* method)
+{
+  XmlRpc::XmlRpcValue result = callNodeRaw(node, method);
+  if (result.getType() != XmlRpc::XmlRpcValue::TypeArray || result.size() != 3 ||
+      result[0].getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(result[0]) != 1)
+    return {};
+  return result[2];
+}
+
+// The pid a node reports (getPid), or -1 when it does not answer.
+inline int pidOf(const std::string& node)
+{
+  XmlRpc::XmlRpcValue pid = callNode(node, "getPid");
+  return pid.getType() == XmlRpc::XmlRpcValue::TypeInt ? static_cast<int>(pid) : -1;
 }
 
 }  // namespace test

@@ -10,10 +10,7 @@
 #include "test_support.h"
 
 #include <gtest/gtest.h>
-#include <ros/master.h>
-#include <ros/network.h>
 #include <ros/ros.h>
-#include <xmlrpcpp/XmlRpcClient.h>
 
 #include <chrono>
 #include <filesystem>
@@ -27,6 +24,7 @@
 
 namespace fs = std::filesystem;
 using cartpole_qlearning::test::fileText;
+using cartpole_qlearning::test::pidOf;
 using cartpole_qlearning::test::runCommand;
 using cartpole_qlearning::test::spinUntil;
 using cartpole_qlearning::test::startProcess;
@@ -100,29 +98,6 @@ std::vector<fs::path> runFolders(const std::string& ns)
   return folders;
 }
 
-// A node's pid, asked through its XML-RPC API as rosnode does.
-int nodePid(const std::string& node)
-{
-  XmlRpc::XmlRpcValue args, result, payload;
-  args[0] = ros::this_node::getName();
-  args[1] = node;
-  if (!ros::master::execute("lookupNode", args, result, payload, false) || result.size() < 3 ||
-      result[0].getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(result[0]) != 1)
-    return -1;
-  const std::string uri = result[2];
-  std::string host;
-  std::uint32_t port = 0;
-  if (!ros::network::splitURI(uri, host, port))
-    return -1;
-  XmlRpc::XmlRpcClient client(host.c_str(), static_cast<int>(port), "/");
-  XmlRpc::XmlRpcValue pid_args, pid_result;
-  pid_args[0] = ros::this_node::getName();
-  if (!client.execute("getPid", pid_args, pid_result) || pid_result.size() < 3 ||
-      pid_result[2].getType() != XmlRpc::XmlRpcValue::TypeInt)
-    return -1;
-  return static_cast<int>(pid_result[2]);
-}
-
 // Episode numbers from ns/episode_stats, in order of arrival.
 struct Episodes
 {
@@ -149,7 +124,7 @@ struct Episodes
 void expectGoesOnFromItsCheckpoint(const Launch& run, Episodes& episodes, const std::string& ns,
                                    const std::string& node, double max_seconds)
 {
-  const int pid = nodePid(node);
+  const int pid = pidOf(node);
   ASSERT_GT(pid, 0) << node;
   ::kill(pid, SIGKILL);
   const ros::WallTime killed = ros::WallTime::now();
@@ -239,12 +214,12 @@ TEST(TrainLaunch, Kill9OfTheSimOrTheControllerDoesNotEndTraining)
       << run.output();
 
   // The sim: respawned, and training goes on.
-  const int sim = nodePid("/killed/cartpole_sim");
+  const int sim = pidOf("/killed/cartpole_sim");
   ASSERT_GT(sim, 0);
   ::kill(sim, SIGKILL);
   std::uint32_t at_kill = episodes.last();
   EXPECT_TRUE(
-      spinUntil([&] { return nodePid("/killed/cartpole_sim") > 0 && nodePid("/killed/cartpole_sim") != sim; }, 30.0))
+      spinUntil([&] { return pidOf("/killed/cartpole_sim") > 0 && pidOf("/killed/cartpole_sim") != sim; }, 30.0))
       << "the sim did not come back";
   EXPECT_TRUE(spinUntil([&] { return episodes.last() >= at_kill + 30; }, 60.0))
       << "training did not go on after the sim was killed: " << episodes.last() - at_kill << " episodes\n"
