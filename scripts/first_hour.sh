@@ -55,7 +55,7 @@ record() {
     CASES+="  <testcase classname=\"first_hour\" name=\"$escaped\" time=\"$seconds\"><failure message=\"$(printf '%s' "$failure" | xml_escape)\"/></testcase>"$'\n'
     SUMMARY+=$(printf '%8.1f s  FAIL  %s: %s' "$seconds" "$name" "$failure")$'\n'
   fi
-  printf '[first-hour] %8.1f s  %s  %s\n' "$seconds" "${failure:+FAIL}${failure:-ok}" "$name"
+  printf '[first-hour] %8.1f s  %s  %s\n' "$seconds" "${failure:+FAIL}${failure:+: $failure}${failure:-ok}" "$name"
 }
 
 in_readme() { grep -qF -- "$1" "$README"; }
@@ -213,8 +213,14 @@ if start "sim.launch" "roslaunch cartpole_qlearning sim.launch"; then
   run "sim: reset to a random start" 30 0 "rosservice call /cartpole/cartpole_sim/reset \"state: []\"" "success: True"
   run "sim: reset to a given state" 30 0 "rosservice call /cartpole/cartpole_sim/reset \"state: [0.0, 0.0, 0.1, 0.0]\"" \
     "success: True"
-  run "sim: push the cart (rostopic pub -r 50)" 3 124 \
-    "rostopic pub -r 50 /cartpole/cart_effort std_msgs/Float64 \"data: 5.0\"" "."
+  # The push, held while it comes: the sim's joint_states then carry the cart's effort, 5 N.
+  if start "sim: push the cart (rostopic pub -r 50)" "rostopic pub -r 50 /cartpole/cart_effort std_msgs/Float64 \"data: 5.0\""; then
+    pusher=$BACKGROUND_PID
+    sleep 2
+    timeout 20 rostopic echo -n 1 /cartpole/joint_states/effort >"$LOGS/pushed.log" 2>&1
+    kill -INT "$pusher" 2>/dev/null
+    check "sim: the pushed cart's joint_states carry effort 5.0" "grep -q '^\\[5.0,' '$LOGS/pushed.log'"
+  fi
   stop_launch "sim.launch ends on Ctrl-C" "$sim" "$sim_log"
 fi
 
