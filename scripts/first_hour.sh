@@ -31,10 +31,12 @@ unset CARTPOLE_WS ROS_HOME ROS_PACKAGE_PATH CMAKE_PREFIX_PATH
 PORT=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI="http://127.0.0.1:$PORT" ROS_HOSTNAME=127.0.0.1 PYTHONUNBUFFERED=1
 BACKGROUND=()
+# Background commands run in process groups of their own (setsid): Ctrl-C goes to the whole
+# group, as a terminal sends it, and nothing they started outlives this script.
 cleanup() {
-  for pid in "${BACKGROUND[@]}"; do kill -INT "$pid" 2>/dev/null; done
-  sleep 1
-  for pid in "${BACKGROUND[@]}"; do kill -KILL "$pid" 2>/dev/null; done
+  for pid in "${BACKGROUND[@]}"; do kill -INT -- "-$pid" 2>/dev/null; done
+  sleep 2
+  for pid in "${BACKGROUND[@]}"; do kill -KILL -- "-$pid" 2>/dev/null; done
   rm -rf "$WORK"
 }
 trap cleanup EXIT
@@ -116,7 +118,7 @@ start() {
     record "$name" 0 "the README no longer says: $command"
     return 1
   fi
-  bash -c "exec $command" >"$log" 2>&1 </dev/null &
+  setsid bash -c "exec $command" >"$log" 2>&1 </dev/null &
   BACKGROUND+=($!)
   BACKGROUND_PID=$!
 }
@@ -125,16 +127,23 @@ start() {
 stop_launch() {
   local name=$1 pid=$2 log=$3
   shift 3
-  kill -INT "$pid" 2>/dev/null
-  local status
+  kill -INT -- "-$pid" 2>/dev/null
+  local status=""
   for _ in $(seq 1 300); do
-    kill -0 "$pid" 2>/dev/null || break
+    if ! kill -0 "$pid" 2>/dev/null; then
+      wait "$pid"
+      status=$?
+      break
+    fi
     sleep 0.1
   done
-  wait "$pid"
-  status=$?
   local failure=""
-  [[ "$status" == 0 ]] || failure="exit status $status after Ctrl-C"
+  if [[ -z "$status" ]]; then
+    kill -KILL -- "-$pid" 2>/dev/null
+    failure="still running 30 s after Ctrl-C"
+  elif [[ "$status" != 0 ]]; then
+    failure="exit status $status after Ctrl-C"
+  fi
   for pattern in "$@"; do
     if [[ -z "$failure" ]] && ! grep -qE -- "$pattern" "$log"; then
       failure="no line matching '$pattern'"
@@ -166,7 +175,7 @@ in_readme "source ~/cartpole_ws/devel/setup.bash" || record "source the workspac
 source "$HOME/cartpole_ws/devel/setup.bash"
 # Debian's python3 for the ROS tools, as the README's advice has it.
 export PATH="/usr/bin:$PATH"
-roscore -p "$PORT" >"$LOGS/roscore.log" 2>&1 &
+setsid roscore -p "$PORT" >"$LOGS/roscore.log" 2>&1 &
 BACKGROUND+=($!)
 wait_for 30 "$LOGS/roscore.log" "started core service" || echo "[first-hour] roscore did not say it started"
 
@@ -175,7 +184,7 @@ run "train.launch" 300 0 "roslaunch cartpole_qlearning train.launch" "SOLVED aft
 cp "$TABLES/q_table.yaml" "$WORK/two_process.yaml" 2>/dev/null
 run "train.launch nodelet:=true" 300 0 "roslaunch cartpole_qlearning train.launch nodelet:=true" "SOLVED after"
 check "nodelets wrote the two-process table, byte for byte" "cmp '$TABLES/q_table.yaml' '$WORK/two_process.yaml'"
-rosrun cartpole_qlearning train_headless --seed 0 --quiet --save "$WORK/headless.yaml" >/dev/null 2>&1
+timeout 120 rosrun cartpole_qlearning train_headless --seed 0 --quiet --save "$WORK/headless.yaml" >/dev/null 2>&1
 check "train_headless --seed 0 wrote the launched table, byte for byte" "cmp '$TABLES/q_table.yaml' '$WORK/headless.yaml'"
 cp "$TABLES/q_table.yaml" "$WORK/solved.yaml"
 
@@ -218,7 +227,7 @@ if start "sim.launch" "roslaunch cartpole_qlearning sim.launch"; then
     pusher=$BACKGROUND_PID
     sleep 2
     timeout 20 rostopic echo -n 1 /cartpole/joint_states/effort >"$LOGS/pushed.log" 2>&1
-    kill -INT "$pusher" 2>/dev/null
+    kill -INT -- "-$pusher" 2>/dev/null
     check "sim: the pushed cart's joint_states carry effort 5.0" "grep -q '^\\[5.0,' '$LOGS/pushed.log'"
   fi
   stop_launch "sim.launch ends on Ctrl-C" "$sim" "$sim_log"

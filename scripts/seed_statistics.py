@@ -53,12 +53,14 @@ def main():
     parser.add_argument("--train-headless", help="the train_headless executable (default: found, see above)")
     args = parser.parse_args()
     trainer = train_headless_command(args.train_headless)
-    # The config beside this script unless told otherwise: no package lookup needed.
+    # Unless told otherwise, the config beside this script in a source tree (no package lookup
+    # needed); elsewhere (an install space) train_headless's own default.
     config = args.config or os.path.join(HERE, "..", "config", "cartpole.yaml")
+    config_args = ["--config", config] if os.path.isfile(config) else []
 
     episodes, walls, unsolved = [], [], []
     for seed in args.seeds:
-        command = trainer + ["--quiet", "--seed", str(seed), "--config", config]
+        command = trainer + ["--quiet", "--seed", str(seed)] + config_args
         if args.max_episodes:
             command += ["--max-episodes", str(args.max_episodes)]
         run = subprocess.run(command, capture_output=True, text=True)

@@ -2,11 +2,14 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <vector>
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -129,7 +132,11 @@ Located locate(Descriptor base, const std::string& base_path, const std::string&
     {
       const int error = errno;
       if (error == ELOOP || error == ENOTDIR)
-        refuse(located.shown + ": " + walked.string() + " " + describeEntry(located.folder.get(), part) + outside);
+      {
+        const std::string what = describeEntry(located.folder.get(), part);
+        refuse(located.shown + ": " + walked.string() + " " + what +
+               (what == "is a symbolic link" ? outside : ", not a folder"));
+      }
       refuse(systemError("cannot open directory", walked.string(), error));
     }
     located.folder = Descriptor(fd);
@@ -145,6 +152,10 @@ std::string readOpenFile(const Descriptor& fd, const std::string& shown, std::ui
     refuse(systemError("cannot read", shown, errno));
   if (!S_ISREG(status.st_mode))
     refuse("cannot read " + shown + ": not a regular file");
+  // Opened non-blocking so that a FIFO could not hang the open; a file reads as usual.
+  const int flags = ::fcntl(fd.get(), F_GETFL);
+  if (flags >= 0)
+    ::fcntl(fd.get(), F_SETFL, flags & ~O_NONBLOCK);
   if (static_cast<std::uint64_t>(status.st_size) > max_bytes)
     refuse(shown + ": " + std::to_string(status.st_size) + " bytes, more than this file may have (" +
            std::to_string(max_bytes) + ")");
@@ -165,6 +176,34 @@ std::string readOpenFile(const Descriptor& fd, const std::string& shown, std::ui
   }
 }
 
+// Temporary files ".<name>.tmp.<pid>.<n>" left by a writer killed mid-save (its pid gone).
+void removeStaleTemporaries(const Descriptor& folder, const std::string& name)
+{
+  const int fd = ::openat(folder.get(), ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0)
+    return;
+  DIR* entries = ::fdopendir(fd);
+  if (entries == nullptr)
+  {
+    ::close(fd);
+    return;
+  }
+  const std::string prefix = "." + name + ".tmp.";
+  std::vector<std::string> stale;
+  while (const dirent* entry = ::readdir(entries))
+  {
+    const std::string file = entry->d_name;
+    if (file.compare(0, prefix.size(), prefix) != 0)
+      continue;
+    const long pid = std::strtol(file.c_str() + prefix.size(), nullptr, 10);
+    if (pid > 0 && pid != ::getpid() && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH)
+      stale.push_back(file);
+  }
+  ::closedir(entries);
+  for (const std::string& file : stale)
+    ::unlinkat(folder.get(), file.c_str(), 0);
+}
+
 // Atomic, durable replacement of `name` in the open folder by `text`.
 void replaceIn(const Descriptor& folder, const std::string& name, const std::string& shown, const std::string& text,
                bool refuse_links)
@@ -178,6 +217,7 @@ void replaceIn(const Descriptor& folder, const std::string& name, const std::str
       refuse("cannot save to " + shown + ": it is a symbolic link (refused: no symbolic links here)");
   }
 
+  removeStaleTemporaries(folder, name);
   // A name of our own beside the target: the pid and a counter keep concurrent writers apart,
   // O_EXCL makes sure nothing already there (a planted link) is opened instead.
   static std::atomic<unsigned> counter{0};
@@ -275,6 +315,18 @@ void writeFileUnder(const std::string& directory, const std::string& path, const
   const std::string base = fs::absolute(directory).lexically_normal().string();
   const Located at = locate(openDirectory(base, true), base, relative, true);
   replaceIn(at.folder, at.name, at.shown, text, true);
+}
+
+bool makeDirectoryUnder(const std::string& directory, const std::string& path)
+{
+  const std::string relative = relativePathUnder(directory, path);
+  const std::string base = fs::absolute(directory).lexically_normal().string();
+  const Located at = locate(openDirectory(base, true), base, relative, true);
+  if (::mkdirat(at.folder.get(), at.name.c_str(), 0755) == 0)
+    return true;
+  if (errno == EEXIST)
+    return false;
+  refuse(systemError("cannot create directory", at.shown, errno));
 }
 
 std::string readFile(const std::string& path, std::uint64_t max_bytes)

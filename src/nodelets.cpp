@@ -8,6 +8,7 @@
 // manager's own queues each message would cross threads (its dispatcher, then a worker), which
 // costs about ten times more than the step itself (bench/run_benchmarks.sh). Timers and
 // services stay on the manager's threads; the node classes lock their state for that.
+#include "cartpole_qlearning/launch_control.h"
 #include "cartpole_qlearning/cartpole_sim_node.h"
 #include "cartpole_qlearning/qlearning_controller_node.h"
 
@@ -88,6 +89,10 @@ private:
     catch (const std::exception& e)
     {
       NODELET_FATAL("cartpole_sim: %s", e.what());
+      // Its loader would respawn into the same error: the launch that started the manager
+      // ends instead (as for the executables).
+      if (endParentLaunch())
+        NODELET_FATAL("cartpole_sim: ending the launch: this cannot work until the above is fixed");
       throw;
     }
   }
@@ -119,6 +124,10 @@ private:
     catch (const std::exception& e)
     {
       NODELET_FATAL("qlearning_controller: %s", e.what());
+      // Its loader would respawn into the same error: the launch that started the manager
+      // ends instead (as for the executables).
+      if (endParentLaunch())
+        NODELET_FATAL("qlearning_controller: ending the launch: this cannot work until the above is fixed");
       throw;
     }
   }

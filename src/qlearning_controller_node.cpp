@@ -13,8 +13,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <ctime>
-#include <filesystem>
 #include <sstream>
+
+#include <unistd.h>
 
 namespace cartpole_qlearning
 {
@@ -171,7 +172,7 @@ QLearningControllerNode::~QLearningControllerNode()
   for (Robot& robot : robots_)
     robot.state_sub.shutdown();
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (learning_ && save_on_shutdown_ && !finished_training_)
+  if (learning_ && save_on_shutdown_ && !final_saved_)
   {
     std::string message;
     checkpoint("", message);
@@ -216,6 +217,7 @@ void QLearningControllerNode::readParameters()
   priv.read("run_id", run_id_);
   // Set by the controller itself (openRun), for a respawn of it to find.
   priv.know("run/id");
+  priv.know("run/launcher");
   priv.know("run/folder");
   priv.read("evaluation_episodes", evaluation_episodes_, 0);
   priv.read("checkpoint_every", checkpoint_every_, 0);
@@ -387,11 +389,15 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
   bool saved_ok = true;
   if (training_finished)
   {
-    saved_ok = checkpoint(s.solved ? "solved" : "max_episodes", saved);
+    // The default table first: a crash between the two saves then leaves a run not yet marked
+    // finished, which a respawn finishes again.
     std::string published;
-    if (saved_ok && s.solved)
-      saved += save("", published) ? "; the default table: " + published : "; BUT NOT the default table: " + published;
-    else if (saved_ok)
+    const bool published_ok = s.solved && save("", published);
+    saved_ok = checkpoint(s.solved ? "solved" : "max_episodes", saved);
+    final_saved_ = saved_ok || published_ok;
+    if (s.solved)
+      saved += published_ok ? "; the default table: " + published : "; BUT NOT the default table: " + published;
+    else
       saved += "; the default table " + resolve("") +
                " is left as it was (this run did not solve: ~save_q_table saves it there if you want it)";
   }
@@ -507,8 +513,14 @@ void QLearningControllerNode::openRun()
   run_.run_id = run_id_;
   run_.name_space = nh_.getNamespace();
   run_.seed = seed_;
+  // A respawn has the run id and the roslaunch (else the parent) of the process that started the
+  // run; a node started by hand on a reused master has at most the id left there.
+  const pid_t roslaunch = launchingRoslaunch();
+  const int launcher = static_cast<int>(roslaunch > 0 ? roslaunch : ::getppid());
   std::string stored_id;
+  int stored_launcher = 0;
   if (!run_id_.empty() && pnh_.getParam("run/id", stored_id) && stored_id == run_id_ &&
+      pnh_.getParam("run/launcher", stored_launcher) && stored_launcher == launcher &&
       pnh_.getParam("run/folder", run_folder_) && !run_folder_.empty())
   {
     resumeRun();
@@ -517,13 +529,26 @@ void QLearningControllerNode::openRun()
   const std::time_t now = std::time(nullptr);
   run_.started = localTimeText(now);
   const std::string name = runFolderName(now, nh_.getNamespace(), seed_);
-  run_folder_ = name;
-  std::error_code ec;
-  for (int n = 2; std::filesystem::exists(std::filesystem::symlink_status(resolve(run_folder_), ec)); ++n)
-    run_folder_ = name + "_" + std::to_string(n);
+  // Made now, so that a folder that cannot be written is said at the start, not at the first
+  // checkpoint; a name taken (another run started in the same second) gets a suffix.
+  try
+  {
+    run_folder_ = name;
+    for (int n = 2; !makeDirectoryUnder(q_table_dir_, run_folder_); ++n)
+      run_folder_ = name + "_" + std::to_string(n);
+    writeFileUnder(q_table_dir_, run_folder_ + "/" + kRunRecordFile, formatRunRecord(run_));
+  }
+  catch (const FileError& e)
+  {
+    ROS_ERROR(
+        "qlearning_controller: cannot make this run's folder (%s): checkpoints will fail; ~save_q_table can "
+        "still save the table elsewhere",
+        e.what());
+  }
   if (!run_id_.empty())
   {
     pnh_.setParam("run/id", run_id_);
+    pnh_.setParam("run/launcher", launcher);
     pnh_.setParam("run/folder", run_folder_);
   }
   ROS_INFO("qlearning_controller: run %s: checkpoints go to %s", run_folder_.c_str(),
@@ -565,10 +590,13 @@ void QLearningControllerNode::resumeRun()
            record_matches ? "" : " (its record was one checkpoint behind: the solved window starts empty)");
   if (!record.finished.empty())
   {
-    finished_training_ = true;
+    // Ended (or killed) after its final save: nothing to train. It stays up rather than exit,
+    // which under respawn would only start it again.
+    finished_training_ = final_saved_ = true;
     ROS_INFO("qlearning_controller: run %s has finished already (%s); nothing left to do", run_folder_.c_str(),
              record.finished.c_str());
-    endWhenFinished();
+    if (shutdown_when_finished_ && endParentLaunch())
+      ROS_INFO("qlearning_controller: ending the launch");
   }
 }
 
@@ -586,7 +614,8 @@ bool QLearningControllerNode::checkpoint(const std::string& finished, std::strin
   }
   catch (const std::exception& e)
   {
-    message += ", but not its run record (a restart would start the run over): " + std::string(e.what());
+    message +=
+        ", but not its run record (a restart would go on from the previous checkpoint): " + std::string(e.what());
     return false;
   }
   return true;

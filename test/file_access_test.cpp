@@ -146,6 +146,21 @@ TEST_F(FileAccessTest, AFifoOrAnOversizedFileIsRefusedWithoutHanging)
   EXPECT_EQ(100u, readFileUnder(tables_, "big.yaml", 100).size());
 }
 
+TEST_F(FileAccessTest, TemporaryFilesOfWritersThatDiedAreRemovedByTheNextSave)
+{
+  // pid_max is at most 2^22 on Linux: no process has pid 999999999. This process is alive.
+  const fs::path dead = dir_ / "tables" / ".q.yaml.tmp.999999999.0";
+  const fs::path alive = dir_ / "tables" / (".q.yaml.tmp." + std::to_string(::getpid() + 0) + ".77");
+  const fs::path other = dir_ / "tables" / ".other.yaml.tmp.999999999.0";
+  write(dead, "left by a kill -9");
+  write(alive, "being written");
+  write(other, "another file's");
+  writeFileUnder(tables_, "q.yaml", "new");
+  EXPECT_FALSE(fs::exists(dead));
+  EXPECT_TRUE(fs::exists(alive));
+  EXPECT_TRUE(fs::exists(other));
+}
+
 TEST_F(FileAccessTest, AProcessKilledMidSaveLeavesTheOldFileOrTheNewOneWhole)
 {
   // Large versions, so that a kill at a random moment mostly lands inside a write or an fsync.

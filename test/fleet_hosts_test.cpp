@@ -21,9 +21,9 @@
 using cartpole_qlearning::EpisodeStats;
 using cartpole_qlearning::EpisodeStatsConstPtr;
 using cartpole_qlearning::test::spinUntil;
-using cartpole_qlearning::test::uriOf;
 using cartpole_qlearning::test::startProcess;
 using cartpole_qlearning::test::stopProcess;
+using cartpole_qlearning::test::uriOf;
 
 namespace
 {

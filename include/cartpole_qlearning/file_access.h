@@ -44,6 +44,10 @@ std::string readFileUnder(const std::string& directory, const std::string& path,
 // missing folders on the way (never through a symbolic link). Throws FileError.
 void writeFileUnder(const std::string& directory, const std::string& path, const std::string& text);
 
+// Makes the folder `path` below the directory (and the folders on the way, never through a
+// link); false when something of that name exists already. Throws FileError.
+bool makeDirectoryUnder(const std::string& directory, const std::string& path);
+
 // The same for a path of the caller's own (a command-line argument): links are followed as the
 // shell would. Throws FileError.
 std::string readFile(const std::string& path, std::uint64_t max_bytes = kMaxFileBytes);

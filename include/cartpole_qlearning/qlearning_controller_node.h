@@ -139,6 +139,7 @@ private:
   std::vector<Robot> robots_;
   std::unique_ptr<RobotRounds> rounds_;
   bool finished_training_ = false;
+  bool final_saved_ = false;  // training ended and its table is saved (else Ctrl-C saves it)
 
   // Wall-clock bookkeeping for steps/s.
   std::chrono::steady_clock::time_point started_;
