@@ -50,6 +50,12 @@ protected:
         boost::function<void(const cartpole_qlearning::EpisodeStatsConstPtr&)>(
             [](const cartpole_qlearning::EpisodeStatsConstPtr& m) { stats_.push_back(*m); }));
   }
+  // Released while roscpp is up: a ros::Subscriber destroyed among the static objects at exit
+  // reads roscpp's strings after they were freed (ASan: heap-use-after-free).
+  static void TearDownTestSuite()
+  {
+    sub_ = ros::Subscriber();
+  }
 };
 std::vector<EpisodeStats> ControllerTrainTest::stats_;
 ros::Subscriber ControllerTrainTest::sub_;
