@@ -486,6 +486,9 @@ protected:
   static void TearDownTestSuite()
   {
     spinner_->stop();
+    // Released while roscpp is up: destroyed among the statics at exit, the spinner's
+    // NodeHandle unregisters through roscpp's already freed strings (ASan: heap-use-after-free).
+    spinner_.reset();
     subs_.clear();
     states_pub_.shutdown();
     command_pub_.shutdown();
