@@ -1,28 +1,134 @@
 #!/usr/bin/env bash
-# Builds the core's unit tests (the core_tests of CMakeLists.txt: everything that needs no ROS)
-# with clang-14, AddressSanitizer and UndefinedBehaviorSanitizer, and runs them: any sanitizer
-# report fails the run. Debian: clang-14 libclang-rt-14-dev libgtest-dev libyaml-cpp-dev
-# libeigen3-dev (scripts/setup.sh installs them).
+# Builds the whole package and every test (nodes, nodelet library, train_headless, gtests and
+# rostests) with clang-14's AddressSanitizer (with LeakSanitizer) and UndefinedBehaviorSanitizer
+# in a build and devel space of their own beside the plain ones ($WS/build_sanitize,
+# $WS/devel_sanitize), and runs the gtests and rostests there. Any sanitizer report, in a test or
+# in a node that roslaunch started, fails the run.
 #
-# usage: bash scripts/sanitize.sh [RESULTS_DIR]   (RESULTS_DIR: the gtest JUnit file goes there)
+# usage: bash scripts/sanitize.sh [RESULTS_DIR]
+#   The workspace is the one scripts/setup.sh chose (CARTPOLE_WS, or the one this clone is in);
+#   run scripts/setup.sh once first. RESULTS_DIR (default $WS/build_sanitize/sanitized_results)
+#   gets the JUnit files, each named sanitized-*.xml, and sanitized-reports.xml: one test case
+#   per sanitizer report file written (failed), or one passed case when none was.
+# Exit status: 0 when the tests could be built and run (the JUnit files say what failed), 2 when
+# the workspace or compiler is missing, another non-zero one when the build failed. Debian: clang-14
+# libclang-rt-14-dev (scripts/setup.sh installs them).
+#
+# clang rather than gcc: with gcc's separate libubsan, UBSan ignores log_path and its reports
+# would only reach stderr; gcc 12 also warns (-Werror) inside libstdc++ with the sanitizers.
+# clang builds against Debian's ROS libraries (libstdc++) as they are.
+#
+# A process that aborts from a sanitizer report fails its test only if the test notices (a node
+# under roslaunch that dies may not); so every process writes its reports to files under
+# $WS/build_sanitize/sanitizer_logs (log_path) and each such file is a failed test case here.
+# Reports that are not the project's are suppressed in test/sanitizer/asan.supp (a nodelet
+# bug) and test/sanitizer/lsan.supp (leaks; none so far), each with its reason. The Python nodes (rostest's hztest) are not
+# instrumented. nodelet's own executable (the manager that loads the instrumented nodelet
+# library) is not instrumented either: the sanitized devel space gets a lib/nodelet/nodelet of
+# its own, found by roslaunch before Debian's, that starts Debian's with the ASan runtime
+# preloaded. The instrumented executables need nothing preloaded.
 set -euo pipefail
 RESULTS=${1:-}
 SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-CXX=${SANITIZE_CXX:-clang++-14}
+if [ -z "${CARTPOLE_WS:-}" ] && [ "$(basename "$(dirname "$SRC")")" = src ]; then
+  CARTPOLE_WS="$(dirname "$(dirname "$SRC")")"
+fi
+WS=${CARTPOLE_WS:-$HOME/cartpole_ws}
+[ -e "$WS/src/cartpole_qlearning" ] || { echo "sanitize.sh: no workspace at $WS (run scripts/setup.sh first)" >&2; exit 2; }
+export CC=clang-14 CXX=clang++-14
 command -v "$CXX" >/dev/null || { echo "sanitize.sh: $CXX not found (Debian: clang-14 libclang-rt-14-dev)" >&2; exit 2; }
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/cartpole_sanitize.XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
+BUILD="$WS/build_sanitize"
+DEVEL="$WS/devel_sanitize"
+LOGS="$BUILD/sanitizer_logs"
+RESULTS=${RESULTS:-$BUILD/sanitized_results}
+export PATH="/usr/bin:$PATH"
 
-# The sources as CMakeLists.txt lists them for the core library and for core_tests.
-list() { sed -n "/^ *$1/,/)/p" "$SRC/CMakeLists.txt" | grep -o "$2/[a-z_]*\.cpp"; }
-mapfile -t CORE < <(list 'add_library(${PROJECT_NAME}_core' src)
-mapfile -t TESTS < <(list 'catkin_add_gtest(core_tests' test)
-echo "[sanitize] building core_tests (${#CORE[@]} core sources, ${#TESTS[@]} test files) with ASan + UBSan"
-"$CXX" -std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all \
-  -I "$SRC/include" -isystem /usr/include/eigen3 -DCARTPOLE_CONFIG_DIR="\"$SRC/config\"" \
-  "${CORE[@]/#/$SRC/}" "${TESTS[@]/#/$SRC/}" -lgtest -lyaml-cpp -pthread -o "$WORK/core_tests"
-output=()
-[[ -n "$RESULTS" ]] && mkdir -p "$RESULTS" && output=(--gtest_output="xml:$RESULTS/sanitized-core_tests.xml")
-echo "[sanitize] running core_tests under ASan + UBSan"
-ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  "$WORK/core_tests" "${output[@]}" --gtest_brief=1
+# Not the plain devel space: drop it from the paths (setup.sh may have sourced it), so that the
+# sanitized devel space chains to the system (or a sourced /opt/ros) only and roslaunch finds
+# the sanitized executables.
+strip_plain() { # VAR: removes the entries under $WS/devel from the :-separated variable VAR
+  local kept=() entry
+  IFS=: read -ra entries <<<"${!1:-}"
+  for entry in "${entries[@]}"; do
+    case "$entry" in "$WS/devel" | "$WS/devel/"*) ;; "") ;; *) kept+=("$entry") ;; esac
+  done
+  local IFS=:
+  export "$1=${kept[*]}"
+}
+for var in CMAKE_PREFIX_PATH LD_LIBRARY_PATH PKG_CONFIG_PATH PYTHONPATH; do strip_plain "$var"; done
+
+FLAGS="-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
+ARGS=(--build "$BUILD" -DCATKIN_DEVEL_PREFIX="$DEVEL" -DCMAKE_BUILD_TYPE=Sanitize "-DCMAKE_CXX_FLAGS=$FLAGS"
+  -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE)
+[ -x /usr/bin/python3 ] && ARGS+=(-DPYTHON_EXECUTABLE=/usr/bin/python3)
+cd "$WS"
+echo "[sanitize] building the nodes, the nodelet library and every test with ASan + UBSan ($CXX) in $BUILD"
+SECONDS=0
+catkin_make "${ARGS[@]}" cartpole_sim qlearning_controller cartpole_qlearning_nodelets train_headless tests
+echo "[sanitize] built in $SECONDS s"
+
+set +u
+# shellcheck disable=SC1091
+source "$DEVEL/setup.bash"
+set -u
+case ":$CMAKE_PREFIX_PATH:" in *":$WS/devel:"*) echo "sanitize.sh: $WS/devel still on CMAKE_PREFIX_PATH" >&2; exit 2 ;; esac
+# nodelet's manager with the ASan runtime preloaded, for the instrumented nodelet library. (The
+# loaders, the same executable, get it too, harmlessly.)
+wrapper="$DEVEL/lib/nodelet/nodelet"
+rm -rf "$DEVEL/lib/nodelet"  # (an empty folder there would hide Debian's from the search too)
+nodelet=$(python3 -c "import roslib.packages as p; print(p.find_node('nodelet', 'nodelet')[0])")
+runtime=$("$CXX" -print-file-name=libclang_rt.asan-x86_64.so)
+[ -f "$runtime" ] || { echo "sanitize.sh: no $runtime (Debian: libclang-rt-14-dev)" >&2; exit 2; }
+mkdir -p "$(dirname "$wrapper")"
+# shellcheck disable=SC2016 # $LD_PRELOAD and $@ are the wrapper's
+printf '#!/bin/sh\n# scripts/sanitize.sh: %s with the ASan runtime preloaded\nexport LD_PRELOAD=%s${LD_PRELOAD:+:$LD_PRELOAD}\nexec %s "$@"\n' \
+  "$nodelet" "$runtime" "$nodelet" >"$wrapper"
+chmod +x "$wrapper"
+[ "$(python3 -c "import roslib.packages as p; print(p.find_node('nodelet', 'nodelet')[0])")" = "$wrapper" ] ||
+  { echo "sanitize.sh: roslaunch would not start $wrapper" >&2; exit 2; }
+
+rm -rf "$LOGS" "$BUILD/test_results/cartpole_qlearning"
+mkdir -p "$LOGS" "$RESULTS"
+rm -f "$RESULTS"/sanitized-*.xml
+# Reports go to files named after the process: $LOGS/report.<executable>.<pid>.
+common="log_path=$LOGS/report:log_exe_name=1"
+export ASAN_OPTIONS="detect_leaks=1:detect_stack_use_after_return=1:check_initialization_order=1:suppressions=$SRC/test/sanitizer/asan.supp:$common"
+export LSAN_OPTIONS="suppressions=$SRC/test/sanitizer/lsan.supp:print_suppressions=0:$common"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:$common"
+# Not run here: FileAccessTest.AProcessKilledMidSave... needs more than a third of its random
+# kills to land inside a save's write or fsync; with ASan each 8 MiB version is a fresh mmap and
+# building it takes longer than saving it, so the kills land between saves (1 of 12 instead of
+# more than 4). What it checks is not memory safety; the plain run keeps it.
+export GTEST_FILTER="-FileAccessTest.AProcessKilledMidSaveLeavesTheOldFileOrTheNewOneWhole"
+echo "[sanitize] running the gtests and rostests under ASan + UBSan; reports go to $LOGS"
+# The gtests and rostests; not the launch file checks (Python only: nothing instrumented runs).
+SECONDS=0
+catkin_make "${ARGS[@]}" run_tests_cartpole_qlearning_gtest run_tests_cartpole_qlearning_rostest || true
+echo "[sanitize] ran in $SECONDS s"
+unset ASAN_OPTIONS LSAN_OPTIONS UBSAN_OPTIONS GTEST_FILTER
+
+# The results, named sanitized-* so that a reader tells them from the plain ones.
+for f in "$BUILD/test_results/cartpole_qlearning"/*.xml; do
+  [ -e "$f" ] && cp "$f" "$RESULTS/sanitized-$(basename "$f")"
+done
+# Every report file written is a failed test case, named after its file.
+reports="$RESULTS/sanitized-reports.xml"
+mapfile -t logs < <(find "$LOGS" -type f | sort)
+{
+  echo '<?xml version="1.0" encoding="UTF-8"?>'
+  echo "<testsuite name=\"sanitizer_reports\" tests=\"$((${#logs[@]} > 0 ? ${#logs[@]} : 1))\" failures=\"${#logs[@]}\" errors=\"0\">"
+  if [ "${#logs[@]}" -eq 0 ]; then
+    echo '  <testcase classname="sanitizer_reports" name="no_sanitizer_report"/>'
+  fi
+  for log in "${logs[@]}"; do
+    what=$(grep -m1 -oE '(ERROR|SUMMARY): [A-Za-z]+Sanitizer: [^(]*|runtime error: .*' "$log" | head -c 200 |
+      sed 's/&/\&amp;/g; s/</\&lt;/g; s/>/\&gt;/g; s/"/\&quot;/g' || true)
+    echo "  <testcase classname=\"sanitizer_reports\" name=\"$(basename "$log")\"><failure message=\"$log: ${what:-a sanitizer report}\"/></testcase>"
+  done
+  echo '</testsuite>'
+} >"$reports"
+for log in "${logs[@]:0:5}"; do
+  echo "[sanitize] report $log:"
+  head -n 25 "$log"
+done
+echo "[sanitize] ${#logs[@]} sanitizer report file(s); results in $RESULTS"
