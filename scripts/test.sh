@@ -54,7 +54,7 @@ fi
 if [ "${FIRST_HOUR:-1}" != 0 ]; then
   echo "[test] the README's commands in a fresh home (scripts/first_hour.sh, about 6 to 10 minutes); log in $CARTPOLE_WS/first_hour.log"
   bash "$CARTPOLE_SRC/scripts/first_hour.sh" build/test_results/cartpole_qlearning >"$CARTPOLE_WS/first_hour.log" 2>&1 || true
-  grep -E "^\[first-hour\] (+[0-9.]+ s|[0-9]+ passed)" "$CARTPOLE_WS/first_hour.log" | grep -E "FAIL|passed" || true
+  grep -E "^\[first-hour\] +([0-9.]+ s|[0-9]+ passed)" "$CARTPOLE_WS/first_hour.log" | grep -E "FAIL|passed" || true
   if [ ! -s build/test_results/cartpole_qlearning/first_hour.xml ]; then
     tail -n 30 "$CARTPOLE_WS/first_hour.log"
     cat >build/test_results/cartpole_qlearning/first_hour-aborted.xml <<XML

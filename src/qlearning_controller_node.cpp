@@ -530,13 +530,15 @@ void QLearningControllerNode::openRun()
   run_.started = localTimeText(now);
   const std::string name = runFolderName(now, nh_.getNamespace(), seed_);
   // Made now, so that a folder that cannot be written is said at the start, not at the first
-  // checkpoint; a name taken (another run started in the same second) gets a suffix.
+  // checkpoint; a name taken (another run started in the same second) gets a suffix. A node told
+  // to write nothing along the way (no checkpoints, no save on shutdown) writes nothing yet.
+  run_folder_ = name;
   try
   {
-    run_folder_ = name;
-    for (int n = 2; !makeDirectoryUnder(q_table_dir_, run_folder_); ++n)
+    for (int n = 2; (checkpoint_every_ > 0 || save_on_shutdown_) && !makeDirectoryUnder(q_table_dir_, run_folder_); ++n)
       run_folder_ = name + "_" + std::to_string(n);
-    writeFileUnder(q_table_dir_, run_folder_ + "/" + kRunRecordFile, formatRunRecord(run_));
+    if (checkpoint_every_ > 0 || save_on_shutdown_)
+      writeFileUnder(q_table_dir_, run_folder_ + "/" + kRunRecordFile, formatRunRecord(run_));
   }
   catch (const FileError& e)
   {
