@@ -55,8 +55,10 @@ public:
     std::istringstream in(text);
     std::string line;
     TracedTable* table = nullptr;
+    static const std::regex colour("\x1b\\[[0-9;]*m");  // rosconsole's, around each message
     while (std::getline(in, line))
     {
+      line = std::regex_replace(line, colour, "");
       std::smatch m;
       if (table != nullptr && readRow(line, *table))
         continue;
