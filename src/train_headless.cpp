@@ -20,7 +20,7 @@ void usage(std::ostream& out)
 {
   out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--save PATH] [--ns NS] [--max-episodes N] "
          "[--quiet]\n"
-         "                     [--trace] [--replay FILE]\n"
+         "                      [--trace] [--replay FILE]\n"
          "  --config FILE     physics, task, learning and training parameters (YAML);\n"
          "                    default: the package's config/cartpole.yaml\n"
          "  --seed N          seed of the start states and of exploration (default 0)\n"
