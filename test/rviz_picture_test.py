@@ -10,6 +10,7 @@ import os
 import sys
 import tempfile
 import unittest
+import xml.etree.ElementTree as ElementTree
 from importlib.machinery import SourceFileLoader
 from importlib.util import module_from_spec, spec_from_loader
 
@@ -18,15 +19,15 @@ import rostest
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def load_screenshot_module():
-    path = os.path.join(PACKAGE_DIR, "scripts", "rviz_screenshot")
-    loader = SourceFileLoader("rviz_screenshot", path)
-    module = module_from_spec(spec_from_loader("rviz_screenshot", loader))
+def load_script(name):
+    loader = SourceFileLoader(name, os.path.join(PACKAGE_DIR, "scripts", name))
+    module = module_from_spec(spec_from_loader(name, loader))
     loader.exec_module(module)
     return module
 
 
-screenshot = load_screenshot_module()
+screenshot = load_script("rviz_screenshot")
+rviz_robots = load_script("rviz_robots")
 
 THETA = 0.2
 # RViz needs several seconds to start under software OpenGL on a loaded machine; the picture is
@@ -42,7 +43,8 @@ class RvizPictureTest(unittest.TestCase):
         cls.urdf = os.path.join(PACKAGE_DIR, "urdf", "cartpole.urdf")
         states = [(0.0, theta, os.path.join(cls.work, "theta_%+.1f.png" % theta)) for theta in (THETA, -THETA)]
         results = screenshot.take(states, TIMEOUT_S, lambda text: print(text, flush=True))
-        cls.pictures = {theta: (complete, measured, out) for (_, theta, out), (complete, measured) in zip(states, results)}
+        cls.pictures = {theta: (complete, measured, out)
+                        for (_, theta, out), (complete, measured) in zip(states, results)}
 
     def check(self, theta):
         complete, measured, out = self.pictures[theta]
@@ -67,6 +69,23 @@ class RvizPictureTest(unittest.TestCase):
 
     def test_negative_theta_leans_as_the_geometry_says(self):
         self.check(-THETA)
+
+    # train.launch robots:=N rviz:=true: RViz on scripts/rviz_robots' config (not pictured here).
+    def test_several_robots_get_a_model_each_on_their_prefixed_frames(self):
+        displays = rviz_robots.robots_config(self.config, 3)["Visualization Manager"]["Displays"]
+        models = [d for d in displays if d["Class"] == "rviz/RobotModel"]
+        self.assertEqual([(d["Name"], d["TF Prefix"], d["Robot Description"], d["Enabled"]) for d in models],
+                         [("robot_%d" % i, "robot_%d" % i, rviz_robots.DESCRIPTION, True) for i in range(3)])
+        others = [d["Class"] for d in displays if d["Class"] != "rviz/RobotModel"]
+        self.assertEqual(others, [d["Class"] for d in self.config["Visualization Manager"]["Displays"]
+                                  if d["Class"] != "rviz/RobotModel"])
+
+    def test_the_robots_model_has_no_unprefixed_world_link(self):
+        with open(self.urdf) as f:
+            robot = ElementTree.fromstring(rviz_robots.robot_urdf(f.read()))
+        self.assertEqual(sorted(l.get("name") for l in robot.findall("link")), ["cart", "pole"])
+        self.assertEqual([(j.get("name"), j.find("parent").get("link")) for j in robot.findall("joint")],
+                         [("pole_joint", "cart")])
 
 
 if __name__ == "__main__":
