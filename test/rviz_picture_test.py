@@ -8,12 +8,12 @@ axis flipped, or a camera looking from behind all fail here."""
 import math
 import os
 import sys
-import tempfile
 import unittest
 import xml.etree.ElementTree as ElementTree
 from importlib.machinery import SourceFileLoader
 from importlib.util import module_from_spec, spec_from_loader
 
+import rospkg
 import rostest
 
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -32,13 +32,15 @@ rviz_robots = load_script("rviz_robots")
 THETA = 0.2
 # RViz needs several seconds to start under software OpenGL on a loaded machine; the picture is
 # taken as soon as it is drawn, this only bounds a broken run.
-TIMEOUT_S = 25.0
+TIMEOUT_S = 40.0
 
 
 class RvizPictureTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.work = tempfile.mkdtemp(prefix="rviz_picture_test.")
+        # The pictures stay to be looked at, in one folder rewritten at each run.
+        cls.work = os.path.join(rospkg.get_ros_home(), "rviz_picture_test")
+        os.makedirs(cls.work, exist_ok=True)
         cls.config = screenshot.read_rviz_config(os.path.join(PACKAGE_DIR, "rviz", "cartpole.rviz"))
         cls.urdf = os.path.join(PACKAGE_DIR, "urdf", "cartpole.urdf")
         states = [(0.0, theta, os.path.join(cls.work, "theta_%+.1f.png" % theta)) for theta in (THETA, -THETA)]
