@@ -1,5 +1,6 @@
 // train_headless: trains with the core alone (no ROS master), prints progress and ends with
 // one line "solved=true|false episodes=N steps=M wall_s=T".
+#include "cartpole_qlearning/episode_csv.h"
 #include "cartpole_qlearning/headless_trainer.h"
 #include "cartpole_qlearning/q_table_file.h"
 
@@ -9,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <string>
 
 namespace
@@ -16,7 +18,7 @@ namespace
 void usage(std::ostream& out)
 {
   out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--save PATH] [--ns NS] [--max-episodes N] "
-         "[--quiet]\n"
+         "[--stats-csv FILE] [--quiet]\n"
          "  --config FILE     physics, task, learning and training parameters (YAML);\n"
          "                    default: the package's config/cartpole.yaml\n"
          "  --seed N          seed of the start states and of exploration (default 0)\n"
@@ -27,6 +29,9 @@ void usage(std::ostream& out)
          "                    evaluate.launch q_table:=PATH finds it; without --save nothing is written\n"
          "  --ns NS           the namespace whose table folder --save uses (default cartpole)\n"
          "  --max-episodes N  override training/max_episodes\n"
+         "  --stats-csv FILE  write one CSV row per episode there as it ends (the learning curve, for\n"
+         "                    rosrun cartpole_qlearning plot_learning_curve FILE); FILE is taken as given\n"
+         "                    (relative to the current directory) and replaced if it exists\n"
          "  --quiet           no progress lines, only the result line\n";
 }
 
@@ -57,6 +62,7 @@ int run(int argc, char** argv)
   using namespace cartpole_qlearning;
   std::string config_path;
   std::string save_path;
+  std::string stats_csv_path;
   std::string name_space = "/cartpole";
   std::uint64_t seed = 0;
   std::uint64_t max_episodes = 0;
@@ -77,6 +83,8 @@ int run(int argc, char** argv)
       config_path = argv[++i];
     else if (arg == "--save" && has_value)
       save_path = argv[++i];
+    else if (arg == "--stats-csv" && has_value)
+      stats_csv_path = argv[++i];
     else if (arg == "--ns" && has_value)
     {
       name_space = argv[++i];
@@ -147,12 +155,34 @@ int run(int argc, char** argv)
   if (max_episodes > 0)
     config.limits.max_episodes = max_episodes;
 
+  // Opened before training, so that a path that cannot be written is said at once.
+  std::unique_ptr<EpisodeCsvWriter> stats_csv;
+  if (!stats_csv_path.empty())
+  {
+    try
+    {
+      stats_csv = std::make_unique<EpisodeCsvWriter>(AppendingFile::open(stats_csv_path));
+    }
+    catch (const FileError& e)
+    {
+      std::cerr << "train_headless: --stats-csv: " << e.what() << "\n";
+      return 2;
+    }
+  }
+
   HeadlessTrainer trainer(config, seed, robots);
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t every = quiet ? 0 : config.limits.progress_every;
   std::uint64_t last_steps = 0;
   auto last_time = start;
   const TrainingResult result = trainer.run([&](const EpisodeSummary& s) {
+    if (stats_csv)
+    {
+      // The robots' names as train.launch robots:=N gives them.
+      const std::string robot = robots > 1 ? "robot_" + std::to_string(s.robot) : "";
+      const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+      stats_csv->write(s, robot, now);
+    }
     if (every == 0 || (s.episode % every != 0 && !config.limits.reached(s.episode, s.solved)))
       return;
     const auto now = std::chrono::steady_clock::now();
