@@ -25,6 +25,7 @@ DEBIAN_PACKAGES=(
   libros-rosgraph-msgs-dev libtf2-ros-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev libeigen3-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev catkin-lint rviz
   clang-14 libclang-rt-14-dev
+  python3-matplotlib python3-numpy python3-rosbag python3-rospy python3-genpy
 )
 
 install_dependencies() {
