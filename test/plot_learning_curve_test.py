@@ -220,6 +220,12 @@ class CsvToPngTest(PictureTest):
         self.assertIn("300 episodes, solved at episode 270", result.stdout)
         self.assert_rising_curve(self.path("curve.png"), solved_at=270, last=300)
 
+    def test_a_row_being_written_is_left_out(self):
+        # A live run's file may end in the middle of a row: the whole rows are drawn.
+        csv = self.write("live.csv", csv_text(synthetic_episodes(300, solved_from=270)) + "301,,4")
+        result = self.draw([csv, "-o", self.path("live.png")])
+        self.assertIn("300 episodes, solved at episode 270", result.stdout)
+
     def test_an_unsolved_run_has_no_solved_mark_and_the_png_goes_beside_the_csv(self):
         csv = self.write("unsolved.csv", csv_text(synthetic_episodes(150)))
         self.draw([csv])
