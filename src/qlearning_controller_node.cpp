@@ -603,14 +603,24 @@ void QLearningControllerNode::startStatsCsv()
       stats_csv_pending_ = true;
       return;
     }
-    stats_csv_pending_ = false;
     try
     {
+      if (stats_csv_pending_)
+      {
+        // Its folder is made now, under a name no other run has taken (as openRun does).
+        const std::string name = run_folder_;
+        for (int n = 2; !makeDirectoryUnder(q_table_dir_, run_folder_); ++n)
+          run_folder_ = name + "_" + std::to_string(n);
+        if (!run_id_.empty())
+          pnh_.setParam("run/folder", run_folder_);
+      }
+      stats_csv_pending_ = false;
       stats_file_ =
           std::make_unique<AppendingFile>(AppendingFile::openUnder(q_table_dir_, run_folder_ + "/" + kRunEpisodesFile));
     }
     catch (const FileError& e)
     {
+      stats_csv_pending_ = false;
       ROS_ERROR("qlearning_controller: no learning curve for this run (~stats_csv none silences this): %s", e.what());
       return;
     }
