@@ -113,8 +113,10 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   {
     ROS_WARN("qlearning_controller: evaluating a table of zeros (set ~load_on_start to a trained table)");
   }
+  openStatsFile();
   if (learning_)
     openRun();
+  startStatsCsv();
 
   started_ = last_episode_end_ = last_progress_ = std::chrono::steady_clock::now();
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
@@ -223,6 +225,18 @@ void QLearningControllerNode::readParameters()
     priv.fail("q_table_path", "'" + q_table_path_ + "'", e.what());
   }
   priv.read("load_on_start", load_on_start_);
+  priv.read("stats_csv", stats_csv_);
+  if (stats_csv_ != "none" && !stats_csv_.empty() && stats_csv_.front() != '/')
+  {
+    try
+    {
+      relativePathUnder(q_table_dir_, stats_csv_);
+    }
+    catch (const FileError& e)
+    {
+      priv.fail("stats_csv", "'" + stats_csv_ + "'", e.what());
+    }
+  }
   priv.read("run_id", run_id_);
   // Set by the controller itself (openRun), for a respawn of it to find.
   priv.know("run/id");
@@ -388,6 +402,8 @@ void QLearningControllerNode::report(const Robot& robot, const Reaction& reactio
 void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, bool training_finished)
 {
   const EpisodeSummary& s = session_->lastEpisode();
+  // Before any checkpoint: a row is never missing from a run that a respawn resumes from there.
+  writeStatsRow(robot, s);
   const double wall = secondsSince(last_episode_end_);
   const double robot_wall = secondsSince(robot.last_episode_end);
   last_episode_end_ = robot.last_episode_end = std::chrono::steady_clock::now();
@@ -575,8 +591,101 @@ void QLearningControllerNode::openRun()
            resolve(run_folder_ + "/" + kRunTableFile).c_str());
 }
 
+void QLearningControllerNode::openStatsFile()
+{
+  if (stats_csv_ == "none" || stats_csv_.empty())
+    return;
+  try
+  {
+    stats_file_ =
+        std::make_unique<AppendingFile>(stats_csv_.front() == '/' ? AppendingFile::open(stats_csv_)
+                                                                  : AppendingFile::openUnder(q_table_dir_, stats_csv_));
+  }
+  catch (const FileError& e)
+  {
+    refuseParameter(pnh_, "stats_csv", "'" + stats_csv_ + "'", e.what());
+  }
+}
+
+void QLearningControllerNode::startStatsCsv()
+{
+  if (stats_csv_ == "none" || (stats_csv_.empty() && !learning_))
+    return;
+  if (!stats_file_)
+  {
+    // The run's own file: beside its checkpoints, made with its folder. A node told to write
+    // nothing along the way (no checkpoints, no save on shutdown) makes that folder only when
+    // there is something to write: here, at the first episode's end.
+    if (!(checkpoint_every_ > 0 || save_on_shutdown_) && !resumed_run_ && !stats_csv_pending_)
+    {
+      stats_csv_pending_ = true;
+      return;
+    }
+    try
+    {
+      if (stats_csv_pending_)
+      {
+        // Its folder is made now, under a name no other run has taken (as openRun does).
+        const std::string name = run_folder_;
+        for (int n = 2; !makeDirectoryUnder(q_table_dir_, run_folder_); ++n)
+          run_folder_ = name + "_" + std::to_string(n);
+        if (!run_id_.empty())
+          pnh_.setParam("run/folder", run_folder_);
+      }
+      stats_csv_pending_ = false;
+      stats_file_ =
+          std::make_unique<AppendingFile>(AppendingFile::openUnder(q_table_dir_, run_folder_ + "/" + kRunEpisodesFile));
+    }
+    catch (const FileError& e)
+    {
+      stats_csv_pending_ = false;
+      ROS_ERROR("qlearning_controller: no learning curve for this run (~stats_csv none silences this): %s", e.what());
+      return;
+    }
+  }
+  try
+  {
+    // A respawn goes on with its run's curve from the checkpoint it resumed (a run that starts
+    // over keeps the header alone); anything else starts the curve afresh.
+    stats_csv_writer_ = resumed_run_
+                            ? std::make_unique<EpisodeCsvWriter>(std::move(*stats_file_), session_->episodesEnded())
+                            : std::make_unique<EpisodeCsvWriter>(std::move(*stats_file_));
+  }
+  catch (const FileError& e)
+  {
+    stats_file_.reset();
+    if (!stats_csv_.empty())
+      refuseParameter(pnh_, "stats_csv", "'" + stats_csv_ + "'", e.what());
+    ROS_ERROR("qlearning_controller: no learning curve for this run (~stats_csv none silences this): %s", e.what());
+    return;
+  }
+  stats_file_.reset();
+  ROS_INFO(
+      "qlearning_controller: one row per episode goes to %s (rosrun cartpole_qlearning plot_learning_curve "
+      "--follow %s)",
+      stats_csv_writer_->path().c_str(), stats_csv_writer_->path().c_str());
+}
+
+void QLearningControllerNode::writeStatsRow(const Robot& robot, const EpisodeSummary& summary)
+{
+  if (stats_csv_pending_)
+    startStatsCsv();
+  if (!stats_csv_writer_)
+    return;
+  try
+  {
+    stats_csv_writer_->write(summary, robot.name, ros::WallTime::now().toSec());
+  }
+  catch (const FileError& e)
+  {
+    ROS_ERROR("qlearning_controller: the learning curve stops here: %s", e.what());
+    stats_csv_writer_.reset();
+  }
+}
+
 void QLearningControllerNode::resumeRun()
 {
+  resumed_run_ = true;
   const std::string table_path = run_folder_ + "/" + kRunTableFile;
   RunRecord record;
   QTable table;

@@ -85,7 +85,32 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
   ASSERT_EQ(0, std::system(command.c_str())) << command;
   EXPECT_EQ(fileText(headless), fileText(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
 
-  // 3. A fresh controller in evaluate mode loads the table and balances a full 500-step episode.
+  // 3. The run's learning curve: episodes.csv beside its checkpoint, a header and one row per
+  //    episode, each the episode_stats message of that episode.
+  std::vector<fs::path> runs;
+  for (const auto& entry : fs::directory_iterator(qTableDir() + "/runs"))
+    runs.push_back(entry.path());
+  ASSERT_EQ(1u, runs.size());
+  std::istringstream csv(fileText((runs.front() / "episodes.csv").string()));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line)) << "no episodes.csv in " << runs.front();
+  EXPECT_EQ(0u, line.find("episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,"));
+  std::vector<std::string> rows;
+  while (std::getline(csv, line))
+    rows.push_back(line);
+  ASSERT_EQ(solved.episode, rows.size()) << "one row per episode";
+  for (const EpisodeStats& m : stats_)
+  {
+    std::ostringstream expected;
+    expected << m.episode << ",," << m.steps << "," << m.steps << ",";
+    EXPECT_EQ(0u, rows.at(m.episode - 1).find(expected.str())) << rows.at(m.episode - 1);
+  }
+  const auto flag = [](bool value) { return std::string(value ? "true" : "false"); };
+  EXPECT_NE(std::string::npos, rows.back().find("," + flag(solved.terminated) + "," + flag(solved.truncated) +
+                                                ",true," + std::to_string(solved.total_steps) + ","))
+      << "the last row is not the solved episode: " << rows.back();
+
+  // 4. A fresh controller in evaluate mode loads the table and balances a full 500-step episode.
   const std::size_t before = stats_.size();
   const pid_t pid = ::fork();
   ASSERT_GE(pid, 0);

@@ -11,6 +11,7 @@
 #include "cartpole_qlearning/LoadQTable.h"
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/episode_csv.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
 #include "cartpole_qlearning/robot_rounds.h"
 #include "cartpole_qlearning/training_run.h"
@@ -74,6 +75,12 @@ private:
   // controller that started it (the same ~run_id).
   void openRun();
   void resumeRun();
+  // ~stats_csv: the file a user named is opened before the run starts (a bad one stops the node
+  // naming the parameter); the curve itself starts once the run is known (fresh, or going on
+  // from the checkpoint a respawn resumed).
+  void openStatsFile();
+  void startStatsCsv();
+  void writeStatsRow(const Robot& robot, const EpisodeSummary& summary);
   // Saves the table and the run record into the run's folder; returns the message to log.
   bool checkpoint(const std::string& finished, std::string& message);
   // Puts a loaded table in place (checked; on a mismatch returns what differs, nothing changed).
@@ -122,8 +129,15 @@ private:
   std::string q_table_dir_;
   std::string q_table_path_ = "q_table.yaml";
   std::string load_on_start_;
-  std::string run_id_;      // ~run_id: the launch's own id (train.launch: $(anon run))
-  std::string run_folder_;  // this run's folder, relative to q_table_dir_ ("" when evaluating)
+  std::string run_id_;        // ~run_id: the launch's own id (train.launch: $(anon run))
+  std::string run_folder_;    // this run's folder, relative to q_table_dir_ ("" when evaluating)
+  bool resumed_run_ = false;  // this process is a respawn going on with its run
+  // ~stats_csv: "" the run's folder/episodes.csv (training; none when evaluating), "none" no
+  // file, else a path (relative: under q_table_dir_).
+  std::string stats_csv_;
+  std::unique_ptr<AppendingFile> stats_file_;  // opened, its curve not started yet
+  std::unique_ptr<EpisodeCsvWriter> stats_csv_writer_;
+  bool stats_csv_pending_ = false;  // the default file, opened at the first episode's end
   RunRecord run_;
   std::uint64_t evaluation_episodes_ = 10;  // evaluate: the verdict after this many episodes (0: never)
   std::uint64_t evaluated_balanced_ = 0;
