@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <sstream>
+#include <tuple>
 
 #include <unistd.h>
 
@@ -94,27 +95,14 @@ LearningConfig toConfig(const LearningSettings& s)
   return c;
 }
 
-// Empty when every field could be read (the values themselves are the core's to check).
+// Empty when every field could be read (the values themselves are the core's to check); a
+// schedule name the core does not know leaves that schedule's type as it was.
 std::string fromConfig(const LearningConfig& c, LearningSettings& s)
 {
   const auto rate = [](double value) { return value < 0.0 ? std::nullopt : std::optional<double>(value); };
   s.epsilon_override = rate(c.epsilon_override);
   s.alpha_override = rate(c.alpha_override);
   s.gamma = c.gamma;
-  const std::pair<const std::string*, ScheduleType*> types[] = {{&c.epsilon_schedule, &s.epsilon.type},
-                                                                {&c.alpha_schedule, &s.alpha.type}};
-  for (const auto& [text, type] : types)
-  {
-    try
-    {
-      *type = scheduleTypeFromString(*text);
-    }
-    catch (const std::invalid_argument& e)
-    {
-      return std::string(type == &s.epsilon.type ? "epsilon" : "alpha") + "_schedule = '" + *text +
-             "' is not allowed (" + e.what() + ")";
-    }
-  }
   s.epsilon.start = c.epsilon_start;
   s.epsilon.min = c.epsilon_min;
   s.epsilon.decay_episodes = c.epsilon_decay_episodes;
@@ -125,6 +113,19 @@ std::string fromConfig(const LearningConfig& c, LearningSettings& s)
   s.alpha.decay_episodes = c.alpha_decay_episodes;
   s.alpha.decay_rate = c.alpha_decay_rate;
   s.alpha.log_divisor = c.alpha_log_divisor;
+  const std::tuple<const char*, const std::string&, ScheduleType&> types[] = {
+      {"epsilon", c.epsilon_schedule, s.epsilon.type}, {"alpha", c.alpha_schedule, s.alpha.type}};
+  for (const auto& [name, text, type] : types)
+  {
+    try
+    {
+      type = scheduleTypeFromString(text);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      return std::string(name) + "_schedule = '" + text + "' is not allowed (" + e.what() + ")";
+    }
+  }
   return "";
 }
 
@@ -884,8 +885,8 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
           "(%s): this run goes on with its configuration's: %s",
           asServerField(error).c_str(), settingsText(in_use).c_str());
     else
-      ROS_WARN("qlearning_controller: live tuning refused: %s; nothing changed, in use: %s",
-               asServerField(error).c_str(), settingsText(in_use).c_str());
+      ROS_WARN("qlearning_controller: live tuning refused (asked: %s): %s; nothing changed, in use: %s",
+               changesText(in_use, wanted).c_str(), asServerField(error).c_str(), settingsText(in_use).c_str());
     return;
   }
   const std::string changes = changesText(in_use, wanted);
