@@ -851,12 +851,17 @@ void QLearningControllerNode::startLiveTuning()
     // says so). A new run starts from its configuration: what an earlier node left is replaced.
     if (!respawned_)
     {
-      std::string left;
-      for (const auto& param : LearningConfig::__getParamDescriptions__())
-        left += pnh_.hasParam(param->name) ? (left.empty() ? "~" : ", ~") + param->name : "";
-      if (!left.empty())
-        ROS_INFO("qlearning_controller: %s on the parameter server replaced by this run's learning settings (%s)",
-                 left.c_str(), settingsText(session_->learningSettings()).c_str());
+      const LearningSettings& running = session_->learningSettings();
+      LearningConfig left = toConfig(running);
+      left.__fromServer__(pnh_);  // only the fields present there change
+      LearningSettings left_settings = running;
+      fromConfig(left, left_settings);
+      const std::string replaced = changesText(left_settings, running);
+      if (!replaced.empty())
+        ROS_INFO(
+            "qlearning_controller: a new run: live-tuning values left on the parameter server replaced by "
+            "its configuration's: %s",
+            replaced.c_str());
       toConfig(session_->learningSettings()).__toServer__(pnh_);
     }
   }
