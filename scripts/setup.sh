@@ -25,6 +25,7 @@ DEBIAN_PACKAGES=(
   libros-rosgraph-msgs-dev libtf2-ros-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure libeigen3-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev catkin-lint rviz
+  python3-rospy xvfb imagemagick libgl1-mesa-dri python3-numpy python3-pil python3-yaml
   clang-14 libclang-rt-14-dev
 )
 

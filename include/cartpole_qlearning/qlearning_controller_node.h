@@ -144,6 +144,8 @@ private:
   std::vector<std::string> robot_names_{""};
   bool sync_ = true;
   ControllerProtocolParams protocol_params_;
+  bool trace_ = false;                    // ~trace: log every update and the table at each episode end
+  std::vector<std::string> state_names_;  // as the trace names the rows (trace.h)
 
   bool respawned_ = false;  // this process goes on with the run of a controller that died (openRun)
 
