@@ -143,6 +143,21 @@ QUpdate QLearningAgent::update(std::size_t state, std::size_t action, double rew
   return done;
 }
 
+std::string QLearningAgent::setLearning(double gamma, const ScheduleParams& epsilon, const ScheduleParams& alpha)
+{
+  AgentParams candidate = params_;
+  candidate.gamma = gamma;
+  candidate.epsilon = epsilon;
+  candidate.alpha = alpha;
+  const std::string error = candidate.validate();
+  if (!error.empty())
+    return error;
+  params_ = std::move(candidate);
+  epsilon_ = Schedule(epsilon);
+  alpha_ = Schedule(alpha);
+  return "";
+}
+
 std::string QLearningAgent::replaceTable(QTable table)
 {
   const std::string mismatch = table_.shapeMismatch(table);

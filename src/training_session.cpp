@@ -28,7 +28,11 @@ void ReturnWindow::push(double value)
 
 TrainingSession::TrainingSession(const TaskParams& task, const AgentParams& agent, std::uint64_t seed, bool learning,
                                  std::size_t robots)
-  : task_(task), agent_(agent, seed), learning_(learning), returns_(task.solved_window)
+  : task_(task),
+    agent_(agent, seed),
+    learning_settings_(LearningSettings::of(agent)),
+    learning_(learning),
+    returns_(task.solved_window)
 {
   if (robots < 1)
     throw std::invalid_argument("TrainingSession: at least one robot");
@@ -111,6 +115,7 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   last_.mean_return_window = returns_.mean();
   last_.epsilon = e.epsilon;
   last_.alpha = e.alpha;
+  last_.gamma = agent_.params().gamma;
   last_.terminated = decision.outcome.terminated;
   last_.truncated = decision.outcome.truncated;
   last_.solved = returns_.full() && last_.mean_return_window >= task_.params().solved_mean_return;
@@ -120,6 +125,16 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   last_.robot_mean_return_window = e.returns.mean();
   last_.robot_total_steps = e.total_steps;
   return decision;
+}
+
+std::string TrainingSession::setLearning(const LearningSettings& settings)
+{
+  std::string error = settings.validate();
+  if (error.empty())
+    error = agent_.setLearning(settings.gamma, settings.effectiveEpsilon(), settings.effectiveAlpha());
+  if (error.empty())
+    learning_settings_ = settings;
+  return error;
 }
 
 std::string TrainingSession::replaceTable(QTable table)

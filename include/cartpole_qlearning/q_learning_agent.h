@@ -75,6 +75,12 @@ public:
     return alpha_.value(episode);
   }
 
+  // Replaces the discount and the schedules of a running agent (live tuning), checked as the
+  // configuration is (AgentParams::validate); on a bad value returns the message and changes
+  // nothing. The schedules are then read at the table's episode count, as if they had applied
+  // from the start.
+  std::string setLearning(double gamma, const ScheduleParams& epsilon, const ScheduleParams& alpha);
+
   // With probability epsilon a uniformly drawn action, else the greedy one. Always takes one
   // draw for the coin and, when exploring, one for the action.
   std::size_t selectAction(std::size_t state, double epsilon);

@@ -4,10 +4,12 @@
 // TrainingSession), answers on joint_command stamped with the state's stamp, ends episodes by
 // calling that robot's reset service (or, for a robot without one, waits for it to be stood
 // up), and publishes episode_stats. Several robots are served in lockstep rounds (RobotRounds)
-// unless ~sync is false. It saves and loads its Q-table through services.
+// unless ~sync is false. It saves and loads its Q-table through services, and serves its learning
+// settings (epsilon, alpha, gamma and their schedules) for live tuning with dynamic_reconfigure.
 #pragma once
 
 #include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/LearningConfig.h"
 #include "cartpole_qlearning/LoadQTable.h"
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/config.h"
@@ -18,6 +20,8 @@
 #include "cartpole_qlearning/training_session.h"
 #include "cartpole_qlearning/wall_throttle.h"
 
+#include <boost/thread/recursive_mutex.hpp>
+#include <dynamic_reconfigure/server.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
@@ -71,6 +75,12 @@ private:
   };
 
   void readParameters();
+  // Serves the learning settings in use on ~set_parameters (dynamic_reconfigure). Called with
+  // mutex_ free: the server calls onReconfigure at once, which takes it.
+  void startLiveTuning();
+  // A change from a dynamic_reconfigure client: applied when the core accepts it, else refused
+  // with the values in use put back into config (what the server then keeps and reports).
+  void onReconfigure(LearningConfig& config, std::uint32_t level);
   // Training: starts this run's folder, or continues it when this process is a respawn of the
   // controller that started it (the same ~run_id).
   void openRun();
@@ -151,6 +161,8 @@ private:
   bool trace_ = false;                    // ~trace: log every update and the table at each episode end
   std::vector<std::string> state_names_;  // as the trace names the rows (trace.h)
 
+  bool respawned_ = false;  // this process goes on with the run of a controller that died (openRun)
+
   std::unique_ptr<TrainingSession> session_;
   std::vector<Robot> robots_;
   std::unique_ptr<RobotRounds> rounds_;
@@ -172,6 +184,10 @@ private:
   ros::ServiceServer save_srv_;
   ros::ServiceServer load_srv_;
   ros::SteadyTimer watchdog_;
+  // Given to the server so that its updates and its callback never run at the same time.
+  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<LearningConfig>> reconfigure_;
+  bool reconfigure_started_ = false;  // the server's first callback (at its start) has run
 
   std::mutex reset_mutex_;
   std::condition_variable reset_wanted_;

@@ -11,6 +11,7 @@
 #pragma once
 
 #include "cartpole_qlearning/cartpole_task.h"
+#include "cartpole_qlearning/learning_settings.h"
 #include "cartpole_qlearning/q_learning_agent.h"
 #include "cartpole_qlearning/trace.h"
 
@@ -30,6 +31,7 @@ struct EpisodeSummary
   double mean_return_window = 0.0;  // over the last solved_window episodes (fewer at the start)
   double epsilon = 0.0;
   double alpha = 0.0;
+  double gamma = 0.0;  // the discount in force when the episode ended (live tuning may change it)
   bool terminated = false;
   bool truncated = false;
   bool solved = false;  // a full window whose mean return reaches solved_mean_return
@@ -136,6 +138,17 @@ public:
     return agent_;
   }
 
+  // The learning settings in use: at first the configuration's, no override.
+  const LearningSettings& learningSettings() const
+  {
+    return learning_settings_;
+  }
+  // Live tuning: checks the settings (LearningSettings::validate); on a bad value returns the
+  // message and changes nothing. Else they apply at once: gamma from the next update, epsilon
+  // and alpha (fixed for an episode when it begins) from the next episode that begins, each
+  // schedule read at the table's episode count (it resumes there, it does not start over).
+  std::string setLearning(const LearningSettings& settings);
+
   // The table with its training counters brought up to date.
   const QTable& table() const
   {
@@ -176,6 +189,7 @@ private:
 
   CartPoleTask task_;
   QLearningAgent agent_;
+  LearningSettings learning_settings_;
   bool learning_;
   std::vector<Episode> episodes_;
   ReturnWindow returns_;  // every robot's episodes
