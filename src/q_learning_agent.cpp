@@ -26,10 +26,20 @@ ScheduleParams AgentParams::defaultAlpha()
   return schedule;
 }
 
+FeatureParams AgentParams::featureParams() const
+{
+  FeatureParams params;
+  params.kind = features;
+  params.discretiser = discretiser;
+  params.tilings = tilings;
+  params.tiles = tiles;
+  return params;
+}
+
 std::string AgentParams::validate() const
 {
   std::ostringstream out;
-  std::string error = discretiser.validate();
+  std::string error = featureParams().validate();
   if (!error.empty())
     return error;
   if (actions.empty())
@@ -72,27 +82,74 @@ const AgentParams& checked(const AgentParams& params)
 
 QLearningAgent::QLearningAgent(const AgentParams& params, std::uint64_t seed)
   : params_(checked(params)),
-    discretiser_(params.discretiser),
+    features_(params.featureParams()),
     epsilon_(params.epsilon),
     alpha_(params.alpha),
-    table_(params.discretiser, params.actions),
+    table_(params.featureParams(), params.actions),
     rng_(seed, kAgentStream)
 {
 }
 
-std::size_t QLearningAgent::selectAction(std::size_t state, double epsilon)
+double QLearningAgent::value(const ActiveRows& state, std::size_t action) const
+{
+  double q = table_.at(state.rows[0], action);
+  for (unsigned i = 1; i < state.count; ++i)
+    q += table_.at(state.rows[i], action);
+  return q;
+}
+
+std::size_t QLearningAgent::greedyAction(const ActiveRows& state) const
+{
+  if (state.count == 1)
+    return table_.argmax(state.rows[0]);
+  std::size_t best = 0;
+  double best_q = value(state, 0);
+  for (std::size_t a = 1; a < table_.actionCount(); ++a)
+  {
+    const double q = value(state, a);
+    if (q > best_q)
+    {
+      best = a;
+      best_q = q;
+    }
+  }
+  return best;
+}
+
+double QLearningAgent::maxValue(const ActiveRows& state) const
+{
+  if (state.count == 1)
+    return table_.max(state.rows[0]);
+  return value(state, greedyAction(state));
+}
+
+std::size_t QLearningAgent::selectAction(const ActiveRows& state, double epsilon)
 {
   if (rng_.uniform01() < epsilon)
     return static_cast<std::size_t>(rng_.uniformIndex(table_.actionCount()));
-  return table_.argmax(state);
+  return greedyAction(state);
 }
 
-void QLearningAgent::update(std::size_t state, std::size_t action, double reward, std::size_t next_state,
-                            bool next_is_terminal, double alpha)
+QLearningAgent::Update QLearningAgent::update(const ActiveRows& state, std::size_t action, double reward,
+                                              const ActiveRows& next_state, bool next_is_terminal, double alpha)
 {
-  const double future = next_is_terminal ? 0.0 : params_.gamma * table_.max(next_state);
-  double& q = table_.at(state, action);
-  q += alpha * (reward + future - q);
+  Update report;
+  const double future = next_is_terminal ? 0.0 : params_.gamma * maxValue(next_state);
+  report.target = reward + future;
+  if (state.count == 1)
+  {
+    double& q = table_.at(state.rows[0], action);
+    report.old_q = q;
+    q += alpha * (reward + future - q);
+    report.new_q = q;
+    return report;
+  }
+  report.old_q = value(state, action);
+  const double step = alpha / state.count * (report.target - report.old_q);
+  for (unsigned i = 0; i < state.count; ++i)
+    table_.at(state.rows[i], action) += step;
+  report.new_q = value(state, action);
+  return report;
 }
 
 std::string QLearningAgent::replaceTable(QTable table)

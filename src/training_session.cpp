@@ -35,7 +35,7 @@ TrainingSession::TrainingSession(const TaskParams& task, const AgentParams& agen
   episodes_.assign(robots, Episode(task.solved_window));
 }
 
-std::size_t TrainingSession::chooseAction(std::size_t state, double epsilon)
+std::size_t TrainingSession::chooseAction(const ActiveRows& state, double epsilon)
 {
   return learning_ ? agent_.selectAction(state, epsilon) : agent_.greedyAction(state);
 }
@@ -50,8 +50,8 @@ double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size
   e.running = true;
   e.steps = 0;
   e.episode_return = 0.0;
-  e.state = agent_.discretiser().index(start_state);
-  e.action = chooseAction(e.state, e.epsilon);
+  agent_.activeRows(start_state, e.rows[e.current]);
+  e.action = chooseAction(e.state(), e.epsilon);
   return agent_.table().actions()[e.action];
 }
 
@@ -62,17 +62,17 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   ++e.steps;
   decision.outcome = task_.evaluate(state, e.steps);
   e.episode_return += decision.outcome.reward;
-  const std::size_t next_state = agent_.discretiser().index(state);
+  agent_.activeRows(state, e.next());
   if (learning_)
   {
-    agent_.update(e.state, e.action, decision.outcome.reward, next_state, decision.outcome.terminated, e.alpha);
+    agent_.update(e.state(), e.action, decision.outcome.reward, e.next(), decision.outcome.terminated, e.alpha);
     ++agent_.table().steps;
   }
 
   if (!decision.outcome.done())
   {
-    e.state = next_state;
-    e.action = chooseAction(e.state, e.epsilon);
+    e.current ^= 1;
+    e.action = chooseAction(e.state(), e.epsilon);
     decision.action = e.action;
     decision.effort = agent_.table().actions()[e.action];
     return decision;
