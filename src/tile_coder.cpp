@@ -63,37 +63,56 @@ TileCoder::TileCoder(const TileCoderParams& params) : params_(params)
   const std::string error = params_.validate();
   if (!error.empty())
     throw std::invalid_argument(error);
-  unsigned odd = 1;
   for (std::size_t d = 0; d < kStateDimensions; ++d)
   {
-    const bool used = params_.tiles[d] > 1;
-    span_[d] = used ? params_.tiles[d] + 1 : 1;
+    span_[d] = params_.tiles[d] > 1 ? params_.tiles[d] + 1 : 1;
     tiles_per_tiling_ *= span_[d];
-    for (unsigned i = 0; i < params_.tilings; ++i)
-      offsets_[i][d] = used ? (i * odd) % params_.tilings : 0;
-    if (used)
-      odd += 2;
+    if (span_[d] > 1)
+      used_[used_count_++] = d;
   }
+  for (unsigned k = 0; k < used_count_; ++k)
+  {
+    stride_[k] = 1;
+    for (std::size_t d = used_[k] + 1; d < kStateDimensions; ++d)
+      stride_[k] *= span_[d];
+    const unsigned odd = 2 * k + 1;  // Sutton and Barto's displacement vector (1, 3, 5, 7, ...)
+    for (unsigned i = 0; i < params_.tilings; ++i)
+      offsets_[i][k] = (i * odd) % params_.tilings;
+  }
+}
+
+unsigned TileCoder::offset(unsigned tiling, std::size_t dimension) const
+{
+  for (unsigned k = 0; k < used_count_; ++k)
+  {
+    if (used_[k] == dimension)
+      return offsets_[tiling][k];
+  }
+  return 0;
 }
 
 void TileCoder::activeTiles(const CartPoleState& state, std::uint32_t* tiles) const
 {
   const unsigned n = params_.tilings;
-  // Where the value falls on a grid n times finer than one tiling: a tile is n consecutive fine
-  // cells, and tiling i's tiles start n - offset cells earlier, so one division per dimension
-  // serves every tiling and a tile edge is exactly a fine-cell edge.
-  std::array<unsigned, kStateDimensions> fine{};
-  for (std::size_t d = 0; d < kStateDimensions; ++d)
+  // Where the value falls on a grid n times finer than a tile: tiling i's tile is
+  // (fine + offset_i) / n, so one division per dimension serves every tiling and a tile edge is
+  // exactly a fine-cell edge. With fine = n * whole + part that is whole, plus one when
+  // part + offset_i reaches n.
+  std::array<unsigned, kStateDimensions> whole{};
+  std::array<unsigned, kStateDimensions> part{};
+  for (unsigned k = 0; k < used_count_; ++k)
   {
-    if (span_[d] > 1)
-      fine[d] = uniformBin(state[d], params_.lower[d], params_.upper[d], params_.tiles[d] * n);
+    const std::size_t d = used_[k];
+    const unsigned fine = uniformBin(state[d], params_.lower[d], params_.upper[d], params_.tiles[d] * n);
+    whole[k] = fine / n;
+    part[k] = fine - whole[k] * n;
   }
   for (unsigned i = 0; i < n; ++i)
   {
-    std::size_t tile = 0;
-    for (std::size_t d = 0; d < kStateDimensions; ++d)
-      tile = tile * span_[d] + (span_[d] > 1 ? (fine[d] + offsets_[i][d]) / n : 0);
-    tiles[i] = static_cast<std::uint32_t>(i * tiles_per_tiling_ + tile);
+    std::size_t tile = i * tiles_per_tiling_;
+    for (unsigned k = 0; k < used_count_; ++k)
+      tile += stride_[k] * (whole[k] + (part[k] + offsets_[i][k] >= n ? 1 : 0));
+    tiles[i] = static_cast<std::uint32_t>(tile);
   }
 }
 

@@ -65,10 +65,7 @@ public:
   // Tiling i is displaced by offset(i, d) / tilings of a tile width along dimension d (towards
   // lower values): i times the odd number of d among the used dimensions (1, 3, 5, 7), modulo
   // tilings.
-  unsigned offset(unsigned tiling, std::size_t dimension) const
-  {
-    return offsets_[tiling][dimension];
-  }
+  unsigned offset(unsigned tiling, std::size_t dimension) const;
 
   // Writes the active tile of every tiling to tiles[0 .. tilings): tiling i's tile numbered
   // i * tilesPerTiling() + its tiles combined in mixed radix, first dimension most significant.
@@ -79,6 +76,11 @@ private:
   TileCoderParams params_;
   std::array<unsigned, kStateDimensions> span_{};
   std::size_t tiles_per_tiling_ = 1;
+  // The used dimensions (tiles > 1) in order, the stride of each in a tiling's mixed radix, and
+  // each tiling's offset along each, so that the per-step loops skip the ignored dimensions.
+  unsigned used_count_ = 0;
+  std::array<std::size_t, kStateDimensions> used_{};
+  std::array<std::size_t, kStateDimensions> stride_{};
   std::array<std::array<unsigned, kStateDimensions>, kMaxTilings> offsets_{};
 };
 
