@@ -1,5 +1,7 @@
 #include "cartpole_qlearning/q_learning_agent.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -108,29 +110,45 @@ double QLearningAgent::value(const ActiveRows& state, std::size_t action) const
   return q;
 }
 
+std::size_t QLearningAgent::greedyAction(const ActiveRows& state, double* best_q) const
+{
+  const std::size_t actions = table_.actionCount();
+  // Row by row, all actions at once: each row's weights are contiguous.
+  std::array<double, kMaxActions> q;
+  const double* const values = table_.values().data();
+  const double* first = values + state.rows[0] * actions;
+  std::copy(first, first + actions, q.begin());
+  for (unsigned i = 1; i < state.count; ++i)
+  {
+    const double* row = values + state.rows[i] * actions;
+    for (std::size_t a = 0; a < actions; ++a)
+      q[a] += row[a];
+  }
+  std::size_t best = 0;
+  for (std::size_t a = 1; a < actions; ++a)
+  {
+    if (q[a] > q[best])
+      best = a;
+  }
+  if (best_q != nullptr)
+    *best_q = q[best];
+  return best;
+}
+
 std::size_t QLearningAgent::greedyAction(const ActiveRows& state) const
 {
   if (state.count == 1)
     return table_.argmax(state.rows[0]);
-  std::size_t best = 0;
-  double best_q = value(state, 0);
-  for (std::size_t a = 1; a < table_.actionCount(); ++a)
-  {
-    const double q = value(state, a);
-    if (q > best_q)
-    {
-      best = a;
-      best_q = q;
-    }
-  }
-  return best;
+  return greedyAction(state, nullptr);
 }
 
 double QLearningAgent::maxValue(const ActiveRows& state) const
 {
   if (state.count == 1)
     return table_.max(state.rows[0]);
-  return value(state, greedyAction(state));
+  double best_q = 0.0;
+  greedyAction(state, &best_q);
+  return best_q;
 }
 
 std::size_t QLearningAgent::selectAction(const ActiveRows& state, double epsilon)

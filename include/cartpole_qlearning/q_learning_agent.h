@@ -127,6 +127,8 @@ public:
   std::string replaceTable(QTable table);
 
 private:
+  // Over several rows: the greedy action, and its Q in best_q when given.
+  std::size_t greedyAction(const ActiveRows& state, double* best_q) const;
   double maxValue(const ActiveRows& state) const;
 
   AgentParams params_;
