@@ -123,10 +123,10 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
   const FeatureParams& features = session_->table().features();
-  const std::string rows = features.kind == FeatureKind::Tiles
-                               ? std::to_string(features.tilings) + " tilings, " +
-                                     std::to_string(session_->table().stateCount()) + " tiles"
-                               : std::to_string(session_->table().stateCount()) + " states";
+  const std::string rows =
+      features.kind == FeatureKind::Tiles
+          ? std::to_string(features.tilings) + " tilings, " + std::to_string(session_->table().stateCount()) + " tiles"
+          : std::to_string(session_->table().stateCount()) + " states";
   ROS_INFO("qlearning_controller: %s, seed %llu, %s x %zu actions, tables under %s; serving %s%s; %s",
            learning_ ? "training" : "evaluating (greedy, no learning)", static_cast<unsigned long long>(seed_),
            rows.c_str(), session_->table().actionCount(), q_table_dir_.c_str(), served.c_str(),

@@ -286,7 +286,8 @@ TEST_F(QTableFileTest, MissingFileIsRefusedWithItsPath)
 namespace
 {
 // A version 1 file as the build before tile coding wrote it (test/fuzz/corpus/q_table/tiny.yaml).
-const char* const kVersion1Table = R"(# Q-table of cartpole_qlearning. The checksum covers every number below: edit by hand and the
+const char* const kVersion1Table =
+    R"(# Q-table of cartpole_qlearning. The checksum covers every number below: edit by hand and the
 # file will be refused.
 format: cartpole_qlearning/q_table
 version: 1

@@ -181,8 +181,8 @@ TEST(TileCodedAgent, QIsTheSumOfTheActiveTilesWeights)
 {
   QLearningAgent agent(twoTilings(), 0);
   ASSERT_EQ(6u, agent.table().stateCount());
-  agent.table().at(1, 0) = 1.5;   // tiling 0, tile 1
-  agent.table().at(4, 0) = 2.0;   // tiling 1, tile 1
+  agent.table().at(1, 0) = 1.5;  // tiling 0, tile 1
+  agent.table().at(4, 0) = 2.0;  // tiling 1, tile 1
   agent.table().at(1, 1) = -1.0;
   agent.table().at(4, 1) = 0.25;
   agent.table().at(5, 1) = 10.0;  // not active at 0.25

@@ -18,12 +18,14 @@ namespace cartpole_qlearning
 {
 struct AgentParams
 {
+  // What the learner sees of the state (features.h). The bins are used by bins only, the bounds
+  // by both, tilings and tiles (per dimension) by tiles only.
   FeatureKind features = FeatureKind::Bins;
-  DiscretiserParams discretiser;  // bins (used by bins) and bounds (used by both)
-  unsigned tilings = 8;                                          // tiles only
-  std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};  // tiles only, per dimension
-  std::vector<double> actions{-10.0, 10.0};   // [N] the effort of each action
-  double gamma = 0.99;                        // discount, in [0, 1]
+  DiscretiserParams discretiser;
+  unsigned tilings = 8;
+  std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
+  std::vector<double> actions{-10.0, 10.0};  // [N] the effort of each action
+  double gamma = 0.99;                       // discount, in [0, 1]
   // Q(s, a) of a new table, every state and action (tiles: this / tilings in every weight).
   // Above the returns to come it is optimistic: untried actions look best until tried.
   double initial_q = 0.0;
