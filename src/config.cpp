@@ -253,7 +253,6 @@ AgentParams readAgent(const ParameterSource& source)
   AgentParams agent;
   SectionReader reader(source, "learning");
   reader.read("gamma", agent.gamma);
-  reader.read("initial_q", agent.initial_q);
   reader.read("actions", agent.actions);
   readEnum(reader, "features", agent.features, featureKindFromString);
   reader.readDimensions("bins", agent.discretiser.bins, true);

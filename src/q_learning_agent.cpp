@@ -62,11 +62,6 @@ std::string AgentParams::validate() const
     out << "gamma = " << gamma << " is not allowed (must be in [0, 1])";
     return out.str();
   }
-  if (!std::isfinite(initial_q))
-  {
-    out << "initial_q = " << initial_q << " is not allowed (must be finite)";
-    return out.str();
-  }
   error = epsilon.validate();
   if (!error.empty())
     return "epsilon/" + error;
@@ -95,11 +90,6 @@ QLearningAgent::QLearningAgent(const AgentParams& params, std::uint64_t seed)
     table_(params.featureParams(), params.actions),
     rng_(seed, kAgentStream)
 {
-  if (params_.initial_q != 0.0)
-  {
-    const double weight = params_.initial_q / (params_.features == FeatureKind::Tiles ? params_.tilings : 1);
-    table_.setValues(std::vector<double>(table_.values().size(), weight));
-  }
 }
 
 double QLearningAgent::value(const ActiveRows& state, std::size_t action) const

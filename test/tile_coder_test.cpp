@@ -237,14 +237,3 @@ TEST(TileCodedAgent, AnUpdateSpreadsAlphaOverTheTilings)
   EXPECT_DOUBLE_EQ(1.0, fall.target);
   EXPECT_DOUBLE_EQ(3.6 + 0.5 * (1.0 - 3.6), fall.new_q);
 }
-
-TEST(TileCodedAgent, InitialQIsSharedOutOverTheTilings)
-{
-  AgentParams p = twoTilings();
-  p.initial_q = 3.0;
-  QLearningAgent agent(p, 0);
-  ActiveRows s;
-  agent.activeRows(CartPoleState(0.0, 0.0, 0.0, 0.25), s);
-  EXPECT_EQ(3.0, agent.value(s, 0));
-  EXPECT_EQ(1.5, agent.table().at(0, 1));
-}

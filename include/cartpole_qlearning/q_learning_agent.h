@@ -26,9 +26,6 @@ struct AgentParams
   std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
   std::vector<double> actions{-10.0, 10.0};  // [N] the effort of each action
   double gamma = 0.99;                       // discount, in [0, 1]
-  // Q(s, a) of a new table, every state and action (tiles: this / tilings in every weight).
-  // Above the returns to come it is optimistic: untried actions look best until tried.
-  double initial_q = 0.0;
   ScheduleParams epsilon = defaultEpsilon();  // exploration rate per episode
   ScheduleParams alpha = defaultAlpha();      // learning rate per episode
 
