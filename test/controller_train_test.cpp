@@ -94,7 +94,10 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
                               configFile() + " --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
   EXPECT_EQ(fileText(headless), fileText(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
-  // The table is of the features the config asks for.
+  // The table is of the features the config asks for, as the test names them.
+  std::string features;
+  ros::param::get("~features", features);
+  EXPECT_EQ(features, toString(table.features().kind));
   const auto source = cartpole_qlearning::loadYamlParameters(CARTPOLE_CONFIG_DIR "/" + configFile());
   EXPECT_EQ("", cartpole_qlearning::QTable(cartpole_qlearning::readAgent(*source).featureParams(), table.actions())
                     .shapeMismatch(table));
