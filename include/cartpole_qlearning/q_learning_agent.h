@@ -24,8 +24,8 @@ struct AgentParams
   DiscretiserParams discretiser;
   unsigned tilings = 8;
   std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
-  std::vector<double> actions{-10.0, 10.0};  // [N] the effort of each action
-  double gamma = 0.99;                       // discount, in [0, 1]
+  std::vector<double> actions{-10.0, 10.0};   // [N] the effort of each action
+  double gamma = 0.99;                        // discount, in [0, 1]
   ScheduleParams epsilon = defaultEpsilon();  // exploration rate per episode
   ScheduleParams alpha = defaultAlpha();      // learning rate per episode
 
@@ -121,7 +121,7 @@ public:
     return update(ActiveRows::single(state), action, reward, ActiveRows::single(next_state), next_is_terminal, alpha);
   }
 
-  // Replaces the table after checking it has this agent's discretisation and actions; on a
+  // Replaces the table after checking it has this agent's features and actions; on a
   // mismatch returns what differs and leaves the table in use as it was.
   std::string replaceTable(QTable table);
 
