@@ -268,9 +268,14 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   std::string served;
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
-  ROS_INFO("qlearning_controller: %s, seed %llu, %zu states x %zu actions, tables under %s; serving %s%s; %s",
+  const FeatureParams& features = session_->table().features();
+  const std::string rows =
+      features.kind == FeatureKind::Tiles
+          ? std::to_string(features.tilings) + " tilings, " + std::to_string(session_->table().stateCount()) + " tiles"
+          : std::to_string(session_->table().stateCount()) + " states";
+  ROS_INFO("qlearning_controller: %s, seed %llu, %s x %zu actions, tables under %s; serving %s%s; %s",
            learning_ ? "training" : "evaluating (greedy, no learning)", static_cast<unsigned long long>(seed_),
-           session_->table().stateCount(), session_->table().actionCount(), q_table_dir_.c_str(), served.c_str(),
+           rows.c_str(), session_->table().actionCount(), q_table_dir_.c_str(), served.c_str(),
            robots_.size() > 1 ? (sync_ ? " in lockstep rounds" : ", each as its states come") : "",
            protocol_params_.reset_service ? ("resets by ~" + reset_service_).c_str()
                                           : "no reset service: episodes start when the state is in ~start_region");
@@ -403,6 +408,8 @@ void QLearningControllerNode::readParameters()
   readRobots(pnh_, priv, robot_names_);
   priv.read("sync", sync_);
   priv.read("trace", trace_);
+  if (trace_ && config_.agent.features == FeatureKind::Tiles)
+    priv.fail("trace", "true", "the trace shows one table row per state: learning/features bins only");
   // Live tuning's values, which the controller's own dynamic_reconfigure server keeps there.
   for (const auto& param : LearningConfig::__getParamDescriptions__())
     priv.know(param->name);

@@ -170,6 +170,12 @@ int run(int argc, char** argv)
   }
   if (max_episodes > 0)
     config.limits.max_episodes = max_episodes;
+  if ((trace || !replay_path.empty()) && config.agent.features == FeatureKind::Tiles)
+  {
+    std::cerr << "train_headless: " << (trace ? "--trace" : "--replay")
+              << " shows one table row per state: it needs learning/features bins (" << config_path << " has tiles)\n";
+    return 2;
+  }
 
   // The one path rule: a relative table path is under the table folder (as the controller's
   // services and the launch files take it); an absolute one is the user's own.

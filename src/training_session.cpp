@@ -39,7 +39,7 @@ TrainingSession::TrainingSession(const TaskParams& task, const AgentParams& agen
   episodes_.assign(robots, Episode(task.solved_window));
 }
 
-std::size_t TrainingSession::chooseAction(std::size_t state, double epsilon)
+std::size_t TrainingSession::chooseAction(const ActiveRows& state, double epsilon)
 {
   return learning_ ? agent_.selectAction(state, epsilon) : agent_.greedyAction(state);
 }
@@ -55,8 +55,8 @@ double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size
   e.number = episodes_.size() == 1 ? last_.episode + 1 : e.ended + 1;
   e.steps = 0;
   e.episode_return = 0.0;
-  e.state = agent_.discretiser().index(start_state);
-  e.action = chooseAction(e.state, e.epsilon);
+  agent_.activeRows(start_state, e.rows[e.current]);
+  e.action = chooseAction(e.state(), e.epsilon);
   return agent_.table().actions()[e.action];
 }
 
@@ -67,21 +67,22 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   ++e.steps;
   decision.outcome = task_.evaluate(state, e.steps);
   e.episode_return += decision.outcome.reward;
-  const std::size_t next_state = agent_.discretiser().index(state);
+  agent_.activeRows(state, e.next());
   if (learning_)
   {
     const QUpdate update =
-        agent_.update(e.state, e.action, decision.outcome.reward, next_state, decision.outcome.terminated, e.alpha);
+        agent_.update(e.state(), e.action, decision.outcome.reward, e.next(), decision.outcome.terminated, e.alpha);
     ++agent_.table().steps;
     if (trace_)
     {
       TraceStep step;
       step.episode = e.number;
       step.step = e.steps;
-      step.state = e.state;
+      // One row per state: the trace is for bins (features tiles refuse it, see traceRefusal).
+      step.state = e.state().rows[0];
       step.action = e.action;
       step.reward = decision.outcome.reward;
-      step.next_state = next_state;
+      step.next_state = e.next().rows[0];
       step.terminal = decision.outcome.terminated;
       step.truncated = decision.outcome.truncated;
       step.alpha = e.alpha;
@@ -93,8 +94,8 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
 
   if (!decision.outcome.done())
   {
-    e.state = next_state;
-    e.action = chooseAction(e.state, e.epsilon);
+    e.current ^= 1;
+    e.action = chooseAction(e.state(), e.epsilon);
     decision.action = e.action;
     decision.effort = agent_.table().actions()[e.action];
     return decision;

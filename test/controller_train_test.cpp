@@ -1,6 +1,8 @@
 // train.launch's nodes, lockstep, seed 0: the controller solves CartPole-v1 over ROS topics,
 // writes the same table as train_headless, and a fresh greedy controller balances with it.
+// With ~config (controller_train_tiles.test: tiles.yaml) the same over that config.
 #include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/q_table_file.h"
 
 #include "ros_test_support.h"
@@ -33,6 +35,14 @@ std::string qTableDir()
   std::string dir;
   ros::param::get("~q_table_dir", dir);
   return dir;
+}
+
+// The config file loaded over cartpole.yaml in the controller's namespace.
+std::string configFile()
+{
+  std::string file = "cartpole.yaml";
+  ros::param::get("~config", file);
+  return file;
 }
 }  // namespace
 
@@ -80,10 +90,17 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
   EXPECT_EQ(solved.episode, table.episodes);
   EXPECT_EQ(solved.total_steps, table.steps);
   const std::string headless = qTableDir() + "/headless.yaml";
-  const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " +
-                              CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
+  const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " + CARTPOLE_CONFIG_DIR "/" +
+                              configFile() + " --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
   EXPECT_EQ(fileText(headless), fileText(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
+  // The table is of the features the config asks for, as the test names them.
+  std::string features;
+  ros::param::get("~features", features);
+  EXPECT_EQ(features, toString(table.features().kind));
+  const auto source = cartpole_qlearning::loadYamlParameters(CARTPOLE_CONFIG_DIR "/" + configFile());
+  EXPECT_EQ("", cartpole_qlearning::QTable(cartpole_qlearning::readAgent(*source).featureParams(), table.actions())
+                    .shapeMismatch(table));
 
   // 3. The run's learning curve: episodes.csv beside its checkpoint, a header and one row per
   //    episode, each the episode_stats message of that episode.

@@ -213,6 +213,13 @@ TEST_F(NodeParametersTest, ControllerRefusesBinsWithThreeEntries)
                 "learning/bins\\b.*\\[\\s*1(\\.0*)?\\s*,\\s*6(\\.0*)?\\s*,\\s*12(\\.0*)?\\s*\\]");
 }
 
+TEST_F(NodeParametersTest, ControllerRefusesATraceOfTiles)
+{
+  expectRefused(kController, "/ko_controller_trace_tiles",
+                {{"qlearning_controller/trace", XmlRpcValue(true)}, {"learning/features", XmlRpcValue("tiles")}},
+                "[/~]trace\\b.*features bins only");
+}
+
 TEST_F(NodeParametersTest, ControllerRefusesANegativeCheckpointInterval)
 {
   expectRefused(kController, "/ko_controller_checkpoint", {{"qlearning_controller/checkpoint_every", XmlRpcValue(-5)}},

@@ -283,6 +283,22 @@ TEST_F(TrainHeadlessTest, BadReplayFileNamesTheLineAndRunsNothing)
   }
 }
 
+// The trace prints one table row per state: a tile-coded config has none, and is told so
+// before anything runs.
+TEST_F(TrainHeadlessTest, TraceAndReplayRefuseATileCodedConfig)
+{
+  const std::string tiles = std::string(" --config ") + CARTPOLE_CONFIG_DIR + "/tiles.yaml";
+  const std::vector<std::string> options{" --trace",
+                                         std::string(" --replay ") + CARTPOLE_CONFIG_DIR + "/tutorial_10_steps.yaml"};
+  for (const std::string& option : options)
+  {
+    const CommandRun run = trainHeadless(tiles + option);
+    EXPECT_EQ(2, run.status) << run.output;
+    EXPECT_NE(std::string::npos, run.output.find("it needs learning/features bins")) << run.output;
+    EXPECT_EQ(std::string::npos, run.output.find("solved=")) << run.output;
+  }
+}
+
 // Training with --trace on the tutorial's 4 states: every printed update holds its arithmetic,
 // and a table, equal to what the updates printed so far, ends each episode.
 TEST_F(TrainHeadlessTest, TraceWhileTrainingHoldsItsArithmeticWithATableAtEachEpisodeEnd)

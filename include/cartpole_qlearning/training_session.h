@@ -15,6 +15,7 @@
 #include "cartpole_qlearning/q_learning_agent.h"
 #include "cartpole_qlearning/trace.h"
 
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -172,9 +173,20 @@ private:
   struct Episode
   {
     explicit Episode(unsigned window) : returns(window) {}
+    // The rows of the state the action was taken in, and of the state it led to: two buffers
+    // swapped at each step, so that a step copies no rows.
+    const ActiveRows& state() const
+    {
+      return rows[current];
+    }
+    ActiveRows& next()
+    {
+      return rows[current ^ 1];
+    }
     bool running = false;
     std::uint64_t number = 0;  // as the trace numbers it (TraceStep::episode)
-    std::size_t state = 0;
+    std::array<ActiveRows, 2> rows{};
+    unsigned current = 0;
     std::size_t action = 0;
     unsigned steps = 0;
     double episode_return = 0.0;
@@ -185,7 +197,7 @@ private:
     ReturnWindow returns;
   };
 
-  std::size_t chooseAction(std::size_t state, double epsilon);
+  std::size_t chooseAction(const ActiveRows& state, double epsilon);
 
   CartPoleTask task_;
   QLearningAgent agent_;
