@@ -11,46 +11,63 @@ namespace
 const char* const kDimensionNames[kStateDimensions] = {"x", "x_dot", "theta", "theta_dot"};
 }  // namespace
 
-std::string DiscretiserParams::validate() const
+std::string uniformGridError(const char* count_key, const std::array<unsigned, kStateDimensions>& counts,
+                             const std::array<double, kStateDimensions>& lower,
+                             const std::array<double, kStateDimensions>& upper)
 {
   std::ostringstream out;
   for (std::size_t d = 0; d < kStateDimensions; ++d)
   {
-    if (bins[d] < 1 || bins[d] > kMaxBinsPerDimension)
+    if (counts[d] < 1 || counts[d] > kMaxBinsPerDimension)
     {
-      out << "bins[" << d << "] (" << kDimensionNames[d] << ") = " << bins[d] << " is not allowed (must be in [1, "
-          << kMaxBinsPerDimension << "])";
+      out << count_key << "[" << d << "] (" << kDimensionNames[d] << ") = " << counts[d]
+          << " is not allowed (must be in [1, " << kMaxBinsPerDimension << "])";
       return out.str();
     }
-    if (bins[d] > 1 && !(std::isfinite(lower[d]) && std::isfinite(upper[d]) && lower[d] < upper[d]))
+    if (counts[d] > 1 && !(std::isfinite(lower[d]) && std::isfinite(upper[d]) && lower[d] < upper[d]))
     {
       out << "lower_bounds[" << d << "], upper_bounds[" << d << "] (" << kDimensionNames[d] << ") = " << lower[d]
           << ", " << upper[d] << " are not allowed (must be finite with lower < upper)";
       return out.str();
     }
   }
+  return "";
+}
+
+bool sameUniformGrid(const std::array<unsigned, kStateDimensions>& counts,
+                     const std::array<double, kStateDimensions>& lower,
+                     const std::array<double, kStateDimensions>& upper,
+                     const std::array<unsigned, kStateDimensions>& other_counts,
+                     const std::array<double, kStateDimensions>& other_lower,
+                     const std::array<double, kStateDimensions>& other_upper)
+{
+  // Bounds of an ignored (count 1) dimension play no part in the mapping.
+  if (counts != other_counts)
+    return false;
+  for (std::size_t d = 0; d < kStateDimensions; ++d)
+  {
+    if (counts[d] > 1 && (lower[d] != other_lower[d] || upper[d] != other_upper[d]))
+      return false;
+  }
+  return true;
+}
+
+std::string DiscretiserParams::validate() const
+{
+  const std::string error = uniformGridError("bins", bins, lower, upper);
+  if (!error.empty())
+    return error;
   std::uint64_t states = 1;
   for (const unsigned b : bins)
     states *= b;  // at most 1000^4: no overflow
   if (states > kMaxStates)
-  {
-    out << "bins give " << states << " states, more than the " << kMaxStates << " allowed";
-    return out.str();
-  }
+    return "bins give " + std::to_string(states) + " states, more than the " + std::to_string(kMaxStates) + " allowed";
   return "";
 }
 
 bool DiscretiserParams::operator==(const DiscretiserParams& other) const
 {
-  // Bounds of an ignored (1-bin) dimension play no part in the mapping.
-  if (bins != other.bins)
-    return false;
-  for (std::size_t d = 0; d < kStateDimensions; ++d)
-  {
-    if (bins[d] > 1 && (lower[d] != other.lower[d] || upper[d] != other.upper[d]))
-      return false;
-  }
-  return true;
+  return sameUniformGrid(bins, lower, upper, other.bins, other.lower, other.upper);
 }
 
 Discretiser::Discretiser(const DiscretiserParams& params) : params_(params), state_count_(1)

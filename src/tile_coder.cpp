@@ -6,11 +6,6 @@
 
 namespace cartpole_qlearning
 {
-namespace
-{
-const char* const kDimensionNames[kStateDimensions] = {"x", "x_dot", "theta", "theta_dot"};
-}  // namespace
-
 std::string TileCoderParams::validate() const
 {
   std::ostringstream out;
@@ -19,23 +14,12 @@ std::string TileCoderParams::validate() const
     out << "tilings = " << tilings << " is not allowed (must be in [1, " << kMaxTilings << "])";
     return out.str();
   }
+  const std::string error = uniformGridError("tiles", tiles, lower, upper);
+  if (!error.empty())
+    return error;
   std::uint64_t per_tiling = 1;
   for (std::size_t d = 0; d < kStateDimensions; ++d)
-  {
-    if (tiles[d] < 1 || tiles[d] > kMaxBinsPerDimension)
-    {
-      out << "tiles[" << d << "] (" << kDimensionNames[d] << ") = " << tiles[d] << " is not allowed (must be in [1, "
-          << kMaxBinsPerDimension << "])";
-      return out.str();
-    }
-    if (tiles[d] > 1 && !(std::isfinite(lower[d]) && std::isfinite(upper[d]) && lower[d] < upper[d]))
-    {
-      out << "lower_bounds[" << d << "], upper_bounds[" << d << "] (" << kDimensionNames[d] << ") = " << lower[d]
-          << ", " << upper[d] << " are not allowed (must be finite with lower < upper)";
-      return out.str();
-    }
     per_tiling *= tiles[d] > 1 ? tiles[d] + 1 : 1;  // at most 1001^4: no overflow
-  }
   const std::uint64_t total = per_tiling * tilings;
   if (total > kMaxStates)
   {
@@ -48,14 +32,7 @@ std::string TileCoderParams::validate() const
 
 bool TileCoderParams::operator==(const TileCoderParams& other) const
 {
-  if (tilings != other.tilings || tiles != other.tiles)
-    return false;
-  for (std::size_t d = 0; d < kStateDimensions; ++d)
-  {
-    if (tiles[d] > 1 && (lower[d] != other.lower[d] || upper[d] != other.upper[d]))
-      return false;
-  }
-  return true;
+  return tilings == other.tilings && sameUniformGrid(tiles, lower, upper, other.tiles, other.lower, other.upper);
 }
 
 TileCoder::TileCoder(const TileCoderParams& params) : params_(params)

@@ -428,9 +428,7 @@ struct Delivery
 
 std::string tableDir()
 {
-  std::string dir;
-  ros::param::get("~q_table_dir", dir);
-  return dir;
+  return cartpole_qlearning::test::privateParam("q_table_dir");
 }
 
 // Saves the controller's table through its service and loads it back with the core's loader.

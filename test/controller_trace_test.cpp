@@ -29,9 +29,7 @@ namespace
 {
 std::string rosHome()
 {
-  std::string dir;
-  ros::param::get("~ros_home", dir);
-  return dir;
+  return cartpole_qlearning::test::privateParam("ros_home");
 }
 
 // roslaunch train.launch ARGS to its end (or a time limit); its whole output, nodes included.

@@ -26,9 +26,7 @@ namespace
 {
 std::string tableDir()
 {
-  std::string dir;
-  ros::param::get("~q_table_dir", dir);
-  return dir;
+  return cartpole_qlearning::test::privateParam("q_table_dir");
 }
 }  // namespace
 

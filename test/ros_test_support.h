@@ -13,6 +13,14 @@ namespace cartpole_qlearning
 {
 namespace test
 {
+// A string parameter of this test node's own (the .test file sets it), "" when absent.
+inline std::string privateParam(const std::string& name)
+{
+  std::string value;
+  ros::param::get("~" + name, value);
+  return value;
+}
+
 // Spins the global callback queue until done() holds or the wall-clock timeout passes (wall
 // clock: in lockstep, ROS time is the sim's and may stand still).
 inline bool spinUntil(const std::function<bool()>& done, double timeout_s)

@@ -34,9 +34,7 @@ namespace
 {
 std::string rosHome()
 {
-  std::string dir;
-  ros::param::get("~ros_home", dir);
-  return dir;
+  return cartpole_qlearning::test::privateParam("ros_home");
 }
 
 // roslaunch train.launch in the background, its output (nodes included) in a file.

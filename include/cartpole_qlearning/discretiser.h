@@ -30,6 +30,20 @@ struct DiscretiserParams
   bool operator==(const DiscretiserParams& other) const;
 };
 
+// A uniform grid's parameters, as bins and tiles both give them (counts named by count_key:
+// "bins" or "tiles"; a dimension with count 1 is ignored and its bounds are not read). Empty
+// when valid, else a message naming the first bad count or bounds.
+std::string uniformGridError(const char* count_key, const std::array<unsigned, kStateDimensions>& counts,
+                             const std::array<double, kStateDimensions>& lower,
+                             const std::array<double, kStateDimensions>& upper);
+// Whether two grids map states alike: the same counts, and the same bounds where a count is above 1.
+bool sameUniformGrid(const std::array<unsigned, kStateDimensions>& counts,
+                     const std::array<double, kStateDimensions>& lower,
+                     const std::array<double, kStateDimensions>& upper,
+                     const std::array<unsigned, kStateDimensions>& other_counts,
+                     const std::array<double, kStateDimensions>& other_lower,
+                     const std::array<double, kStateDimensions>& other_upper);
+
 // The bin of a value among n uniform bins over [lower, upper): bin i covers
 // [lower + i*w, lower + (i+1)*w) with w = (upper - lower) / n; values below lower (and NaN) go to
 // bin 0, values at or above upper to bin n - 1. A value on an edge always lands in the bin that
