@@ -8,7 +8,7 @@ namespace cartpole_qlearning
 {
 const char* const kEpisodeCsvHeader =
     "episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,terminated,truncated,solved,total_steps,"
-    "wall_time";
+    "wall_time,gamma";
 
 namespace
 {
@@ -54,13 +54,18 @@ std::string episodeCsvRow(const EpisodeSummary& s, const std::string& robot, dou
   return std::to_string(s.episode) + "," + field(robot) + "," + std::to_string(s.steps) + "," +
          exact(s.episode_return) + "," + exact(s.mean_return_window) + "," + exact(s.epsilon) + "," + exact(s.alpha) +
          "," + yesNo(s.terminated) + "," + yesNo(s.truncated) + "," + yesNo(s.solved) + "," +
-         std::to_string(s.total_steps) + "," + time;
+         std::to_string(s.total_steps) + "," + time + "," + exact(s.gamma);
 }
 
 EpisodeCsvWriter::EpisodeCsvWriter(AppendingFile file) : file_(std::move(file))
 {
-  file_.truncate(0);
-  file_.append(std::string(kEpisodeCsvHeader) + "\n");
+  // Only a curve is replaced: a path that names a table or notes by mistake must not lose them.
+  // (Any version of the curve counts: its first columns have always been these.)
+  const std::string text = file_.read();
+  if (!text.empty() && text.rfind("episode,robot,steps,", 0) != 0)
+    throw FileError(file_.path() + " is not an episode CSV of cartpole_qlearning (its first line is not '" +
+                    kEpisodeCsvHeader + "'): refused, left as it was; name a new file, or an old curve to replace");
+  startOver();
 }
 
 EpisodeCsvWriter::EpisodeCsvWriter(AppendingFile file, std::uint64_t episodes) : file_(std::move(file))
@@ -89,6 +94,12 @@ EpisodeCsvWriter::EpisodeCsvWriter(AppendingFile file, std::uint64_t episodes) :
   }
   if (keep < text.size())
     file_.truncate(keep);
+}
+
+void EpisodeCsvWriter::startOver()
+{
+  file_.truncate(0);
+  file_.append(std::string(kEpisodeCsvHeader) + "\n");
 }
 
 void EpisodeCsvWriter::write(const EpisodeSummary& summary, const std::string& robot, double wall_time)

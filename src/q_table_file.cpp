@@ -289,22 +289,25 @@ QTable parseQTable(const std::string& text)
     refuse("actions has " + std::to_string(actions.size()) + " entries (allowed: 1 to " + std::to_string(kMaxActions) +
            ")");
 
-  QTable table(features, actions);
-  table.episodes = readCount(required(root, "episodes"), "episodes");
-  table.steps = readCount(required(root, "steps"), "steps");
+  // Every count is checked against the rows the file really holds before the table (up to
+  // kMaxStates rows of kMaxActions values: 8 GB) is allocated, so a short file that claims a
+  // huge table costs nothing.
+  const std::size_t row_count = features.rowCount();
   const char* const rows_key = version1 ? "states" : "rows";
   const std::uint64_t rows_said = readCount(required(root, rows_key), rows_key);
-  if (rows_said != table.stateCount())
+  if (rows_said != row_count)
     refuse(std::string(rows_key) + " is " + std::to_string(rows_said) + " but the " +
-           (features.kind == FeatureKind::Tiles ? "tilings and tiles" : "bins") + " give " +
-           std::to_string(table.stateCount()));
-
+           (features.kind == FeatureKind::Tiles ? "tilings and tiles" : "bins") + " give " + std::to_string(row_count));
   const YAML::Node rows = required(root, "values");
   if (!rows.IsSequence())
     refuse("values is not a list of rows");
-  if (rows.size() != table.stateCount())
-    refuse("values has " + std::to_string(rows.size()) + " rows, expected " + std::to_string(table.stateCount()) +
+  if (rows.size() != row_count)
+    refuse("values has " + std::to_string(rows.size()) + " rows, expected " + std::to_string(row_count) +
            " (the file is truncated or its shape is wrong)");
+
+  QTable table(features, actions);
+  table.episodes = readCount(required(root, "episodes"), "episodes");
+  table.steps = readCount(required(root, "steps"), "steps");
   std::vector<double> values;
   values.reserve(table.stateCount() * table.actionCount());
   for (std::size_t s = 0; s < rows.size(); ++s)

@@ -945,6 +945,21 @@ bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::R
     response.message = "loaded " + path + " (" + std::to_string(episodes) + " episodes, " + std::to_string(steps) +
                        " steps of training)";
     ROS_INFO("qlearning_controller: load_q_table: %s", response.message.c_str());
+    if (learning_ && stats_csv_writer_)
+    {
+      // Training goes on from the loaded table's episode count; the curve follows it.
+      try
+      {
+        stats_csv_writer_->startOver();
+        ROS_INFO("qlearning_controller: the learning curve %s starts over from the loaded table's episode %llu",
+                 stats_csv_writer_->path().c_str(), static_cast<unsigned long long>(episodes));
+      }
+      catch (const FileError& e)
+      {
+        ROS_WARN("qlearning_controller: %s; the learning curve stops here", e.what());
+        stats_csv_writer_.reset();
+      }
+    }
   }
   catch (const std::exception& e)  // QTableFileError, or anything else: never out of a service
   {

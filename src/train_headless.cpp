@@ -35,7 +35,8 @@ void usage(std::ostream& out)
          "  --max-episodes N  override training/max_episodes\n"
          "  --stats-csv FILE  write one CSV row per episode there as it ends (the learning curve, for\n"
          "                    rosrun cartpole_qlearning plot_learning_curve FILE); FILE is taken as given\n"
-         "                    (relative to the current directory) and replaced if it exists\n"
+         "                    (relative to the current directory); an earlier curve there is replaced, any\n"
+         "                    other file refused\n"
          "  --quiet           no progress lines, only the result line\n"
          "  --trace           print every update as the tutorial works it (state, action, reward, next state,\n"
          "                    old Q, target, new Q) and the Q-table at each episode's end\n"
@@ -209,7 +210,9 @@ int run(int argc, char** argv)
     return 0;
   };
 
-  const std::vector<std::string> names = stateNames(config.agent);
+  // Only the trace and the replay name states (one name per table row: built for them alone).
+  const std::vector<std::string> names =
+      trace || !replay_path.empty() ? stateNames(config.agent) : std::vector<std::string>();
   if (!replay_path.empty())
   {
     if (robots != 1 || max_episodes != 0 || !stats_csv_path.empty())
@@ -288,7 +291,17 @@ int run(int argc, char** argv)
       // The robots' names as train.launch robots:=N gives them.
       const std::string robot = robots > 1 ? "robot_" + std::to_string(s.robot) : "";
       const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-      stats_csv->write(s, robot, now);
+      try
+      {
+        stats_csv->write(s, robot, now);
+      }
+      catch (const FileError& e)
+      {
+        // The curve is a by-product: training goes on, and its table is still saved.
+        std::cerr << "train_headless: --stats-csv: " << e.what() << "; the learning curve stops at episode "
+                  << s.episode - 1 << ", training goes on\n";
+        stats_csv.reset();
+      }
     }
     if (every == 0 || (s.episode % every != 0 && !config.limits.reached(s.episode, s.solved)))
       return;

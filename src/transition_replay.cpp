@@ -1,5 +1,7 @@
 #include "cartpole_qlearning/transition_replay.h"
 
+#include "cartpole_qlearning/file_access.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -156,12 +158,19 @@ std::vector<ReplayTransition> parseReplay(const std::string& text, const std::st
 std::vector<ReplayTransition> loadReplay(const std::string& path, const std::vector<std::string>& names,
                                          std::size_t action_count)
 {
-  std::ifstream in(path);
-  if (!in)
-    throw ReplayError(path + ": cannot be read");
-  std::stringstream text;
-  text << in.rdbuf();
-  return parseReplay(text.str(), path, names, action_count);
+  // A replay is a page of transitions typed by hand: a few MB is far more than anyone writes, and
+  // readFile refuses what is not a regular file (a FIFO would block, /dev/zero never end).
+  constexpr std::uint64_t kMaxReplayBytes = std::uint64_t(16) << 20;
+  std::string text;
+  try
+  {
+    text = readFile(path, kMaxReplayBytes);
+  }
+  catch (const FileError& e)
+  {
+    throw ReplayError(e.what());
+  }
+  return parseReplay(text, path, names, action_count);
 }
 
 void replayTransitions(QLearningAgent& agent, const std::vector<ReplayTransition>& transitions,

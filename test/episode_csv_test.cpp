@@ -56,6 +56,7 @@ protected:
     s.mean_return_window = 0.1 * static_cast<double>(n);
     s.epsilon = 1.0 / 3.0;
     s.alpha = 0.5;
+    s.gamma = 0.99;
     s.terminated = true;
     s.total_steps = 100 * n;
     return s;
@@ -74,7 +75,8 @@ TEST_F(EpisodeCsvTest, AHeaderThenOneRowPerEpisodeEachInTheFileAsSoonAsWritten)
     // Read while the writer is still open: a live reader sees every ended episode.
     ASSERT_EQ(n + 1, lines("runs/a/episodes.csv").size());
   }
-  EXPECT_EQ("2,,12,12,0.2,0.3333333333333333,0.5,true,false,false,200,1700000000.250", lines("runs/a/episodes.csv")[2]);
+  EXPECT_EQ("2,,12,12,0.2,0.3333333333333333,0.5,true,false,false,200,1700000000.250,0.99",
+            lines("runs/a/episodes.csv")[2]);
 }
 
 TEST_F(EpisodeCsvTest, NumbersReadBackAsTheSameDoubles)
@@ -87,10 +89,11 @@ TEST_F(EpisodeCsvTest, NumbersReadBackAsTheSameDoubles)
   std::vector<std::string> fields;
   for (std::string f; std::getline(in, f, ',');)
     fields.push_back(f);
-  ASSERT_EQ(12u, fields.size()) << row;
+  ASSERT_EQ(13u, fields.size()) << row;
   EXPECT_EQ("robot_1", fields[1]);
   EXPECT_EQ(s.mean_return_window, std::stod(fields[4]));
   EXPECT_EQ(s.epsilon, std::stod(fields[5]));
+  EXPECT_EQ(s.gamma, std::stod(fields[12]));  // live tuning may change it: the curve shows when
 }
 
 TEST_F(EpisodeCsvTest, ANewCurveReplacesWhatTheFileHeld)
@@ -134,10 +137,29 @@ TEST_F(EpisodeCsvTest, AResumedRunKeepsTheCheckpointsRowsWithoutASecondHeader)
   EXPECT_EQ(std::vector<std::string>{kEpisodeCsvHeader}, lines("new.csv"));
 }
 
-TEST_F(EpisodeCsvTest, AFileThatIsNotACurveIsRefusedOnResumeAndLeftAsItWas)
+TEST_F(EpisodeCsvTest, StartingOverLeavesTheHeaderAloneAndANumberingOfItsOwn)
+{
+  EpisodeCsvWriter csv(AppendingFile::openUnder(dir_.string(), "e.csv"));
+  for (std::uint64_t n = 1; n <= 5; ++n)
+    csv.write(episode(n), "", 0.0);
+  // A table of 300 episodes loaded: its episodes 301, 302 follow the header, nothing of before.
+  csv.startOver();
+  csv.write(episode(301), "", 0.0);
+  csv.write(episode(302), "", 0.0);
+  const std::vector<std::string> rows = lines("e.csv");
+  ASSERT_EQ(3u, rows.size());
+  EXPECT_EQ(kEpisodeCsvHeader, rows[0]);
+  EXPECT_EQ("301,", rows[1].substr(0, 4));
+  EXPECT_EQ("302,", rows[2].substr(0, 4));
+}
+
+TEST_F(EpisodeCsvTest, AFileThatIsNotACurveIsRefusedAndLeftAsItWas)
 {
   std::ofstream(dir_ / "notes.csv") << "name,score\nada,3\n";
   EXPECT_THROW(EpisodeCsvWriter(AppendingFile::openUnder(dir_.string(), "notes.csv"), 10), FileError);
+  EXPECT_EQ("name,score\nada,3\n", text("notes.csv"));
+  // A new run pointed at it by mistake (a Q-table's name, say) refuses it too, rather than empty it.
+  EXPECT_THROW(EpisodeCsvWriter(AppendingFile::openUnder(dir_.string(), "notes.csv")), FileError);
   EXPECT_EQ("name,score\nada,3\n", text("notes.csv"));
 }
 

@@ -28,7 +28,7 @@ import matplotlib.image  # noqa: E402
 PACKAGE = "cartpole_qlearning"
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCRIPT = os.path.join(HERE, "..", "scripts", "plot_learning_curve")
-HEADER = "episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,terminated,truncated,solved,total_steps,wall_time"
+HEADER = "episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,terminated,truncated,solved,total_steps,wall_time,gamma"
 
 RETURN_COLOUR = "#1f77b4"
 MEAN_COLOUR = "#ff7f0e"
@@ -71,7 +71,7 @@ def csv_text(episodes):
     lines = [HEADER]
     for x in episodes:
         lines.append(
-            "%d,,%d,%r,%r,%r,%r,%s,%s,%s,%d,%.3f"
+            "%d,,%d,%r,%r,%r,%r,%s,%s,%s,%d,%.3f,0.99"
             % (
                 x["episode"],
                 x["steps"],

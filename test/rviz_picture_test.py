@@ -3,8 +3,9 @@
 and -0.2 rad (one run of Xvfb, sim.launch mode:=lockstep rviz:=true and RViz, all its own) must
 show a drawn 3D view, the pole's colour, and the pole leaning the way theta says. The expected
 lean comes from the geometry alone: the URDF's pole joint axis and pole length, and the Orbit
-view of rviz/cartpole.rviz, projected; so a sim whose TF turns the pole the wrong way, a URDF
-axis flipped, or a camera looking from behind all fail here."""
+view of rviz/cartpole.rviz, projected; and, apart from them, the package's convention (theta > 0
+toward +x, +x drawn to the right), so a sim whose TF turns the pole the wrong way, a URDF axis
+flipped, or a camera looking from behind all fail here."""
 import math
 import os
 import sys
@@ -64,7 +65,21 @@ class RvizPictureTest(unittest.TestCase):
                          "the pole leans the wrong way: expected slope %+.3f column/row" % expected + where)
         self.assertAlmostEqual(measured.slope, expected, delta=0.25 * abs(expected),
                                msg="the pole's lean is not theta's: expected slope %+.3f column/row" % expected + where)
+        # Pinned apart from the model and the camera the expectation is computed from (a URDF
+        # axis flipped, or a view turned round, would move both alike): in this package's view,
+        # x to the right, theta > 0 leans the pole toward +x, its top right of its pivot.
+        self.assertEqual(math.copysign(1.0, measured.slope), -math.copysign(1.0, theta),
+                         "theta %+.1f should lean the pole's top to the %s" % (theta, "right" if theta > 0 else "left")
+                         + where)
         self.assertTrue(complete, "RViz's picture was not steady with the pole in it" + where)
+
+    def test_the_model_and_the_view_keep_the_packages_convention(self):
+        # DESIGN: theta > 0 leans the pole toward +x; the README's view shows +x to the right.
+        axis, _, top, _ = screenshot.pole_geometry(self.urdf)
+        self.assertGreater(screenshot.rotate(top, axis, THETA)[0], 0.0,
+                           "the URDF's pole joint turns a positive theta away from +x")
+        _, right, _, _ = screenshot.orbit_camera(self.config)
+        self.assertGreater(right[0], 0.0, "rviz/cartpole.rviz's view does not show +x to the right")
 
     def test_positive_theta_leans_as_the_geometry_says(self):
         self.check(THETA)

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -146,7 +147,7 @@ TEST_F(TrainHeadlessTest, TheStatsCsvHasOneRowPerEpisodeEndingWhereTheResultLine
   ASSERT_TRUE(std::getline(in, line));
   EXPECT_EQ(
       "episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,terminated,truncated,solved,total_steps,"
-      "wall_time",
+      "wall_time,gamma",
       line);
   unsigned long rows = 0;
   unsigned long summed_steps = 0;
@@ -154,7 +155,7 @@ TEST_F(TrainHeadlessTest, TheStatsCsvHasOneRowPerEpisodeEndingWhereTheResultLine
   while (std::getline(in, line))
   {
     row = fields(line);
-    ASSERT_EQ(12u, row.size()) << line;
+    ASSERT_EQ(13u, row.size()) << line;
     ++rows;
     EXPECT_EQ(std::to_string(rows), row[0]) << "rows out of order or missing at " << line;
     summed_steps += std::stoul(row[2]);
@@ -280,6 +281,20 @@ TEST_F(TrainHeadlessTest, BadReplayFileNamesTheLineAndRunsNothing)
     EXPECT_NE(std::string::npos, run.output.find(replay + " " + c.second)) << run.output;
     EXPECT_EQ(std::string::npos, run.output.find("episode 1 step")) << run.output;
     EXPECT_FALSE(fs::exists(saved)) << c.first;
+  }
+}
+
+// A replay path that is not a file (a folder, a FIFO that would block, /dev/zero that never
+// ends) is refused at once with its name, rather than hang or fill the memory.
+TEST_F(TrainHeadlessTest, AReplayThatIsNotAFileIsRefusedAtOnce)
+{
+  const std::string fifo = file("fifo.yaml");
+  ASSERT_EQ(0, ::mkfifo(fifo.c_str(), 0600));
+  for (const std::string& path : {dir_.string(), fifo, std::string("/dev/zero")})
+  {
+    const CommandRun run = trainHeadless(tutorialConfig() + " --replay " + path);
+    EXPECT_EQ(2, run.status) << run.output;
+    EXPECT_NE(std::string::npos, run.output.find("cannot read " + path + ": not a regular file")) << run.output;
   }
 }
 

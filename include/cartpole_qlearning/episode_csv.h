@@ -1,7 +1,7 @@
 // The learning curve as a file: one CSV row per episode, written as each episode ends, for
 // plot_learning_curve, a spreadsheet or pandas. The columns are those of EpisodeStats (the
 // learner's episode_stats), plus the wall-clock time the episode ended:
-//   episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,terminated,truncated,solved,total_steps,wall_time
+//   episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,terminated,truncated,solved,total_steps,wall_time,gamma
 // Numbers are written in their shortest exact form (a reader gets the very doubles back),
 // booleans as true/false, wall_time as Unix seconds.
 #pragma once
@@ -27,7 +27,8 @@ std::string episodeCsvRow(const EpisodeSummary& summary, const std::string& robo
 class EpisodeCsvWriter
 {
 public:
-  // A new curve: whatever the file held goes, and the header is written.
+  // A new curve: the curve the file held goes, and the header is written. A file that holds
+  // something else is refused (FileError) and left as it was.
   explicit EpisodeCsvWriter(AppendingFile file);
   // A run that goes on from its checkpoint after `episodes` episodes (a respawned controller):
   // the header and the rows of episodes up to that number stay, later rows go (the run plays
@@ -39,6 +40,9 @@ public:
   // Adds the episode's row: one write, so a reader following the file sees it whole at once.
   // Throws FileError.
   void write(const EpisodeSummary& summary, const std::string& robot, double wall_time);
+  // Empties the curve down to its header: a loaded table brings episode numbers of its own, and
+  // a curve holds one numbering (a resume keeps rows by their numbers). Throws FileError.
+  void startOver();
 
   const std::string& path() const
   {
