@@ -16,7 +16,7 @@ namespace
 void usage(std::ostream& out)
 {
   out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--save PATH] [--ns NS] [--max-episodes N] "
-         "[--quiet]\n"
+         "[--quiet] [--returns]\n"
          "  --config FILE     physics, task, learning and training parameters (YAML);\n"
          "                    default: the package's config/cartpole.yaml\n"
          "  --seed N          seed of the start states and of exploration (default 0)\n"
@@ -27,7 +27,9 @@ void usage(std::ostream& out)
          "                    evaluate.launch q_table:=PATH finds it; without --save nothing is written\n"
          "  --ns NS           the namespace whose table folder --save uses (default cartpole)\n"
          "  --max-episodes N  override training/max_episodes\n"
-         "  --quiet           no progress lines, only the result line\n";
+         "  --quiet           no progress lines, only the result line\n"
+         "  --returns         before the result line, one line \"returns=R1 R2 ...\": every episode's return, in "
+         "order\n";
 }
 
 bool parseCount(const std::string& text, std::uint64_t& value)
@@ -62,6 +64,7 @@ int run(int argc, char** argv)
   std::uint64_t max_episodes = 0;
   std::uint64_t robots = 1;
   bool quiet = false;
+  bool print_returns = false;
   for (int i = 1; i < argc; ++i)
   {
     const std::string arg = argv[i];
@@ -73,6 +76,8 @@ int run(int argc, char** argv)
     }
     else if (arg == "--quiet")
       quiet = true;
+    else if (arg == "--returns")
+      print_returns = true;
     else if (arg == "--config" && has_value)
       config_path = argv[++i];
     else if (arg == "--save" && has_value)
@@ -152,7 +157,14 @@ int run(int argc, char** argv)
   const std::uint64_t every = quiet ? 0 : config.limits.progress_every;
   std::uint64_t last_steps = 0;
   auto last_time = start;
+  std::string returns;
   const TrainingResult result = trainer.run([&](const EpisodeSummary& s) {
+    if (print_returns)
+    {
+      char text[32];
+      std::snprintf(text, sizeof text, "%s%.17g", returns.empty() ? "" : " ", s.episode_return);
+      returns += text;
+    }
     if (every == 0 || (s.episode % every != 0 && !config.limits.reached(s.episode, s.solved)))
       return;
     const auto now = std::chrono::steady_clock::now();
@@ -193,7 +205,10 @@ int run(int argc, char** argv)
   {
     std::printf("nothing saved (--save NAME writes the table to %s/NAME)\n", table_dir.c_str());
   }
-  std::printf("solved=%s episodes=%llu steps=%llu wall_s=%.3f\n", result.solved ? "true" : "false",
+  if (print_returns)
+    std::printf("returns=%s\n", returns.c_str());
+  // Microseconds: a run to solved takes a few milliseconds.
+  std::printf("solved=%s episodes=%llu steps=%llu wall_s=%.6f\n", result.solved ? "true" : "false",
               static_cast<unsigned long long>(result.episodes), static_cast<unsigned long long>(result.steps),
               result.wall_s);
   return status;
