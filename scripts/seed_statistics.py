@@ -39,17 +39,23 @@ CONFIG_DIR = os.path.join(REPO, "config")
 DEFAULT_ANCHOR = os.path.join(os.path.dirname(REPO), "shared", "anchors", "gym_tabular_q.py")
 ANCHOR_PYTHON = "/usr/bin/python3"  # Debian's, where python3-numpy is installed
 
+RETURNS = re.compile(r"^returns=([-0-9.e ]*)$", re.MULTILINE)
 RESULT = re.compile(r"^solved=(true|false) episodes=(\d+) steps=(\d+) wall_s=([0-9.]+)$")
 ANCHOR_RESULT = re.compile(r"^(solved|unsolved) seed=\d+ episodes=(\d+) steps=(\d+) wall_s=([0-9.]+)")
 
 # The shipped configs of the table, in its order: (file in config/, what the row is called).
-SHIPPED = [("cartpole.yaml", "default (bins)"), ("tiles.yaml", "tiles"), ("tutorial.yaml", "tutorial")]
+# CartPole-v1's solved criterion, which every shipped config keeps: a mean return of at least
+# SOLVED_RETURN over the last WINDOW episodes, each returning at most FULL_RETURN (500 steps).
+WINDOW, SOLVED_RETURN, FULL_RETURN = 100, 475, 500
+
+SHIPPED = [("cartpole.yaml", "default, bins"), ("tiles.yaml", "tile coding"), ("tutorial.yaml", "the tutorial's settings")]
 
 
 class Run:
     def __init__(self, seed, solved, episodes, steps, wall_s, line):
         self.seed, self.solved, self.episodes, self.steps, self.wall_s, self.line = (seed, solved, episodes, steps,
                                                                                       wall_s, line)
+        self.returns = None  # every episode's return, when asked for (train_headless --returns)
 
 
 class Summary:
@@ -125,6 +131,9 @@ def run_seeds(seeds, jobs, command_for, parse, label):
         done = subprocess.run(command, capture_output=True, text=True)
         lines = done.stdout.strip().splitlines()
         run = parse(seed, lines[-1]) if lines else None
+        returns = RETURNS.search(done.stdout)
+        if run is not None and returns:
+            run.returns = [float(value) for value in returns.group(1).split()]
         if run is None:
             sys.exit("%s, seed %d: %s failed (exit %d):\n%s%s" % (label, seed, " ".join(command), done.returncode,
                                                                     done.stdout, done.stderr))
@@ -148,11 +157,33 @@ def parse_anchor(seed, line):
     return Run(seed, match.group(1) == "solved", int(match.group(2)), int(match.group(3)), float(match.group(4)), line)
 
 
-def train_headless_runs(trainer, config, seeds, max_episodes, jobs):
+def train_headless_runs(trainer, config, seeds, max_episodes, jobs, returns=False):
     config_args = ["--config", config] if config else []
     episodes_args = ["--max-episodes", str(max_episodes)] if max_episodes else []
-    return run_seeds(seeds, jobs, lambda seed: trainer + ["--quiet", "--seed", str(seed)] + config_args + episodes_args,
+    returns_args = ["--returns"] if returns else []
+    return run_seeds(seeds, jobs,
+                     lambda seed: trainer + ["--quiet", "--seed", str(seed)] + config_args + episodes_args + returns_args,
                      parse_train_headless, config or "train_headless")
+
+
+def where_episodes_go(runs, window, full_return):
+    """Medians over the solved runs: the first episode that returned full_return, the episodes short
+    of it from there to solved, and the short episodes and the missing return in the solved window."""
+    first, short_after, short_in_window, missing = [], [], [], []
+    for run in runs:
+        if not run.solved or not run.returns:
+            continue
+        full = [i for i, value in enumerate(run.returns) if value >= full_return]
+        if not full:
+            continue
+        first.append(full[0] + 1)
+        short_after.append(sum(1 for value in run.returns[full[0]:] if value < full_return))
+        last = run.returns[-window:]
+        short_in_window.append(sum(1 for value in last if value < full_return))
+        missing.append(sum(full_return - value for value in last))
+    if not first:
+        return None
+    return [statistics.median(values) for values in (first, short_after, short_in_window, missing)]
 
 
 def config_max_episodes(config):
@@ -196,6 +227,15 @@ def cpu_model():
     return platform.processor() or "unknown CPU"
 
 
+def load_average():
+    """The 1-minute load average: above the CPU count, other processes were competing for the CPUs."""
+    try:
+        with open("/proc/loadavg") as load:
+            return load.read().split()[0]
+    except OSError:
+        return "unknown"
+
+
 def table_row(name, summary, count):
     steps, wall = summary.median_steps(), summary.median_wall_s()
     return "| %s | %d of %d | %s | %s | %s | %s | %s |" % (
@@ -206,7 +246,8 @@ def table_row(name, summary, count):
 
 def table(args, trainer):
     max_episodes = args.max_episodes or 2000
-    rows, notes = [], []
+    load_before = load_average()
+    rows, analysis, notes = [], [], []
     for file_name, name in SHIPPED:
         config = os.path.join(CONFIG_DIR, file_name)
         if not os.path.isfile(config):
@@ -215,10 +256,17 @@ def table(args, trainer):
             continue
         print("%s: seeds %s ..." % (file_name, describe_seeds(args.seeds)), file=sys.stderr, flush=True)
         summary = Summary(train_headless_runs(trainer, config, args.seeds, max_episodes, args.jobs), max_episodes)
-        rows.append(table_row("%s (`config/%s`)" % (name, file_name), summary, len(args.seeds)))
+        label = "`%s` (%s)" % (file_name, name)
+        rows.append(table_row(label, summary, len(args.seeds)))
+        # Once more with every episode's return (the same seeds give the same episodes), apart
+        # from the timed runs above.
+        medians = where_episodes_go(train_headless_runs(trainer, config, args.seeds, max_episodes, args.jobs, True),
+                                    WINDOW, FULL_RETURN)
+        if medians:
+            analysis.append("| %s | %g | %g | %g | %g |" % tuple([label] + medians))
 
     anchor = args.anchor
-    name = "Python anchor (`gym_tabular_q.py`, Gymnasium + numpy)"
+    name = "Python anchor `gym_tabular_q.py` (the tutorial's method with Gymnasium and numpy)"
     if not os.path.isfile(anchor):
         notes.append("The Python anchor was skipped: %s is not there (it sits beside the development tree, "
                      "not in a clone)." % anchor)
@@ -230,8 +278,8 @@ def table(args, trainer):
                          parse_anchor, "anchor")
         rows.append(table_row(name, Summary(runs, max_episodes), len(args.seeds)))
 
-    print("Seeds %s, at most %d episodes each; %s, %s; %s." %
-          (describe_seeds(args.seeds), max_episodes, cpu_model(), "%d CPUs" % os.cpu_count(),
+    print("Seeds %s, at most %d episodes each; %s, %d CPUs, load average %s before and %s after; %s." %
+          (describe_seeds(args.seeds), max_episodes, cpu_model(), os.cpu_count(), load_before, load_average(),
            datetime.date.today().isoformat()))
     print()
     print("| config | seeds solved | median episodes to solve | 90th percentile | worst | median steps to solve "
@@ -240,6 +288,18 @@ def table(args, trainer):
     for row in rows:
         print(row)
     print()
+    if analysis:
+        print("Where the episodes go (medians over the solved seeds; a window of %d episodes solves when it misses "
+              "at most %d of the %d steps it can hold):" % (WINDOW, WINDOW * (FULL_RETURN - SOLVED_RETURN),
+                                                            WINDOW * FULL_RETURN))
+        print()
+        print("| config | first episode returning %d | episodes short of %d after it, to solved "
+              "| short episodes in the solved window | return missing from the solved window |" % (FULL_RETURN,
+                                                                                                  FULL_RETURN))
+        print("| --- | --- | --- | --- | --- |")
+        for row in analysis:
+            print(row)
+        print()
     if args.jobs > 1:
         notes.append("Runs went %d at a time (-j %d): they shared the CPUs, so the wall times are noisier than "
                      "one at a time." % (args.jobs, args.jobs))
