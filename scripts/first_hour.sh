@@ -233,6 +233,10 @@ if start "sim.launch" "roslaunch cartpole_qlearning sim.launch"; then
   stop_launch "sim.launch ends on Ctrl-C" "$sim" "$sim_log"
 fi
 
+# RViz, by its picture: the README's picture made again here (Xvfb of its own: no display needed).
+run "rviz_screenshot" 120 0 "rosrun cartpole_qlearning rviz_screenshot --x 0.5 --theta 0.2 --out docs/images/rviz.png" \
+  "wrote docs/images/rviz.png"
+
 # Several robots, one learner.
 run "train.launch robots:=4" 300 0 "roslaunch cartpole_qlearning train.launch robots:=4" "SOLVED after"
 cp "$TABLES/q_table.yaml" "$WORK/four_robots.yaml"
@@ -246,9 +250,16 @@ run "train_headless --save headless.yaml" 120 0 "rosrun cartpole_qlearning train
   "saved the Q-table to $TABLES/headless.yaml" "^solved=true"
 run "evaluate.launch q_table:=headless.yaml" 120 0 \
   "roslaunch cartpole_qlearning evaluate.launch q_table:=headless.yaml episodes:=1" "EVALUATED 1 episodes: 1 balanced"
+# The tutorial's worked example: its exact values, and the trace on the graph.
+run "train_headless --replay tutorial_10_steps.yaml" 60 0 \
+  "rosrun cartpole_qlearning train_headless --config config/tutorial_4_states.yaml --replay config/tutorial_10_steps.yaml" \
+  "^  S0 upright +1\.117003125 +1\.380753125$" "^  S1 tilted left +1\.71037015625 +0$" "^  S2 tilted right +0 +0\.8155625$"
+run "train.launch trace:=true, the tutorial's 4 states" 120 0 \
+  "roslaunch cartpole_qlearning train.launch config:=\$(rospack find cartpole_qlearning)/config/tutorial_4_states.yaml trace:=true max_episodes:=3 ns:=tutorial" \
+  "episode 1 step 1: S0 upright --A" "Q-table after episode 3:" "NOT solved, max_episodes reached"
 run "seed_statistics.py" 120 0 "python3 scripts/seed_statistics.py --seeds 0-99" "seeds 0-99: solved 100 of 100"
 
-echo "[first-hour] not run: rqt_plot (Debian 12 ships no rqt), rviz:=true (needs a display), \
+echo "[first-hour] not run: rqt_plot (Debian 12 ships no rqt), rviz:=true (needs a display; rviz_screenshot ran RViz under Xvfb), \
 train_across_hosts.launch (needs ssh to other hosts), bench/ (minutes; figures, not checks)"
 printf '%s' "$SUMMARY" >"$WORK/summary.txt"
 echo "[first-hour] the commands and their times:"

@@ -24,6 +24,7 @@ DEBIAN_PACKAGES=(
   libroscpp-dev libroslib-dev libsensor-msgs-dev libstd-msgs-dev libgeometry-msgs-dev
   libros-rosgraph-msgs-dev libtf2-ros-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev libeigen3-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev catkin-lint rviz
+  python3-rospy xvfb imagemagick libgl1-mesa-dri python3-numpy python3-pil python3-yaml
   clang-14 libclang-rt-14-dev
 )
 

@@ -65,6 +65,24 @@ public:
     return true;
   }
 
+  bool get(const std::string& key, std::vector<std::string>& value) const override
+  {
+    const YAML::Node node = find(key);
+    if (!node)
+      return false;
+    if (!node.IsSequence())
+      throw ConfigError(origin_ + ": " + key + " must be a list of strings");
+    value.clear();
+    for (std::size_t i = 0; i < node.size(); ++i)
+    {
+      if (!node[i].IsScalar())
+        throw ConfigError(origin_ + ": " + key + "[" + std::to_string(i) + "] = '" + text(node[i]) +
+                          "' is not allowed (must be a string)");
+      value.push_back(node[i].Scalar());
+    }
+    return true;
+  }
+
   std::vector<std::string> keysUnder(const std::string& section) const override
   {
     std::vector<std::string> keys;
@@ -259,6 +277,7 @@ AgentParams readAgent(const ParameterSource& source)
   reader.readDimensions("upper_bounds", agent.discretiser.upper, false);
   readSchedule(reader, "epsilon", agent.epsilon);
   readSchedule(reader, "alpha", agent.alpha);
+  reader.read("state_names", agent.state_names);
   reader.refuseUnknown();
   reader.check(agent.validate());
   return agent;

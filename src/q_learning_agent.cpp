@@ -27,6 +27,46 @@ ScheduleParams AgentParams::defaultAlpha()
   return schedule;
 }
 
+namespace
+{
+// Names must tell the rows apart in the trace and in a replay file, each on one line.
+std::string stateNamesError(const std::vector<std::string>& names, const DiscretiserParams& discretiser)
+{
+  if (names.empty())
+    return "";
+  std::size_t states = 1;
+  for (const unsigned b : discretiser.bins)
+    states *= b;
+  std::ostringstream out;
+  if (names.size() != states + 1)
+  {
+    out << "state_names lists " << names.size() << " names, which is not allowed (must be " << states + 1
+        << ": one per table row (the bins give " << states << "), then the terminal state's)";
+    return out.str();
+  }
+  for (std::size_t i = 0; i < names.size(); ++i)
+  {
+    const std::string& name = names[i];
+    if (name.empty() || name.find_first_of("\n\r\t") != std::string::npos || name.front() == ' ' || name.back() == ' ')
+    {
+      out << "state_names[" << i << "] = '" << name
+          << "' is not allowed (must be a non-empty name on one line, without leading or trailing spaces)";
+      return out.str();
+    }
+    for (std::size_t j = 0; j < i; ++j)
+    {
+      if (names[j] == name)
+      {
+        out << "state_names[" << i << "] = '" << name << "' is not allowed (state_names[" << j
+            << "] has that name already)";
+        return out.str();
+      }
+    }
+  }
+  return "";
+}
+}  // namespace
+
 std::string AgentParams::validate() const
 {
   std::ostringstream out;
@@ -51,6 +91,9 @@ std::string AgentParams::validate() const
     out << "gamma = " << gamma << " is not allowed (must be in [0, 1])";
     return out.str();
   }
+  error = stateNamesError(state_names, discretiser);
+  if (!error.empty())
+    return error;
   error = epsilon.validate();
   if (!error.empty())
     return "epsilon/" + error;
@@ -88,12 +131,17 @@ std::size_t QLearningAgent::selectAction(std::size_t state, double epsilon)
   return table_.argmax(state);
 }
 
-void QLearningAgent::update(std::size_t state, std::size_t action, double reward, std::size_t next_state,
-                            bool next_is_terminal, double alpha)
+QUpdate QLearningAgent::update(std::size_t state, std::size_t action, double reward, std::size_t next_state,
+                               bool next_is_terminal, double alpha)
 {
-  const double future = next_is_terminal ? 0.0 : params_.gamma * table_.max(next_state);
+  QUpdate done;
+  done.next_max = next_is_terminal ? 0.0 : table_.max(next_state);
+  done.target = next_is_terminal ? reward : reward + params_.gamma * done.next_max;
   double& q = table_.at(state, action);
-  q += alpha * (reward + future - q);
+  done.old_value = q;
+  q += alpha * (done.target - q);
+  done.new_value = q;
+  return done;
 }
 
 std::string QLearningAgent::replaceTable(QTable table)

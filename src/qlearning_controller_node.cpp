@@ -81,6 +81,15 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   const std::lock_guard<std::mutex> lock(mutex_);
   readParameters();
   session_ = std::make_unique<TrainingSession>(config_.task, config_.agent, seed_, learning_, robot_names_.size());
+  if (trace_ && learning_)
+  {
+    state_names_ = stateNames(config_.agent);
+    session_->setTrace([this](std::size_t robot, const TraceStep& step) {
+      const std::string& name = robot_names_[robot];
+      ROS_INFO("%s%s", robot_names_.size() > 1 ? (name + ": ").c_str() : "",
+               traceLine(step, state_names_, config_.agent.actions).c_str());
+    });
+  }
   if (!load_on_start_.empty())
   {
     std::string path;
@@ -240,6 +249,7 @@ void QLearningControllerNode::readParameters()
   }
   readRobots(pnh_, priv, robot_names_);
   priv.read("sync", sync_);
+  priv.read("trace", trace_);
   priv.refuseUnknown();
   protocol_params_.limits = config_.limits;
 }
@@ -425,6 +435,14 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
     stats.total_steps = s.robot_total_steps;
     stats.steps_per_second = robot_wall > 0.0 ? s.steps / robot_wall : 0.0;
     robot.stats_pub.publish(stats);
+  }
+
+  if (trace_ && learning_)
+  {
+    const std::string which = robots_.size() > 1 ? robot.name + "'s episode " + std::to_string(s.robot_episode) + " (" +
+                                                       std::to_string(s.episode) + " in all)"
+                                                 : "episode " + std::to_string(s.episode);
+    ROS_INFO("Q-table after %s:\n%s", which.c_str(), qTableText(session_->table(), state_names_).c_str());
   }
 
   const TrainingLimits& limits = config_.limits;

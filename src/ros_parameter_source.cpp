@@ -108,6 +108,24 @@ bool RosParameterSource::get(const std::string& key, std::vector<double>& value)
   return true;
 }
 
+bool RosParameterSource::get(const std::string& key, std::vector<std::string>& value) const
+{
+  XmlRpcValue v;
+  if (!nh_.getParam(key, v))
+    return false;
+  if (v.getType() != XmlRpcValue::TypeArray)
+    throw ConfigError(describe(key) + " must be a list of strings");
+  value.clear();
+  for (int i = 0; i < v.size(); ++i)
+  {
+    if (v[i].getType() != XmlRpcValue::TypeString)
+      throw ConfigError(describe(key) + "[" + std::to_string(i) + "] = '" + v[i].toXml() +
+                        "' is not allowed (must be a string)");
+    value.push_back(static_cast<std::string>(v[i]));
+  }
+  return true;
+}
+
 std::vector<std::string> RosParameterSource::keysUnder(const std::string& section) const
 {
   std::vector<std::string> keys;

@@ -1,7 +1,10 @@
 // train_headless: trains with the core alone (no ROS master), prints progress and ends with
-// one line "solved=true|false episodes=N steps=M wall_s=T".
+// one line "solved=true|false episodes=N steps=M wall_s=T". With --replay it learns from the
+// transitions of a file instead (the tutorial's worked example), tracing each update.
 #include "cartpole_qlearning/headless_trainer.h"
 #include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/trace.h"
+#include "cartpole_qlearning/transition_replay.h"
 
 #include <ros/package.h>
 
@@ -16,7 +19,8 @@ namespace
 void usage(std::ostream& out)
 {
   out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--save PATH] [--ns NS] [--max-episodes N] "
-         "[--quiet] [--returns]\n"
+         "[--quiet]\n"
+         "                      [--returns] [--trace] [--replay FILE]\n"
          "  --config FILE     physics, task, learning and training parameters (YAML);\n"
          "                    default: the package's config/cartpole.yaml\n"
          "  --seed N          seed of the start states and of exploration (default 0)\n"
@@ -29,7 +33,13 @@ void usage(std::ostream& out)
          "  --max-episodes N  override training/max_episodes\n"
          "  --quiet           no progress lines, only the result line\n"
          "  --returns         before the result line, one line \"returns=R1 R2 ...\": every episode's return, in "
-         "order\n";
+         "order\n"
+         "  --trace           print every update as the tutorial works it (state, action, reward, next state,\n"
+         "                    old Q, target, new Q) and the Q-table at each episode's end\n"
+         "  --replay FILE     train on nothing else than the transitions listed in FILE ([state, action, reward,\n"
+         "                    next state], states named as the config's learning/state_names), traced as --trace\n"
+         "                    does; e.g. --config config/tutorial_4_states.yaml --replay "
+         "config/tutorial_10_steps.yaml\n";
 }
 
 bool parseCount(const std::string& text, std::uint64_t& value)
@@ -65,6 +75,8 @@ int run(int argc, char** argv)
   std::uint64_t robots = 1;
   bool quiet = false;
   bool print_returns = false;
+  bool trace = false;
+  std::string replay_path;
   for (int i = 1; i < argc; ++i)
   {
     const std::string arg = argv[i];
@@ -78,6 +90,10 @@ int run(int argc, char** argv)
       quiet = true;
     else if (arg == "--returns")
       print_returns = true;
+    else if (arg == "--trace")
+      trace = true;
+    else if (arg == "--replay" && has_value)
+      replay_path = argv[++i];
     else if (arg == "--config" && has_value)
       config_path = argv[++i];
     else if (arg == "--save" && has_value)
@@ -152,7 +168,83 @@ int run(int argc, char** argv)
   if (max_episodes > 0)
     config.limits.max_episodes = max_episodes;
 
+  // The one path rule: a relative table path is under the table folder (as the controller's
+  // services and the launch files take it); an absolute one is the user's own.
+  const std::string table_dir = defaultTableDirectory(name_space);
+  const auto save = [&](const QTable& table) {
+    if (!save_path.empty())
+    {
+      try
+      {
+        std::string written = save_path;
+        if (save_path.front() == '/')
+          saveQTableFile(table, save_path);
+        else
+        {
+          saveQTableUnder(table, table_dir, save_path);
+          written = resolvePathUnder(table_dir, save_path);
+        }
+        if (!quiet)
+          std::printf("saved the Q-table to %s\n", written.c_str());
+      }
+      catch (const QTableFileError& e)
+      {
+        std::cerr << "train_headless: " << e.what() << "\n";
+        return 1;
+      }
+    }
+    else if (!quiet)
+    {
+      std::printf("nothing saved (--save NAME writes the table to %s/NAME)\n", table_dir.c_str());
+    }
+    return 0;
+  };
+
+  const std::vector<std::string> names = stateNames(config.agent);
+  if (!replay_path.empty())
+  {
+    if (robots != 1 || max_episodes != 0)
+    {
+      std::cerr << "train_headless: --replay learns from its file alone: --robots and --max-episodes do not apply\n";
+      return 2;
+    }
+    // Every line is checked before the first update: a bad file changes nothing.
+    std::vector<ReplayTransition> transitions;
+    try
+    {
+      transitions = loadReplay(replay_path, names, config.agent.actions.size());
+    }
+    catch (const ReplayError& e)
+    {
+      std::cerr << "train_headless: " << e.what() << "\n";
+      return 2;
+    }
+    QLearningAgent agent(config.agent, seed);
+    std::printf("replaying %zu transitions of %s (gamma %s, alpha %s at episode 1)\n", transitions.size(),
+                replay_path.c_str(), traceNumber(config.agent.gamma).c_str(), traceNumber(agent.alpha(0)).c_str());
+    std::size_t number = 0;
+    replayTransitions(
+        agent, transitions,
+        [&](const ReplayTransition& t, const TraceStep& step) {
+          std::printf("#%zu (line %d) %s\n", ++number, t.line, traceLine(step, names, config.agent.actions).c_str());
+        },
+        [&](std::uint64_t episode) {
+          std::printf("Q-table after episode %llu:\n%s\n", static_cast<unsigned long long>(episode),
+                      qTableText(agent.table(), names).c_str());
+        });
+    std::printf("Q-table after transition %zu (the end of the replay):\n%s\n", transitions.size(),
+                qTableText(agent.table(), names).c_str());
+    return save(agent.table());
+  }
+
   HeadlessTrainer trainer(config, seed, robots);
+  if (trace)
+  {
+    trainer.session().setTrace([&](std::size_t robot, const TraceStep& step) {
+      const std::string who = robots > 1 ? "robot " + std::to_string(robot) + ": " : std::string();
+      std::printf("%s%s\n", who.c_str(), traceLine(step, names, config.agent.actions).c_str());
+    });
+  }
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t every = quiet ? 0 : config.limits.progress_every;
   std::uint64_t last_steps = 0;
@@ -165,6 +257,14 @@ int run(int argc, char** argv)
       std::snprintf(text, sizeof text, "%s%.17g", returns.empty() ? "" : " ", s.episode_return);
       returns += text;
     }
+    if (trace)
+    {
+      const std::string which = robots > 1 ? "robot " + std::to_string(s.robot) + "'s episode " +
+                                                 std::to_string(s.robot_episode) + " (" + std::to_string(s.episode) +
+                                                 " in all)"
+                                           : "episode " + std::to_string(s.episode);
+      std::printf("Q-table after %s:\n%s\n", which.c_str(), qTableText(trainer.session().table(), names).c_str());
+    }
     if (every == 0 || (s.episode % every != 0 && !config.limits.reached(s.episode, s.solved)))
       return;
     const auto now = std::chrono::steady_clock::now();
@@ -175,36 +275,7 @@ int run(int argc, char** argv)
     last_steps = s.total_steps;
     last_time = now;
   });
-
-  // The one path rule: a relative table path is under the table folder (as the controller's
-  // services and the launch files take it); an absolute one is the user's own.
-  const std::string table_dir = defaultTableDirectory(name_space);
-  int status = 0;
-  if (!save_path.empty())
-  {
-    try
-    {
-      std::string written = save_path;
-      if (save_path.front() == '/')
-        saveQTableFile(trainer.session().table(), save_path);
-      else
-      {
-        saveQTableUnder(trainer.session().table(), table_dir, save_path);
-        written = resolvePathUnder(table_dir, save_path);
-      }
-      if (!quiet)
-        std::printf("saved the Q-table to %s\n", written.c_str());
-    }
-    catch (const QTableFileError& e)
-    {
-      std::cerr << "train_headless: " << e.what() << "\n";
-      status = 1;
-    }
-  }
-  else if (!quiet)
-  {
-    std::printf("nothing saved (--save NAME writes the table to %s/NAME)\n", table_dir.c_str());
-  }
+  const int status = save(trainer.session().table());
   if (print_returns)
     std::printf("returns=%s\n", returns.c_str());
   // Microseconds: a run to solved takes a few milliseconds.

@@ -48,6 +48,7 @@ double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size
   e.epsilon = learning_ ? agent_.epsilon(episode) : 0.0;
   e.alpha = learning_ ? agent_.alpha(episode) : 0.0;
   e.running = true;
+  e.number = episodes_.size() == 1 ? last_.episode + 1 : e.ended + 1;
   e.steps = 0;
   e.episode_return = 0.0;
   e.state = agent_.discretiser().index(start_state);
@@ -65,8 +66,25 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   const std::size_t next_state = agent_.discretiser().index(state);
   if (learning_)
   {
-    agent_.update(e.state, e.action, decision.outcome.reward, next_state, decision.outcome.terminated, e.alpha);
+    const QUpdate update =
+        agent_.update(e.state, e.action, decision.outcome.reward, next_state, decision.outcome.terminated, e.alpha);
     ++agent_.table().steps;
+    if (trace_)
+    {
+      TraceStep step;
+      step.episode = e.number;
+      step.step = e.steps;
+      step.state = e.state;
+      step.action = e.action;
+      step.reward = decision.outcome.reward;
+      step.next_state = next_state;
+      step.terminal = decision.outcome.terminated;
+      step.truncated = decision.outcome.truncated;
+      step.alpha = e.alpha;
+      step.gamma = agent_.params().gamma;
+      step.update = update;
+      trace_(robot, step);
+    }
   }
 
   if (!decision.outcome.done())

@@ -20,36 +20,21 @@
 
 using cartpole_qlearning::EpisodeStats;
 using cartpole_qlearning::EpisodeStatsConstPtr;
+using cartpole_qlearning::test::ChildProcess;
 using cartpole_qlearning::test::spinUntil;
-using cartpole_qlearning::test::startProcess;
-using cartpole_qlearning::test::stopProcess;
 using cartpole_qlearning::test::uriOf;
 
 namespace
 {
 constexpr std::size_t kRobots = 3;
 
-pid_t startSim(std::size_t robot)
+ChildProcess startSim(std::size_t robot)
 {
-  return startProcess(CARTPOLE_SIM,
+  return ChildProcess(CARTPOLE_SIM,
                       {"__ns:=/fleet/robot_" + std::to_string(robot), "__name:=cartpole_sim", "_mode:=lockstep",
                        "_seed:=" + std::to_string(robot), "_publish_tf:=false", "_lockstep_timeout:=0.3"},
                       {"ROS_HOSTNAME=127.0.0." + std::to_string(robot + 1)});
 }
-
-// The sims this test started: stopped however the test ends.
-struct Sims
-{
-  std::array<pid_t, kRobots> pids{};
-  ~Sims()
-  {
-    for (const pid_t pid : pids)
-    {
-      if (pid > 0)
-        stopProcess(pid, SIGKILL);
-    }
-  }
-};
 
 }  // namespace
 
@@ -73,9 +58,10 @@ TEST(FleetHosts, TheLearnerGoesOnWithoutALostRobotAndTakesItBack)
           back_said = true;
       }));
 
-  Sims sims;
+  // Stopped however the test ends.
+  std::array<ChildProcess, kRobots> sims;
   for (std::size_t r = 0; r < kRobots; ++r)
-    sims.pids[r] = startSim(r);
+    sims[r] = startSim(r);
   const auto all_at_least = [&](std::size_t n) { return episodes[0] >= n && episodes[1] >= n && episodes[2] >= n; };
   ASSERT_TRUE(spinUntil([&] { return all_at_least(20); }, 60.0))
       << "training with three robots does not run: " << episodes[0] << ", " << episodes[1] << ", " << episodes[2];
@@ -87,7 +73,7 @@ TEST(FleetHosts, TheLearnerGoesOnWithoutALostRobotAndTakesItBack)
         << "robot_" << r << "'s sim is not bound to 127.0.0." << r + 1;
 
   // robot_2's host goes away: after sim_timeout (1 s) the learner leaves it out and goes on.
-  stopProcess(sims.pids[2], SIGKILL);
+  sims[2].stop(SIGKILL);
   ASSERT_TRUE(spinUntil([&] { return dropped_said; }, 15.0)) << "the learner did not say that robot_2 dropped out";
   const auto before = episodes;
   EXPECT_TRUE(spinUntil([&] { return episodes[0] >= before[0] + 20 && episodes[1] >= before[1] + 20; }, 30.0))
@@ -96,7 +82,7 @@ TEST(FleetHosts, TheLearnerGoesOnWithoutALostRobotAndTakesItBack)
   EXPECT_EQ(before[2], episodes[2]) << "episodes of a dead robot";
 
   // It comes back: the learner takes it into the rounds again and its episodes go on.
-  sims.pids[2] = startSim(2);
+  sims[2] = startSim(2);
   EXPECT_TRUE(spinUntil([&] { return back_said && episodes[2] >= before[2] + 10; }, 30.0))
       << "robot_2 was not taken back: " << episodes[2] - before[2] << " episodes since";
   const auto after = episodes;

@@ -19,9 +19,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+using cartpole_qlearning::test::ChildProcess;
 using cartpole_qlearning::test::spinUntil;
-using cartpole_qlearning::test::startProcess;
-using cartpole_qlearning::test::stopProcess;
 
 namespace
 {
@@ -59,14 +58,14 @@ TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
                                                     "_sim_timeout:=1.0",        "_checkpoint_every:=0",
                                                     "_save_on_shutdown:=false", "_max_episodes:=1000000",
                                                     "_stop_when_solved:=false", "_q_table_dir:=" + tableDir()};
-  pid_t sim = startProcess(CARTPOLE_SIM, sim_args);
-  pid_t controller = startProcess(QLEARNING_CONTROLLER, controller_args);
+  ChildProcess sim(CARTPOLE_SIM, sim_args);
+  ChildProcess controller(QLEARNING_CONTROLLER, controller_args);
   ASSERT_TRUE(spinUntil([&] { return episodes >= 20; }, 30.0)) << "training does not start: " << episodes;
 
   // The sim dies: the controller says so; a new sim comes and training goes on.
-  stopProcess(sim, SIGKILL);
+  sim.stop(SIGKILL);
   EXPECT_TRUE(spinUntil([&] { return silent_reported; }, 15.0)) << "the silent sim was not reported";
-  sim = startProcess(CARTPOLE_SIM, sim_args);
+  sim = ChildProcess(CARTPOLE_SIM, sim_args);
   std::size_t seen = episodes;
   EXPECT_TRUE(spinUntil([&] { return episodes >= seen + 20; }, 30.0))
       << "training did not resume after the sim restarted: " << episodes - seen << " episodes";
@@ -74,8 +73,8 @@ TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
   // The controller dies in the middle of an episode: a new one picks up the waiting state, and
   // training goes on within 5 s of its start.
   EXPECT_GT(commands, 0u) << "this test's joint_command subscription heard nothing";
-  stopProcess(controller, SIGKILL);
-  controller = startProcess(QLEARNING_CONTROLLER, controller_args);
+  controller.stop(SIGKILL);
+  controller = ChildProcess(QLEARNING_CONTROLLER, controller_args);
   const ros::WallTime restarted = ros::WallTime::now();
   seen = episodes;
   EXPECT_TRUE(spinUntil([&] { return episodes >= seen + 2; }, 5.0))
@@ -84,8 +83,8 @@ TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
       << "training did not go on after the controller restarted: " << episodes - seen << " episodes in "
       << (ros::WallTime::now() - restarted).toSec() << " s";
 
-  stopProcess(controller, SIGINT);
-  stopProcess(sim, SIGINT);
+  controller.stop(SIGINT);
+  sim.stop(SIGINT);
 }
 
 int main(int argc, char** argv)

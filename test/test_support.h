@@ -87,5 +87,53 @@ inline void stopProcess(pid_t pid, int signal)
   ::waitpid(pid, &status, 0);
 }
 
+// A process a test started: stopped with SIGKILL and reaped however the test ends (a failed
+// ASSERT returns early), so a failing run leaves no node behind to load the machine.
+class ChildProcess
+{
+public:
+  ChildProcess() = default;
+  ChildProcess(const std::string& executable, const std::vector<std::string>& args,
+               const std::vector<std::string>& environment = {})
+    : pid_(startProcess(executable, args, environment))
+  {
+  }
+  ~ChildProcess()
+  {
+    stop(SIGKILL);
+  }
+  ChildProcess(ChildProcess&& other) noexcept : pid_(other.pid_)
+  {
+    other.pid_ = -1;
+  }
+  ChildProcess& operator=(ChildProcess&& other) noexcept
+  {
+    if (this != &other)
+    {
+      stop(SIGKILL);
+      pid_ = other.pid_;
+      other.pid_ = -1;
+    }
+    return *this;
+  }
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  // Sends the signal and waits for the end (nothing when it was stopped already).
+  void stop(int signal)
+  {
+    if (pid_ > 0)
+      stopProcess(pid_, signal);
+    pid_ = -1;
+  }
+  pid_t pid() const
+  {
+    return pid_;
+  }
+
+private:
+  pid_t pid_ = -1;
+};
+
 }  // namespace test
 }  // namespace cartpole_qlearning

@@ -2,9 +2,11 @@
 #include "cartpole_qlearning/q_table_file.h"
 
 #include "test_support.h"
+#include "trace_check.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -23,6 +25,7 @@ namespace fs = std::filesystem;
 using cartpole_qlearning::test::CommandRun;
 using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::runCommand;
+using cartpole_qlearning::test::TraceReading;
 
 namespace
 {
@@ -35,6 +38,14 @@ std::string config()
 {
   return std::string("--config ") + CARTPOLE_CONFIG_DIR "/cartpole.yaml";
 }
+
+std::string tutorialConfig()
+{
+  return std::string("--config ") + CARTPOLE_CONFIG_DIR "/tutorial_4_states.yaml";
+}
+
+// learning/state_names of tutorial_4_states.yaml: the rows, then the terminal state.
+const std::vector<std::string> kTutorialNames{"S1 tilted left", "S0 upright", "S2 tilted right", "S3 fallen"};
 
 class TrainHeadlessTest : public ::testing::Test
 {
@@ -169,4 +180,96 @@ TEST_F(TrainHeadlessTest, BadArgumentsAreRefused)
   EXPECT_EQ(2, trainHeadless(config() + " --max-episodes 0").status);
   EXPECT_EQ(2, trainHeadless(config() + " --bogus").status);
   EXPECT_EQ(0, trainHeadless("--help").status);
+}
+
+// The tutorial's worked example (10 steps, alpha 0.5, gamma 0.9) replayed from the shipped file:
+// the values printed after every step are the tutorial's, exactly.
+TEST_F(TrainHeadlessTest, ReplayOfTheTutorialsTenStepsPrintsItsExactValues)
+{
+  const CommandRun run = trainHeadless(tutorialConfig() + " --replay " + CARTPOLE_CONFIG_DIR "/tutorial_10_steps.yaml");
+  ASSERT_EQ(0, run.status) << run.output;
+  const TraceReading trace(run.output, kTutorialNames);
+  EXPECT_EQ(std::vector<std::string>(), trace.check(2, 0.9, 0.5)) << run.output;
+
+  // Q(s,a) after each step, as fractions: 1/2, 29/40, -1/4, 561/800, 18849/16000, 1/2,
+  // 13049/16000, 441841/320000, 10946369/6400000, 357441/320000.
+  const std::vector<std::string> expected_new{"0.5", "0.725",     "-0.25",       "0.70125",       "1.1780625",
+                                              "0.5", "0.8155625", "1.380753125", "1.71037015625", "1.117003125"};
+  ASSERT_EQ(expected_new.size(), trace.updates.size()) << run.output;
+  for (std::size_t i = 0; i < expected_new.size(); ++i)
+    EXPECT_EQ(expected_new[i], trace.updates[i].new_value) << "step " << i + 1;
+  EXPECT_TRUE(trace.updates[2].terminal);
+  EXPECT_EQ("-1", trace.updates[2].target);
+
+  // A table when the fall ends episode 1, and the table after step 10.
+  ASSERT_EQ(2u, trace.tables.size()) << run.output;
+  EXPECT_EQ("episode 1", trace.tables[0].title);
+  EXPECT_EQ((std::vector<std::string>{"0", "-0.25"}), trace.tables[0].rows.at("S0 upright"));
+  EXPECT_EQ((std::vector<std::string>{"0.725", "0"}), trace.tables[0].rows.at("S1 tilted left"));
+  const auto& last = trace.tables[1].rows;
+  EXPECT_EQ((std::vector<std::string>{"1.117003125", "1.380753125"}), last.at("S0 upright"));
+  EXPECT_EQ((std::vector<std::string>{"1.71037015625", "0"}), last.at("S1 tilted left"));
+  EXPECT_EQ((std::vector<std::string>{"0", "0.8155625"}), last.at("S2 tilted right"));
+  EXPECT_EQ((std::vector<std::string>{"0", "0"}), last.at("S3 fallen"));
+}
+
+TEST_F(TrainHeadlessTest, ReplayWritesItsTableWhenAskedTo)
+{
+  const std::string saved = file("replayed.yaml");
+  const CommandRun run =
+      trainHeadless(tutorialConfig() + " --replay " + CARTPOLE_CONFIG_DIR + "/tutorial_10_steps.yaml --save " + saved);
+  ASSERT_EQ(0, run.status) << run.output;
+  const cartpole_qlearning::QTable table = cartpole_qlearning::loadQTableFile(saved);
+  EXPECT_EQ(1.117003125, table.at(1, 0));  // S0 upright is row 1
+  EXPECT_EQ(1u, table.episodes);
+  EXPECT_EQ(10u, table.steps);
+}
+
+// A replay file with a mistake is refused with the line it is on, before any update.
+TEST_F(TrainHeadlessTest, BadReplayFileNamesTheLineAndRunsNothing)
+{
+  const std::string head = "transitions:\n  - [S0 upright, A1, 1, S1 tilted left]\n";
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {head + "  - [S0 upright, A1, 1, S9 nowhere]\n", "line 3: unknown state 'S9 nowhere'"},
+      {head + "  - [S0 upright, A2, 1, S1 tilted left]\n", "line 3: action 'A2' is out of range"},
+      {head + "  - [S0 upright, A1, one, S1 tilted left]\n", "line 3: reward 'one' is not a number"},
+      {head + "  - [S3 fallen, A1, 1, S0 upright]\n", "line 3: 'S3 fallen' is the terminal state"},
+      {head + "  - [S0 upright, A1, 1]\n", "line 3: a transition must be a list [state, action, reward, next state]"},
+      {"steps:\n  - [S0 upright, A1, 1, S1 tilted left]\n", "line 1: unknown key 'steps'"},
+  };
+  const std::string saved = file("not_written.yaml");
+  for (const auto& c : cases)
+  {
+    const std::string replay = file("replay.yaml", c.first);
+    const CommandRun run = trainHeadless(tutorialConfig() + " --replay " + replay + " --save " + saved);
+    EXPECT_EQ(2, run.status) << run.output;
+    EXPECT_NE(std::string::npos, run.output.find(replay + " " + c.second)) << run.output;
+    EXPECT_EQ(std::string::npos, run.output.find("episode 1 step")) << run.output;
+    EXPECT_FALSE(fs::exists(saved)) << c.first;
+  }
+}
+
+// Training with --trace on the tutorial's 4 states: every printed update holds its arithmetic,
+// and a table, equal to what the updates printed so far, ends each episode.
+TEST_F(TrainHeadlessTest, TraceWhileTrainingHoldsItsArithmeticWithATableAtEachEpisodeEnd)
+{
+  const CommandRun run = trainHeadless(tutorialConfig() + " --trace --seed 3 --max-episodes 6");
+  ASSERT_EQ(0, run.status) << run.output;
+  EXPECT_EQ(0u, run.lastLine().find("solved=false episodes=6 steps=")) << run.lastLine();
+  const TraceReading trace(run.output, kTutorialNames);
+  EXPECT_EQ(std::vector<std::string>(), trace.check(2, 0.9, 0.5)) << run.output;
+  ASSERT_EQ(6u, trace.tables.size());
+  for (std::size_t e = 0; e < trace.tables.size(); ++e)
+    EXPECT_EQ("episode " + std::to_string(e + 1), trace.tables[e].title);
+  // One update per step, each episode ending on the fall, just before its table.
+  const std::string steps = run.lastLine().substr(run.lastLine().find("steps=") + 6);
+  EXPECT_EQ(std::stoul(steps), trace.updates.size());
+  EXPECT_EQ('t', trace.order.back());
+  for (std::size_t i = 1; i < trace.order.size(); ++i)
+    EXPECT_TRUE(trace.order[i] != 't' ||
+                trace.updates[std::count(trace.order.begin(), trace.order.begin() + i, 'u') - 1].terminal);
+
+  // Without --trace, no trace.
+  const CommandRun quiet = trainHeadless(tutorialConfig() + " --seed 3 --max-episodes 6");
+  EXPECT_TRUE(TraceReading(quiet.output, kTutorialNames).updates.empty()) << quiet.output;
 }

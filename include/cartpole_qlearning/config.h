@@ -40,6 +40,7 @@ public:
   virtual bool get(const std::string& key, bool& value) const = 0;
   virtual bool get(const std::string& key, std::string& value) const = 0;
   virtual bool get(const std::string& key, std::vector<double>& value) const = 0;
+  virtual bool get(const std::string& key, std::vector<std::string>& value) const = 0;
   // Every leaf key present below a section ("learning" -> "learning/gamma", "learning/epsilon/min", ...).
   virtual std::vector<std::string> keysUnder(const std::string& section) const = 0;
   // Where the parameters come from, for messages ("config/cartpole.yaml", "/cartpole").

@@ -134,6 +134,8 @@ private:
   std::vector<std::string> robot_names_{""};
   bool sync_ = true;
   ControllerProtocolParams protocol_params_;
+  bool trace_ = false;                    // ~trace: log every update and the table at each episode end
+  std::vector<std::string> state_names_;  // as the trace names the rows (trace.h)
 
   std::unique_ptr<TrainingSession> session_;
   std::vector<Robot> robots_;

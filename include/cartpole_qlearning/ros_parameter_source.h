@@ -19,6 +19,7 @@ public:
   bool get(const std::string& key, bool& value) const override;
   bool get(const std::string& key, std::string& value) const override;
   bool get(const std::string& key, std::vector<double>& value) const override;
+  bool get(const std::string& key, std::vector<std::string>& value) const override;
   std::vector<std::string> keysUnder(const std::string& section) const override;
   std::string origin() const override;
   std::string describe(const std::string& key) const override;

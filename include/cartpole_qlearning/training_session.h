@@ -12,9 +12,11 @@
 
 #include "cartpole_qlearning/cartpole_task.h"
 #include "cartpole_qlearning/q_learning_agent.h"
+#include "cartpole_qlearning/trace.h"
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -108,6 +110,13 @@ public:
     return episodes_.size();
   }
 
+  // Called with every update while learning (robot: whose step it was); empty: no trace.
+  using TraceSink = std::function<void(std::size_t robot, const TraceStep& step)>;
+  void setTrace(TraceSink sink)
+  {
+    trace_ = std::move(sink);
+  }
+
   // Valid once an episode has ended: the last one, of whichever robot.
   const EpisodeSummary& lastEpisode() const
   {
@@ -151,6 +160,7 @@ private:
   {
     explicit Episode(unsigned window) : returns(window) {}
     bool running = false;
+    std::uint64_t number = 0;  // as the trace numbers it (TraceStep::episode)
     std::size_t state = 0;
     std::size_t action = 0;
     unsigned steps = 0;
@@ -170,6 +180,7 @@ private:
   std::vector<Episode> episodes_;
   ReturnWindow returns_;  // every robot's episodes
   EpisodeSummary last_;
+  TraceSink trace_;
 };
 
 }  // namespace cartpole_qlearning

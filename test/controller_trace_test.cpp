@@ -1,0 +1,117 @@
+// The tutorial on the graph: roslaunch train.launch config:=tutorial_4_states.yaml trace:=true,
+// as a learner runs it (sim and controller in lockstep). Each update the controller logs holds
+// the tutorial's arithmetic (new = old + alpha * (target - old), target = r + gamma * max
+// Q(next) unless the pole fell), and a table, equal to what the updates logged, ends each episode.
+#include "ros_test_support.h"
+#include "test_support.h"
+#include "trace_check.h"
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using cartpole_qlearning::test::fileText;
+using cartpole_qlearning::test::runCommand;
+using cartpole_qlearning::test::startProcess;
+using cartpole_qlearning::test::TraceReading;
+
+namespace
+{
+std::string rosHome()
+{
+  std::string dir;
+  ros::param::get("~ros_home", dir);
+  return dir;
+}
+
+// roslaunch train.launch ARGS to its end (or a time limit); its whole output, nodes included.
+std::string launchToTheEnd(const std::string& name, const std::string& args, int& status)
+{
+  const std::string log = rosHome() + "/" + name + ".log";
+  fs::create_directories(rosHome());
+  const std::string roslaunch = runCommand("command -v roslaunch").lastLine();
+  const pid_t pid = startProcess(
+      "/bin/sh", {"-c", "exec " + roslaunch + " cartpole_qlearning train.launch " + args + " >" + log + " 2>&1"},
+      {"ROS_HOME=" + rosHome(), "PYTHONUNBUFFERED=1"});
+  status = -1;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(90);
+  while (std::chrono::steady_clock::now() < deadline)
+  {
+    int raw = 0;
+    if (::waitpid(pid, &raw, WNOHANG) == pid)
+    {
+      status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+      return fileText(log);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ::kill(pid, SIGINT);
+  ::waitpid(pid, nullptr, 0);
+  return fileText(log);
+}
+
+const std::vector<std::string> kTutorialNames{"S1 tilted left", "S0 upright", "S2 tilted right", "S3 fallen"};
+}  // namespace
+
+TEST(ControllerTrace, TheTutorialsArithmeticHoldsOnTheRunningGraph)
+{
+  int status = -1;
+  const std::string out = launchToTheEnd(
+      "trace", "ns:=tutorial trace:=true max_episodes:=4 config:=" CARTPOLE_CONFIG_DIR "/tutorial_4_states.yaml",
+      status);
+  ASSERT_EQ(0, status) << out;
+  const TraceReading trace(out, kTutorialNames);
+  EXPECT_EQ(std::vector<std::string>(), trace.check(2, 0.9, 0.5)) << out;
+  ASSERT_EQ(4u, trace.tables.size()) << out;
+  for (std::size_t e = 0; e < trace.tables.size(); ++e)
+    EXPECT_EQ("episode " + std::to_string(e + 1), trace.tables[e].title);
+  // Every step of the 4 episodes is traced, steps numbered from 1 in each, the last one a fall
+  // (the tutorial's 4 states cannot balance the pole to the step limit), then its table.
+  ASSERT_FALSE(trace.updates.empty());
+  std::size_t u = 0;
+  for (std::size_t i = 0; i < trace.order.size(); ++i)
+  {
+    if (trace.order[i] == 't')
+    {
+      ASSERT_GT(u, 0u);
+      EXPECT_TRUE(trace.updates[u - 1].terminal) << "a table after a step that did not fall";
+      continue;
+    }
+    const auto& step = trace.updates[u];
+    EXPECT_EQ(u == 0 || trace.updates[u - 1].terminal ? 1u : trace.updates[u - 1].step + 1, step.step);
+    ++u;
+  }
+  EXPECT_EQ(4u, trace.updates.back().episode);
+  EXPECT_NE(std::string::npos, out.find("NOT solved, max_episodes reached")) << out;
+}
+
+TEST(ControllerTrace, NoTraceUnlessAskedFor)
+{
+  int status = -1;
+  const std::string out = launchToTheEnd(
+      "quiet", "ns:=quiet max_episodes:=2 config:=" CARTPOLE_CONFIG_DIR "/tutorial_4_states.yaml", status);
+  ASSERT_EQ(0, status) << out;
+  const TraceReading trace(out, kTutorialNames);
+  EXPECT_TRUE(trace.updates.empty()) << out;
+  EXPECT_TRUE(trace.tables.empty()) << out;
+}
+
+int main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "controller_trace_test");
+  ros::NodeHandle nh;
+  const int result = RUN_ALL_TESTS();
+  fs::remove_all(rosHome());
+  return result;
+}
