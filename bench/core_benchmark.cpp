@@ -1,7 +1,7 @@
-// Speed of the ROS-free core: one physics step, one discretisation, one agent decision and
-// update, one training-session step, and a whole training run to solved, headless and through
-// the lockstep protocol's classes (LockstepLoopback). The same code runs inside the nodes, so
-// these are the ceilings the ROS graph can approach.
+// Speed of the ROS-free core: one physics step, one discretisation, one tile coding, one agent
+// decision and update (bins and tiles), one training-session step, and a whole training run to solved, headless and
+// through the lockstep protocol's classes (LockstepLoopback). The same code runs inside the nodes, so these are the
+// ceilings the ROS graph can approach.
 #include "cartpole_qlearning/cartpole_dynamics.h"
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/discretiser.h"
@@ -9,6 +9,7 @@
 #include "cartpole_qlearning/lockstep_loopback.h"
 #include "cartpole_qlearning/q_learning_agent.h"
 #include "cartpole_qlearning/random.h"
+#include "cartpole_qlearning/tile_coder.h"
 #include "cartpole_qlearning/training_session.h"
 
 #include <benchmark/benchmark.h>
@@ -87,6 +88,23 @@ void BM_DiscretiserIndex(benchmark::State& state)
 }
 BENCHMARK(BM_DiscretiserIndex);
 
+// The tiles of config/tiles.yaml, over states inside and outside their bounds.
+void BM_TileCoderActiveTiles(benchmark::State& state)
+{
+  const TileCoder coder(readAgent(*loadYamlParameters(CARTPOLE_TILES_CONFIG_FILE)).featureParams().tileCoder());
+  const std::vector<CartPoleState> states = randomStates(1.2, 1);
+  std::array<std::uint32_t, kMaxTilings> tiles;
+  std::size_t i = 0;
+  for (auto _ : state)
+  {
+    coder.activeTiles(states[i], tiles.data());
+    benchmark::DoNotOptimize(tiles);
+    i = (i + 1) % kStatePool;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_TileCoderActiveTiles);
+
 // One epsilon-greedy choice and one Q-learning update, as a training step makes them.
 void BM_AgentSelectUpdate(benchmark::State& state)
 {
@@ -109,6 +127,28 @@ void BM_AgentSelectUpdate(benchmark::State& state)
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_AgentSelectUpdate);
+
+// The same over the tiles of config/tiles.yaml: Q sums one weight per tiling.
+void BM_TilesAgentSelectUpdate(benchmark::State& state)
+{
+  QLearningAgent agent(readAgent(*loadYamlParameters(CARTPOLE_TILES_CONFIG_FILE)), 0);
+  const std::vector<CartPoleState> states = randomStates(1.0, 2);
+  std::vector<ActiveRows> visited(kStatePool);
+  for (std::size_t k = 0; k < kStatePool; ++k)
+    agent.activeRows(states[k], visited[k]);
+  std::size_t i = 0;
+  for (auto _ : state)
+  {
+    const ActiveRows& s = visited[i];
+    i = (i + 1) % kStatePool;
+    std::size_t action = agent.selectAction(s, 0.1);
+    agent.update(s, action, 1.0, visited[i], false, 0.1);
+    benchmark::DoNotOptimize(action);
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_TilesAgentSelectUpdate);
 
 // One TrainingSession::observe (judge, discretise, learn, choose), the controller node's work per
 // joint_states message. States stay inside the termination box, so an episode ends only by
@@ -135,9 +175,9 @@ BENCHMARK(BM_TrainingSessionObserve);
 // A whole training run with the shipped config/cartpole.yaml and seed 0, to the solved episode.
 // Both trainers make the same calls in the same order, so they run the same steps.
 template <typename Trainer>
-void trainingToSolved(benchmark::State& state)
+void trainingToSolved(benchmark::State& state, const char* config_file = CARTPOLE_CONFIG_FILE)
 {
-  const TrainingConfig config = readTrainingConfig(*loadYamlParameters(CARTPOLE_CONFIG_FILE));
+  const TrainingConfig config = readTrainingConfig(*loadYamlParameters(config_file));
   std::uint64_t steps = 0;
   std::uint64_t episodes = 0;
   for (auto _ : state)
@@ -147,7 +187,7 @@ void trainingToSolved(benchmark::State& state)
     benchmark::DoNotOptimize(result);
     if (!result.solved)
     {
-      state.SkipWithError("the default config did not solve with seed 0");
+      state.SkipWithError("the config did not solve with seed 0");
       break;
     }
     steps += result.steps;
@@ -165,6 +205,13 @@ void BM_HeadlessTrainingToSolved(benchmark::State& state)
 }
 // Wall time, as train_headless reports it (steps_per_s is then per wall second too).
 BENCHMARK(BM_HeadlessTrainingToSolved)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The same with config/tiles.yaml (tile coding), seed 0.
+void BM_HeadlessTilesTrainingToSolved(benchmark::State& state)
+{
+  trainingToSolved<HeadlessTrainer>(state, CARTPOLE_TILES_CONFIG_FILE);
+}
+BENCHMARK(BM_HeadlessTilesTrainingToSolved)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The lockstep loop without ROS: SimProtocol and ControllerProtocol between the simulation and
 // the session, messages as calls. Its difference from the headless run is the protocol's own

@@ -22,10 +22,12 @@ DEBIAN_PACKAGES=(
   rosbash python3-roslaunch python3-rostopic python3-rosservice python3-rosnode
   python3-sensor-msgs python3-geometry-msgs python3-tf2-msgs python3-std-msgs python3-rosgraph-msgs
   libroscpp-dev libroslib-dev libsensor-msgs-dev libstd-msgs-dev libgeometry-msgs-dev
-  libros-rosgraph-msgs-dev libtf2-ros-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev libeigen3-dev libyaml-cpp-dev
+  libros-rosgraph-msgs-dev libtf2-ros-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure libeigen3-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev catkin-lint rviz
   python3-rospy xvfb imagemagick libgl1-mesa-dri python3-numpy python3-pil python3-yaml
   clang-14 libclang-rt-14-dev
+  python3-matplotlib python3-numpy python3-rosbag python3-rospy python3-genpy
 )
 
 install_dependencies() {

@@ -272,7 +272,10 @@ AgentParams readAgent(const ParameterSource& source)
   SectionReader reader(source, "learning");
   reader.read("gamma", agent.gamma);
   reader.read("actions", agent.actions);
+  readEnum(reader, "features", agent.features, featureKindFromString);
   reader.readDimensions("bins", agent.discretiser.bins, true);
+  reader.read("tilings", agent.tilings, 1, kMaxTilings);
+  reader.readDimensions("tiles", agent.tiles, true);
   reader.readDimensions("lower_bounds", agent.discretiser.lower, false);
   reader.readDimensions("upper_bounds", agent.discretiser.upper, false);
   readSchedule(reader, "epsilon", agent.epsilon);

@@ -67,23 +67,7 @@ unsigned Discretiser::bin(std::size_t dimension, double value) const
   const unsigned n = params_.bins[dimension];
   if (n == 1)
     return 0;
-  const double lower = params_.lower[dimension];
-  const double upper = params_.upper[dimension];
-  if (!(value >= lower))  // below the range, or NaN
-    return 0;
-  if (value >= upper)
-    return n - 1;
-  const double width = (upper - lower) / n;
-  // The product can round across an edge; compare against the edge itself so that a value on an
-  // edge always lands in the bin that starts there.
-  unsigned i = static_cast<unsigned>((value - lower) / width);
-  if (i >= n)
-    i = n - 1;
-  if (value < lower + i * width)
-    --i;
-  else if (i + 1 < n && value >= lower + (i + 1) * width)
-    ++i;
-  return i;
+  return uniformBin(value, params_.lower[dimension], params_.upper[dimension], n);
 }
 
 std::size_t Discretiser::index(const CartPoleState& state) const

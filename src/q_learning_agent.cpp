@@ -1,5 +1,7 @@
 #include "cartpole_qlearning/q_learning_agent.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -67,10 +69,20 @@ std::string stateNamesError(const std::vector<std::string>& names, const Discret
 }
 }  // namespace
 
+FeatureParams AgentParams::featureParams() const
+{
+  FeatureParams params;
+  params.kind = features;
+  params.discretiser = discretiser;
+  params.tilings = tilings;
+  params.tiles = tiles;
+  return params;
+}
+
 std::string AgentParams::validate() const
 {
   std::ostringstream out;
-  std::string error = discretiser.validate();
+  std::string error = featureParams().validate();
   if (!error.empty())
     return error;
   if (actions.empty())
@@ -91,7 +103,10 @@ std::string AgentParams::validate() const
     out << "gamma = " << gamma << " is not allowed (must be in [0, 1])";
     return out.str();
   }
-  error = stateNamesError(state_names, discretiser);
+  // Names label table rows, one per state: tiles have no such rows.
+  error = features == FeatureKind::Tiles && !state_names.empty()
+              ? "state_names is not allowed with features tiles (it names the rows of bins, one per state)"
+              : stateNamesError(state_names, discretiser);
   if (!error.empty())
     return error;
   error = epsilon.validate();
@@ -116,32 +131,106 @@ const AgentParams& checked(const AgentParams& params)
 
 QLearningAgent::QLearningAgent(const AgentParams& params, std::uint64_t seed)
   : params_(checked(params)),
-    discretiser_(params.discretiser),
+    features_(params.featureParams()),
     epsilon_(params.epsilon),
     alpha_(params.alpha),
-    table_(params.discretiser, params.actions),
+    table_(params.featureParams(), params.actions),
     rng_(seed, kAgentStream)
 {
 }
 
-std::size_t QLearningAgent::selectAction(std::size_t state, double epsilon)
+double QLearningAgent::value(const ActiveRows& state, std::size_t action) const
+{
+  double q = table_.at(state.rows[0], action);
+  for (unsigned i = 1; i < state.count; ++i)
+    q += table_.at(state.rows[i], action);
+  return q;
+}
+
+std::size_t QLearningAgent::greedyAction(const ActiveRows& state, double* best_q) const
+{
+  const std::size_t actions = table_.actionCount();
+  // Row by row, all actions at once: each row's weights are contiguous.
+  std::array<double, kMaxActions> q;
+  const double* const values = table_.values().data();
+  const double* first = values + state.rows[0] * actions;
+  std::copy(first, first + actions, q.begin());
+  for (unsigned i = 1; i < state.count; ++i)
+  {
+    const double* row = values + state.rows[i] * actions;
+    for (std::size_t a = 0; a < actions; ++a)
+      q[a] += row[a];
+  }
+  std::size_t best = 0;
+  for (std::size_t a = 1; a < actions; ++a)
+  {
+    if (q[a] > q[best])
+      best = a;
+  }
+  if (best_q != nullptr)
+    *best_q = q[best];
+  return best;
+}
+
+std::size_t QLearningAgent::greedyAction(const ActiveRows& state) const
+{
+  if (state.count == 1)
+    return table_.argmax(state.rows[0]);
+  return greedyAction(state, nullptr);
+}
+
+double QLearningAgent::maxValue(const ActiveRows& state) const
+{
+  if (state.count == 1)
+    return table_.max(state.rows[0]);
+  double best_q = 0.0;
+  greedyAction(state, &best_q);
+  return best_q;
+}
+
+std::size_t QLearningAgent::selectAction(const ActiveRows& state, double epsilon)
 {
   if (rng_.uniform01() < epsilon)
     return static_cast<std::size_t>(rng_.uniformIndex(table_.actionCount()));
-  return table_.argmax(state);
+  return greedyAction(state);
 }
 
-QUpdate QLearningAgent::update(std::size_t state, std::size_t action, double reward, std::size_t next_state,
+QUpdate QLearningAgent::update(const ActiveRows& state, std::size_t action, double reward, const ActiveRows& next_state,
                                bool next_is_terminal, double alpha)
 {
   QUpdate done;
-  done.next_max = next_is_terminal ? 0.0 : table_.max(next_state);
+  done.next_max = next_is_terminal ? 0.0 : maxValue(next_state);
   done.target = next_is_terminal ? reward : reward + params_.gamma * done.next_max;
-  double& q = table_.at(state, action);
-  done.old_value = q;
-  q += alpha * (done.target - q);
-  done.new_value = q;
+  if (state.count == 1)
+  {
+    // Bins: one row, the arithmetic in the order it always had (a seed's table stays the same).
+    double& q = table_.at(state.rows[0], action);
+    done.old_value = q;
+    q += alpha * (done.target - q);
+    done.new_value = q;
+    return done;
+  }
+  done.old_value = value(state, action);
+  const double step = alpha / state.count * (done.target - done.old_value);
+  for (unsigned i = 0; i < state.count; ++i)
+    table_.at(state.rows[i], action) += step;
+  done.new_value = value(state, action);
   return done;
+}
+
+std::string QLearningAgent::setLearning(double gamma, const ScheduleParams& epsilon, const ScheduleParams& alpha)
+{
+  AgentParams candidate = params_;
+  candidate.gamma = gamma;
+  candidate.epsilon = epsilon;
+  candidate.alpha = alpha;
+  const std::string error = candidate.validate();
+  if (!error.empty())
+    return error;
+  params_ = std::move(candidate);
+  epsilon_ = Schedule(epsilon);
+  alpha_ = Schedule(alpha);
+  return "";
 }
 
 std::string QLearningAgent::replaceTable(QTable table)

@@ -5,8 +5,23 @@
 
 namespace cartpole_qlearning
 {
+namespace
+{
+FeatureParams binsOf(const DiscretiserParams& discretiser)
+{
+  FeatureParams features;
+  features.discretiser = discretiser;
+  return features;
+}
+}  // namespace
+
 QTable::QTable(const DiscretiserParams& discretiser, const std::vector<double>& actions)
-  : discretiser_(discretiser), actions_(actions), state_count_(Discretiser(discretiser).stateCount())
+  : QTable(binsOf(discretiser), actions)
+{
+}
+
+QTable::QTable(const FeatureParams& features, const std::vector<double>& actions)
+  : features_(features), actions_(actions), state_count_(FeatureMap(features).rowCount())
 {
   if (actions_.empty())
     throw std::invalid_argument("a Q-table needs at least one action");
@@ -42,34 +57,27 @@ void QTable::setValues(std::vector<double> values)
   values_ = std::move(values);
 }
 
-namespace
-{
-template <typename Container>
-std::string listText(const Container& values)
-{
-  std::ostringstream out;
-  out.precision(17);
-  out << "[";
-  bool first = true;
-  for (const auto& v : values)
-  {
-    out << (first ? "" : ", ") << v;
-    first = false;
-  }
-  out << "]";
-  return out.str();
-}
-}  // namespace
-
 std::string QTable::shapeMismatch(const QTable& other) const
 {
-  if (discretiser_.bins != other.discretiser_.bins)
-    return "bins " + listText(other.discretiser_.bins) + " differ from " + listText(discretiser_.bins);
-  if (!(discretiser_ == other.discretiser_))
-    return "bin bounds lower " + listText(other.discretiser_.lower) + " upper " + listText(other.discretiser_.upper) +
-           " differ from lower " + listText(discretiser_.lower) + " upper " + listText(discretiser_.upper);
+  const std::string features = features_.mismatch(other.features_);
+  if (!features.empty())
+    return features;
   if (actions_ != other.actions_)
-    return "actions " + listText(other.actions_) + " differ from " + listText(actions_);
+  {
+    std::ostringstream out;
+    out.precision(17);
+    const auto list = [&out](const std::vector<double>& values) {
+      out << "[";
+      for (std::size_t i = 0; i < values.size(); ++i)
+        out << (i ? ", " : "") << values[i];
+      out << "]";
+    };
+    out << "actions ";
+    list(other.actions_);
+    out << " differ from ";
+    list(actions_);
+    return out.str();
+  }
   return "";
 }
 

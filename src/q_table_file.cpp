@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
@@ -48,10 +50,16 @@ private:
 std::string checksumOf(const QTable& table)
 {
   Checksum sum;
-  const DiscretiserParams& d = table.discretiser();
+  const FeatureParams& f = table.features();
+  const DiscretiserParams& d = f.discretiser;
+  // A bins table sums as version 1 did, so that version 1 files keep their checksums; a tiles
+  // table sums its tilings first and its tiles in place of the bins.
+  const bool tiles = f.kind == FeatureKind::Tiles;
+  if (tiles)
+    sum.add(static_cast<std::uint64_t>(f.tilings));
   for (std::size_t i = 0; i < kStateDimensions; ++i)
   {
-    sum.add(static_cast<std::uint64_t>(d.bins[i]));
+    sum.add(static_cast<std::uint64_t>(tiles ? f.tiles[i] : d.bins[i]));
     sum.add(d.lower[i]);
     sum.add(d.upper[i]);
   }
@@ -160,26 +168,43 @@ std::uint64_t readCount(const YAML::Node& node, const std::string& where)
 
 std::string formatQTable(const QTable& table)
 {
-  const DiscretiserParams& d = table.discretiser();
+  const FeatureParams& f = table.features();
+  const DiscretiserParams& d = f.discretiser;
+  const bool tiles = f.kind == FeatureKind::Tiles;
   std::ostringstream out;
   out << "# Q-table of cartpole_qlearning. The checksum covers every number below: edit by hand and the\n"
       << "# file will be refused.\n"
       << "format: " << kFormatName << "\n"
-      << "version: " << kQTableFormatVersion << "\n"
-      << "# Discretisation: uniform bins per state dimension; values outside the bounds go to the end bins.\n"
-      << "dimensions: [x, x_dot, theta, theta_dot]\n"
-      << "bins: " << flowList(d.bins) << "\n"
-      << "lower_bounds: " << flowList(d.lower) << "\n"
+      << "version: " << kQTableFormatVersion << "\n";
+  if (tiles)
+    out << "# Features: tile coding. Each of the tilings is a grid of tiles over the bounds (one tile more\n"
+        << "# than 'tiles' along a used dimension), tiling i displaced by i * (1, 3, 5, 7) / tilings of a\n"
+        << "# tile along the used dimensions; values outside the bounds go to the edge tiles.\n"
+        << "# Q(s, a) is the sum of the active tile of every tiling's value.\n"
+        << "features: tiles\n"
+        << "dimensions: [x, x_dot, theta, theta_dot]\n"
+        << "tilings: " << f.tilings << "\n"
+        << "tiles: " << flowList(f.tiles) << "\n";
+  else
+    out << "# Features: uniform bins per state dimension; values outside the bounds go to the end bins.\n"
+        << "features: bins\n"
+        << "dimensions: [x, x_dot, theta, theta_dot]\n"
+        << "bins: " << flowList(d.bins) << "\n";
+  out << "lower_bounds: " << flowList(d.lower) << "\n"
       << "upper_bounds: " << flowList(d.upper) << "\n"
       << "# The effort [N] of each action: one column of values per action.\n"
       << "actions: " << flowList(table.actions()) << "\n"
       << "# Training that produced this table.\n"
       << "episodes: " << table.episodes << "\n"
       << "steps: " << table.steps << "\n"
-      << "states: " << table.stateCount() << "\n"
-      << "checksum: " << checksumOf(table) << "\n"
-      << "# One row per state: the bins combined in mixed radix, x most significant.\n"
-      << "values:\n";
+      << "rows: " << table.stateCount() << "\n"
+      << "checksum: " << checksumOf(table) << "\n";
+  if (tiles)
+    out << "# One row per tile: tiling by tiling, and within a tiling the tiles combined in mixed radix,\n"
+        << "# x most significant.\n";
+  else
+    out << "# One row per state: the bins combined in mixed radix, x most significant.\n";
+  out << "values:\n";
   for (std::size_t s = 0; s < table.stateCount(); ++s)
   {
     out << "  - [";
@@ -189,6 +214,24 @@ std::string formatQTable(const QTable& table)
   }
   return out.str();
 }
+
+namespace
+{
+// A list of 4 whole numbers in [1, kMaxBinsPerDimension] (bins or tiles).
+std::array<unsigned, kStateDimensions> readCounts(const YAML::Node& root, const char* key)
+{
+  const std::vector<double> counts = readNumbers(required(root, key), key, kStateDimensions);
+  std::array<unsigned, kStateDimensions> values{};
+  for (std::size_t i = 0; i < kStateDimensions; ++i)
+  {
+    if (counts[i] != std::floor(counts[i]) || counts[i] < 1 || counts[i] > kMaxBinsPerDimension)
+      refuse(std::string(key) + "[" + std::to_string(i) + "] is not a whole number in [1, " +
+             std::to_string(kMaxBinsPerDimension) + "]");
+    values[i] = static_cast<unsigned>(counts[i]);
+  }
+  return values;
+}
+}  // namespace
 
 QTable parseQTable(const std::string& text)
 {
@@ -207,37 +250,54 @@ QTable parseQTable(const std::string& text)
   if (!format.IsScalar() || format.Scalar() != kFormatName)
     refuse("not a Q-table file (format is not '" + std::string(kFormatName) + "')");
   const YAML::Node version = required(root, "version");
-  if (!version.IsScalar() || version.Scalar() != std::to_string(kQTableFormatVersion))
+  const bool version1 = version.IsScalar() && version.Scalar() == "1";
+  if (!version1 && !(version.IsScalar() && version.Scalar() == std::to_string(kQTableFormatVersion)))
     refuse("format version " + (version.IsScalar() ? version.Scalar() : std::string("?")) +
-           " is not supported (this build reads version " + std::to_string(kQTableFormatVersion) + ")");
+           " is not supported (this build reads versions 1 and " + std::to_string(kQTableFormatVersion) + ")");
 
-  DiscretiserParams discretiser;
-  const std::vector<double> bins = readNumbers(required(root, "bins"), "bins", kStateDimensions);
+  // Version 1 had bins only and no 'features' key.
+  FeatureParams features;
+  if (!version1)
+  {
+    const YAML::Node kind = required(root, "features");
+    if (!kind.IsScalar() || (kind.Scalar() != "bins" && kind.Scalar() != "tiles"))
+      refuse("features is not 'bins' or 'tiles'");
+    features.kind = featureKindFromString(kind.Scalar());
+  }
+  DiscretiserParams& discretiser = features.discretiser;
+  if (features.kind == FeatureKind::Tiles)
+  {
+    const double tilings = readNumber(required(root, "tilings"), "tilings");
+    if (tilings != std::floor(tilings) || tilings < 1 || tilings > kMaxTilings)
+      refuse("tilings is not a whole number in [1, " + std::to_string(kMaxTilings) + "]");
+    features.tilings = static_cast<unsigned>(tilings);
+    features.tiles = readCounts(root, "tiles");
+  }
+  else
+  {
+    discretiser.bins = readCounts(root, "bins");
+  }
   const std::vector<double> lower = readNumbers(required(root, "lower_bounds"), "lower_bounds", kStateDimensions);
   const std::vector<double> upper = readNumbers(required(root, "upper_bounds"), "upper_bounds", kStateDimensions);
-  for (std::size_t i = 0; i < kStateDimensions; ++i)
-  {
-    if (bins[i] != std::floor(bins[i]) || bins[i] < 1 || bins[i] > kMaxBinsPerDimension)
-      refuse("bins[" + std::to_string(i) + "] is not a whole number in [1, " + std::to_string(kMaxBinsPerDimension) +
-             "]");
-    discretiser.bins[i] = static_cast<unsigned>(bins[i]);
-    discretiser.lower[i] = lower[i];
-    discretiser.upper[i] = upper[i];
-  }
-  const std::string invalid = discretiser.validate();
+  std::copy(lower.begin(), lower.end(), discretiser.lower.begin());
+  std::copy(upper.begin(), upper.end(), discretiser.upper.begin());
+  const std::string invalid = features.validate();
   if (!invalid.empty())
-    refuse("invalid discretisation: " + invalid);
+    refuse("invalid " + toString(features.kind) + ": " + invalid);
   const std::vector<double> actions = readNumbers(required(root, "actions"), "actions", 0);
   if (actions.empty() || actions.size() > kMaxActions)
     refuse("actions has " + std::to_string(actions.size()) + " entries (allowed: 1 to " + std::to_string(kMaxActions) +
            ")");
 
-  QTable table(discretiser, actions);
+  QTable table(features, actions);
   table.episodes = readCount(required(root, "episodes"), "episodes");
   table.steps = readCount(required(root, "steps"), "steps");
-  const std::uint64_t states = readCount(required(root, "states"), "states");
-  if (states != table.stateCount())
-    refuse("states is " + std::to_string(states) + " but the bins give " + std::to_string(table.stateCount()));
+  const char* const rows_key = version1 ? "states" : "rows";
+  const std::uint64_t rows_said = readCount(required(root, rows_key), rows_key);
+  if (rows_said != table.stateCount())
+    refuse(std::string(rows_key) + " is " + std::to_string(rows_said) + " but the " +
+           (features.kind == FeatureKind::Tiles ? "tilings and tiles" : "bins") + " give " +
+           std::to_string(table.stateCount()));
 
   const YAML::Node rows = required(root, "values");
   if (!rows.IsSequence())

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <sstream>
+#include <tuple>
 
 #include <unistd.h>
 
@@ -71,6 +72,140 @@ int jointIndex(const sensor_msgs::JointState& msg, const char* name)
   const auto it = std::find(msg.name.begin(), msg.name.end(), name);
   return it == msg.name.end() ? -1 : static_cast<int>(it - msg.name.begin());
 }
+
+// Live tuning: the server's fields <-> the core's settings. An override is off when negative.
+LearningConfig toConfig(const LearningSettings& s)
+{
+  LearningConfig c = LearningConfig::__getDefault__();
+  c.epsilon_override = s.epsilon_override.value_or(-1.0);
+  c.alpha_override = s.alpha_override.value_or(-1.0);
+  c.gamma = s.gamma;
+  c.epsilon_schedule = toString(s.epsilon.type);
+  c.epsilon_start = s.epsilon.start;
+  c.epsilon_min = s.epsilon.min;
+  c.epsilon_decay_episodes = s.epsilon.decay_episodes;
+  c.epsilon_decay_rate = s.epsilon.decay_rate;
+  c.epsilon_log_divisor = s.epsilon.log_divisor;
+  c.alpha_schedule = toString(s.alpha.type);
+  c.alpha_start = s.alpha.start;
+  c.alpha_min = s.alpha.min;
+  c.alpha_decay_episodes = s.alpha.decay_episodes;
+  c.alpha_decay_rate = s.alpha.decay_rate;
+  c.alpha_log_divisor = s.alpha.log_divisor;
+  return c;
+}
+
+// Empty when every field could be read (the values themselves are the core's to check); a
+// schedule name the core does not know leaves that schedule's type as it was.
+std::string fromConfig(const LearningConfig& c, LearningSettings& s)
+{
+  const auto rate = [](double value) { return value < 0.0 ? std::nullopt : std::optional<double>(value); };
+  s.epsilon_override = rate(c.epsilon_override);
+  s.alpha_override = rate(c.alpha_override);
+  s.gamma = c.gamma;
+  s.epsilon.start = c.epsilon_start;
+  s.epsilon.min = c.epsilon_min;
+  s.epsilon.decay_episodes = c.epsilon_decay_episodes;
+  s.epsilon.decay_rate = c.epsilon_decay_rate;
+  s.epsilon.log_divisor = c.epsilon_log_divisor;
+  s.alpha.start = c.alpha_start;
+  s.alpha.min = c.alpha_min;
+  s.alpha.decay_episodes = c.alpha_decay_episodes;
+  s.alpha.decay_rate = c.alpha_decay_rate;
+  s.alpha.log_divisor = c.alpha_log_divisor;
+  const std::tuple<const char*, const std::string&, ScheduleType&> types[] = {
+      {"epsilon", c.epsilon_schedule, s.epsilon.type}, {"alpha", c.alpha_schedule, s.alpha.type}};
+  for (const auto& [name, text, type] : types)
+  {
+    try
+    {
+      type = scheduleTypeFromString(text);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      return std::string(name) + "_schedule = '" + text + "' is not allowed (" + e.what() + ")";
+    }
+  }
+  return "";
+}
+
+// Each field as the server names it, with its value as text.
+std::vector<std::pair<std::string, std::string>> fieldsOf(const LearningSettings& s)
+{
+  const auto number = [](double value) {
+    std::ostringstream out;
+    out << value;
+    return out.str();
+  };
+  const auto override = [&](const std::optional<double>& value) { return value ? number(*value) : "none"; };
+  std::vector<std::pair<std::string, std::string>> fields{{"epsilon_override", override(s.epsilon_override)},
+                                                          {"alpha_override", override(s.alpha_override)},
+                                                          {"gamma", number(s.gamma)}};
+  for (const auto& [name, p] : {std::make_pair("epsilon_", &s.epsilon), std::make_pair("alpha_", &s.alpha)})
+  {
+    fields.emplace_back(name + std::string("schedule"), toString(p->type));
+    fields.emplace_back(name + std::string("start"), number(p->start));
+    fields.emplace_back(name + std::string("min"), number(p->min));
+    fields.emplace_back(name + std::string("decay_episodes"), number(p->decay_episodes));
+    fields.emplace_back(name + std::string("decay_rate"), number(p->decay_rate));
+    fields.emplace_back(name + std::string("log_divisor"), number(p->log_divisor));
+  }
+  return fields;
+}
+
+// "gamma 0.99 -> 0.95, epsilon_override none -> 0" ("" when nothing differs).
+std::string changesText(const LearningSettings& before, const LearningSettings& after)
+{
+  const auto old_fields = fieldsOf(before);
+  const auto new_fields = fieldsOf(after);
+  std::string text;
+  for (std::size_t i = 0; i < old_fields.size(); ++i)
+  {
+    if (old_fields[i].second != new_fields[i].second)
+      text +=
+          (text.empty() ? "" : ", ") + old_fields[i].first + " " + old_fields[i].second + " -> " + new_fields[i].second;
+  }
+  return text;
+}
+
+std::string scheduleText(const ScheduleParams& p)
+{
+  std::ostringstream out;
+  out << toString(p.type) << " " << p.start;
+  if (p.type == ScheduleType::Linear)
+    out << " -> " << p.min << " over " << p.decay_episodes << " episodes";
+  if (p.type == ScheduleType::Exponential)
+    out << " -> " << p.min << " by x" << p.decay_rate << " per episode";
+  if (p.type == ScheduleType::Log)
+    out << " -> " << p.min << " (log_divisor " << p.log_divisor << ")";
+  return out.str();
+}
+
+// "epsilon 0 (override; schedule log 1 -> 0.01 (log_divisor 25)), alpha log 1 -> 0.05 (...), gamma 0.99"
+std::string settingsText(const LearningSettings& s)
+{
+  const auto rate = [](const ScheduleParams& schedule, const std::optional<double>& value) {
+    if (!value)
+      return scheduleText(schedule);
+    std::ostringstream out;
+    out << *value << " (override; schedule " << scheduleText(schedule) << ")";
+    return out.str();
+  };
+  std::ostringstream out;
+  out << "epsilon " << rate(s.epsilon, s.epsilon_override) << ", alpha " << rate(s.alpha, s.alpha_override)
+      << ", gamma " << s.gamma;
+  return out.str();
+}
+
+// The core names a schedule's field as the config file does ("epsilon/min"); the server's field
+// is "epsilon_min".
+std::string asServerField(std::string message)
+{
+  const std::size_t slash = message.find('/');
+  if (slash < message.find(" = "))
+    message[slash] = '_';
+  return message;
+}
 }  // namespace
 
 QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
@@ -78,7 +213,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
                                                  ros::CallbackQueue* state_queue)
   : nh_(nh), pnh_(pnh), shutdown_(std::move(shutdown)), shutdown_when_finished_(shutdown_by_default)
 {
-  const std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_lock<std::mutex> lock(mutex_);
   readParameters();
   session_ = std::make_unique<TrainingSession>(config_.task, config_.agent, seed_, learning_, robot_names_.size());
   if (trace_ && learning_)
@@ -113,8 +248,10 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   {
     ROS_WARN("qlearning_controller: evaluating a table of zeros (set ~load_on_start to a trained table)");
   }
+  openStatsFile();
   if (learning_)
     openRun();
+  startStatsCsv();
 
   started_ = last_episode_end_ = last_progress_ = std::chrono::steady_clock::now();
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
@@ -131,12 +268,19 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   std::string served;
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
-  ROS_INFO("qlearning_controller: %s, seed %llu, %zu states x %zu actions, tables under %s; serving %s%s; %s",
+  const FeatureParams& features = session_->table().features();
+  const std::string rows =
+      features.kind == FeatureKind::Tiles
+          ? std::to_string(features.tilings) + " tilings, " + std::to_string(session_->table().stateCount()) + " tiles"
+          : std::to_string(session_->table().stateCount()) + " states";
+  ROS_INFO("qlearning_controller: %s, seed %llu, %s x %zu actions, tables under %s; serving %s%s; %s",
            learning_ ? "training" : "evaluating (greedy, no learning)", static_cast<unsigned long long>(seed_),
-           session_->table().stateCount(), session_->table().actionCount(), q_table_dir_.c_str(), served.c_str(),
+           rows.c_str(), session_->table().actionCount(), q_table_dir_.c_str(), served.c_str(),
            robots_.size() > 1 ? (sync_ ? " in lockstep rounds" : ", each as its states come") : "",
            protocol_params_.reset_service ? ("resets by ~" + reset_service_).c_str()
                                           : "no reset service: episodes start when the state is in ~start_region");
+  lock.unlock();
+  startLiveTuning();
 }
 
 void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
@@ -170,6 +314,8 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
 
 QLearningControllerNode::~QLearningControllerNode()
 {
+  // First, with mutex_ free: a reconfigure call under way ends (it takes mutex_), no other starts.
+  reconfigure_.reset();
   {
     std::lock_guard<std::mutex> lock(reset_mutex_);
     stopping_ = true;
@@ -223,6 +369,18 @@ void QLearningControllerNode::readParameters()
     priv.fail("q_table_path", "'" + q_table_path_ + "'", e.what());
   }
   priv.read("load_on_start", load_on_start_);
+  priv.read("stats_csv", stats_csv_);
+  if (stats_csv_ != "none" && !stats_csv_.empty() && stats_csv_.front() != '/')
+  {
+    try
+    {
+      relativePathUnder(q_table_dir_, stats_csv_);
+    }
+    catch (const FileError& e)
+    {
+      priv.fail("stats_csv", "'" + stats_csv_ + "'", e.what());
+    }
+  }
   priv.read("run_id", run_id_);
   // Set by the controller itself (openRun), for a respawn of it to find.
   priv.know("run/id");
@@ -250,6 +408,11 @@ void QLearningControllerNode::readParameters()
   readRobots(pnh_, priv, robot_names_);
   priv.read("sync", sync_);
   priv.read("trace", trace_);
+  if (trace_ && config_.agent.features == FeatureKind::Tiles)
+    priv.fail("trace", "true", "the trace shows one table row per state: learning/features bins only");
+  // Live tuning's values, which the controller's own dynamic_reconfigure server keeps there.
+  for (const auto& param : LearningConfig::__getParamDescriptions__())
+    priv.know(param->name);
   priv.refuseUnknown();
   protocol_params_.limits = config_.limits;
 }
@@ -388,6 +551,8 @@ void QLearningControllerNode::report(const Robot& robot, const Reaction& reactio
 void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, bool training_finished)
 {
   const EpisodeSummary& s = session_->lastEpisode();
+  // Before any checkpoint: a row is never missing from a run that a respawn resumes from there.
+  writeStatsRow(robot, s);
   const double wall = secondsSince(last_episode_end_);
   const double robot_wall = secondsSince(robot.last_episode_end);
   last_episode_end_ = robot.last_episode_end = std::chrono::steady_clock::now();
@@ -421,6 +586,7 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
   stats.mean_return_100 = s.mean_return_window;
   stats.epsilon = s.epsilon;
   stats.alpha = s.alpha;
+  stats.gamma = s.gamma;
   stats.terminated = s.terminated;
   stats.truncated = s.truncated;
   stats.solved = s.solved;
@@ -541,6 +707,7 @@ void QLearningControllerNode::openRun()
       pnh_.getParam("run/launcher", stored_launcher) && stored_launcher == launcher &&
       pnh_.getParam("run/folder", run_folder_) && !run_folder_.empty())
   {
+    respawned_ = true;
     resumeRun();
     return;
   }
@@ -575,8 +742,101 @@ void QLearningControllerNode::openRun()
            resolve(run_folder_ + "/" + kRunTableFile).c_str());
 }
 
+void QLearningControllerNode::openStatsFile()
+{
+  if (stats_csv_ == "none" || stats_csv_.empty())
+    return;
+  try
+  {
+    stats_file_ =
+        std::make_unique<AppendingFile>(stats_csv_.front() == '/' ? AppendingFile::open(stats_csv_)
+                                                                  : AppendingFile::openUnder(q_table_dir_, stats_csv_));
+  }
+  catch (const FileError& e)
+  {
+    refuseParameter(pnh_, "stats_csv", "'" + stats_csv_ + "'", e.what());
+  }
+}
+
+void QLearningControllerNode::startStatsCsv()
+{
+  if (stats_csv_ == "none" || (stats_csv_.empty() && !learning_))
+    return;
+  if (!stats_file_)
+  {
+    // The run's own file: beside its checkpoints, made with its folder. A node told to write
+    // nothing along the way (no checkpoints, no save on shutdown) makes that folder only when
+    // there is something to write: here, at the first episode's end.
+    if (!(checkpoint_every_ > 0 || save_on_shutdown_) && !resumed_run_ && !stats_csv_pending_)
+    {
+      stats_csv_pending_ = true;
+      return;
+    }
+    try
+    {
+      if (stats_csv_pending_)
+      {
+        // Its folder is made now, under a name no other run has taken (as openRun does).
+        const std::string name = run_folder_;
+        for (int n = 2; !makeDirectoryUnder(q_table_dir_, run_folder_); ++n)
+          run_folder_ = name + "_" + std::to_string(n);
+        if (!run_id_.empty())
+          pnh_.setParam("run/folder", run_folder_);
+      }
+      stats_csv_pending_ = false;
+      stats_file_ =
+          std::make_unique<AppendingFile>(AppendingFile::openUnder(q_table_dir_, run_folder_ + "/" + kRunEpisodesFile));
+    }
+    catch (const FileError& e)
+    {
+      stats_csv_pending_ = false;
+      ROS_ERROR("qlearning_controller: no learning curve for this run (~stats_csv none silences this): %s", e.what());
+      return;
+    }
+  }
+  try
+  {
+    // A respawn goes on with its run's curve from the checkpoint it resumed (a run that starts
+    // over keeps the header alone); anything else starts the curve afresh.
+    stats_csv_writer_ = resumed_run_
+                            ? std::make_unique<EpisodeCsvWriter>(std::move(*stats_file_), session_->episodesEnded())
+                            : std::make_unique<EpisodeCsvWriter>(std::move(*stats_file_));
+  }
+  catch (const FileError& e)
+  {
+    stats_file_.reset();
+    if (!stats_csv_.empty())
+      refuseParameter(pnh_, "stats_csv", "'" + stats_csv_ + "'", e.what());
+    ROS_ERROR("qlearning_controller: no learning curve for this run (~stats_csv none silences this): %s", e.what());
+    return;
+  }
+  stats_file_.reset();
+  ROS_INFO(
+      "qlearning_controller: one row per episode goes to %s (rosrun cartpole_qlearning plot_learning_curve "
+      "--follow %s)",
+      stats_csv_writer_->path().c_str(), stats_csv_writer_->path().c_str());
+}
+
+void QLearningControllerNode::writeStatsRow(const Robot& robot, const EpisodeSummary& summary)
+{
+  if (stats_csv_pending_)
+    startStatsCsv();
+  if (!stats_csv_writer_)
+    return;
+  try
+  {
+    stats_csv_writer_->write(summary, robot.name, ros::WallTime::now().toSec());
+  }
+  catch (const FileError& e)
+  {
+    ROS_ERROR("qlearning_controller: the learning curve stops here: %s", e.what());
+    stats_csv_writer_.reset();
+  }
+}
+
 void QLearningControllerNode::resumeRun()
 {
+  resumed_run_ = true;
   const std::string table_path = run_folder_ + "/" + kRunTableFile;
   RunRecord record;
   QTable table;
@@ -714,6 +974,71 @@ void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
              describe(robots_[r]).c_str());
   if (!dropped.empty())
     serveRounds();
+}
+
+void QLearningControllerNode::startLiveTuning()
+{
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    // The server starts from what it finds on the parameter server. A respawn finds the values
+    // its predecessor served, the live tuning of this run, and goes on with them (onReconfigure
+    // says so). A new run starts from its configuration: what an earlier node left is replaced.
+    if (!respawned_)
+    {
+      const LearningSettings& running = session_->learningSettings();
+      LearningConfig left = toConfig(running);
+      left.__fromServer__(pnh_);  // only the fields present there change
+      LearningSettings left_settings = running;
+      fromConfig(left, left_settings);
+      const std::string replaced = changesText(left_settings, running);
+      if (!replaced.empty())
+        ROS_INFO(
+            "qlearning_controller: a new run: live-tuning values left on the parameter server replaced by "
+            "its configuration's: %s",
+            replaced.c_str());
+      toConfig(session_->learningSettings()).__toServer__(pnh_);
+    }
+  }
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<LearningConfig>>(reconfigure_mutex_, pnh_);
+  reconfigure_->setCallback([this](LearningConfig& config, std::uint32_t level) { onReconfigure(config, level); });
+}
+
+void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_t)
+{
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const bool first = !reconfigure_started_;
+  reconfigure_started_ = true;
+  const LearningSettings in_use = session_->learningSettings();
+  LearningSettings wanted = in_use;
+  std::string error = fromConfig(config, wanted);
+  if (error.empty())
+    error = session_->setLearning(wanted);
+  // What the server keeps, answers and publishes: the values in use (a refused change undone,
+  // an override given as any negative number shown as -1).
+  config = toConfig(session_->learningSettings());
+  if (!error.empty())
+  {
+    if (first && respawned_)
+      ROS_WARN(
+          "qlearning_controller: restarted; the live tuning left by the controller before the restart is refused "
+          "(%s): this run goes on with its configuration's: %s",
+          asServerField(error).c_str(), settingsText(in_use).c_str());
+    else
+      ROS_WARN("qlearning_controller: live tuning refused (asked: %s): %s; nothing changed, in use: %s",
+               changesText(in_use, wanted).c_str(), asServerField(error).c_str(), settingsText(in_use).c_str());
+    return;
+  }
+  const std::string changes = changesText(in_use, wanted);
+  if (changes.empty())
+    return;
+  const char* applies = learning_ ? "gamma from the next update, epsilon and alpha from the next episode"
+                                  : "evaluating, so none of it applies: actions stay greedy (epsilon 0), nothing "
+                                    "is learnt (alpha 0, gamma unused)";
+  if (first && respawned_)
+    ROS_WARN("qlearning_controller: restarted; the live tuning of this run before the restart applies again: %s (%s)",
+             changes.c_str(), applies);
+  else
+    ROS_INFO("qlearning_controller: live tuning: %s (%s)", changes.c_str(), applies);
 }
 
 void QLearningControllerNode::requestReset(std::size_t robot)

@@ -1,6 +1,7 @@
 // train_headless: trains with the core alone (no ROS master), prints progress and ends with
 // one line "solved=true|false episodes=N steps=M wall_s=T". With --replay it learns from the
 // transitions of a file instead (the tutorial's worked example), tracing each update.
+#include "cartpole_qlearning/episode_csv.h"
 #include "cartpole_qlearning/headless_trainer.h"
 #include "cartpole_qlearning/q_table_file.h"
 #include "cartpole_qlearning/trace.h"
@@ -12,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <string>
 
 namespace
@@ -19,7 +21,7 @@ namespace
 void usage(std::ostream& out)
 {
   out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--save PATH] [--ns NS] [--max-episodes N] "
-         "[--quiet]\n"
+         "[--stats-csv FILE] [--quiet]\n"
          "                      [--returns] [--trace] [--replay FILE]\n"
          "  --config FILE     physics, task, learning and training parameters (YAML);\n"
          "                    default: the package's config/cartpole.yaml\n"
@@ -31,6 +33,9 @@ void usage(std::ostream& out)
          "                    evaluate.launch q_table:=PATH finds it; without --save nothing is written\n"
          "  --ns NS           the namespace whose table folder --save uses (default cartpole)\n"
          "  --max-episodes N  override training/max_episodes\n"
+         "  --stats-csv FILE  write one CSV row per episode there as it ends (the learning curve, for\n"
+         "                    rosrun cartpole_qlearning plot_learning_curve FILE); FILE is taken as given\n"
+         "                    (relative to the current directory) and replaced if it exists\n"
          "  --quiet           no progress lines, only the result line\n"
          "  --returns         before the result line, one line \"returns=R1 R2 ...\": every episode's return, in "
          "order\n"
@@ -69,6 +74,7 @@ int run(int argc, char** argv)
   using namespace cartpole_qlearning;
   std::string config_path;
   std::string save_path;
+  std::string stats_csv_path;
   std::string name_space = "/cartpole";
   std::uint64_t seed = 0;
   std::uint64_t max_episodes = 0;
@@ -98,6 +104,8 @@ int run(int argc, char** argv)
       config_path = argv[++i];
     else if (arg == "--save" && has_value)
       save_path = argv[++i];
+    else if (arg == "--stats-csv" && has_value)
+      stats_csv_path = argv[++i];
     else if (arg == "--ns" && has_value)
     {
       name_space = argv[++i];
@@ -167,6 +175,12 @@ int run(int argc, char** argv)
   }
   if (max_episodes > 0)
     config.limits.max_episodes = max_episodes;
+  if ((trace || !replay_path.empty()) && config.agent.features == FeatureKind::Tiles)
+  {
+    std::cerr << "train_headless: " << (trace ? "--trace" : "--replay")
+              << " shows one table row per state: it needs learning/features bins (" << config_path << " has tiles)\n";
+    return 2;
+  }
 
   // The one path rule: a relative table path is under the table folder (as the controller's
   // services and the launch files take it); an absolute one is the user's own.
@@ -203,9 +217,10 @@ int run(int argc, char** argv)
   const std::vector<std::string> names = stateNames(config.agent);
   if (!replay_path.empty())
   {
-    if (robots != 1 || max_episodes != 0)
+    if (robots != 1 || max_episodes != 0 || !stats_csv_path.empty())
     {
-      std::cerr << "train_headless: --replay learns from its file alone: --robots and --max-episodes do not apply\n";
+      std::cerr << "train_headless: --replay learns from its file alone: --robots, --max-episodes and --stats-csv do "
+                   "not apply\n";
       return 2;
     }
     // Every line is checked before the first update: a bad file changes nothing.
@@ -237,6 +252,21 @@ int run(int argc, char** argv)
     return save(agent.table());
   }
 
+  // Opened before training, so that a path that cannot be written is said at once.
+  std::unique_ptr<EpisodeCsvWriter> stats_csv;
+  if (!stats_csv_path.empty())
+  {
+    try
+    {
+      stats_csv = std::make_unique<EpisodeCsvWriter>(AppendingFile::open(stats_csv_path));
+    }
+    catch (const FileError& e)
+    {
+      std::cerr << "train_headless: --stats-csv: " << e.what() << "\n";
+      return 2;
+    }
+  }
+
   HeadlessTrainer trainer(config, seed, robots);
   if (trace)
   {
@@ -264,6 +294,13 @@ int run(int argc, char** argv)
                                                  " in all)"
                                            : "episode " + std::to_string(s.episode);
       std::printf("Q-table after %s:\n%s\n", which.c_str(), qTableText(trainer.session().table(), names).c_str());
+    }
+    if (stats_csv)
+    {
+      // The robots' names as train.launch robots:=N gives them.
+      const std::string robot = robots > 1 ? "robot_" + std::to_string(s.robot) : "";
+      const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+      stats_csv->write(s, robot, now);
     }
     if (every == 0 || (s.episode % every != 0 && !config.limits.reached(s.episode, s.solved)))
       return;

@@ -28,14 +28,18 @@ void ReturnWindow::push(double value)
 
 TrainingSession::TrainingSession(const TaskParams& task, const AgentParams& agent, std::uint64_t seed, bool learning,
                                  std::size_t robots)
-  : task_(task), agent_(agent, seed), learning_(learning), returns_(task.solved_window)
+  : task_(task),
+    agent_(agent, seed),
+    learning_settings_(LearningSettings::of(agent)),
+    learning_(learning),
+    returns_(task.solved_window)
 {
   if (robots < 1)
     throw std::invalid_argument("TrainingSession: at least one robot");
   episodes_.assign(robots, Episode(task.solved_window));
 }
 
-std::size_t TrainingSession::chooseAction(std::size_t state, double epsilon)
+std::size_t TrainingSession::chooseAction(const ActiveRows& state, double epsilon)
 {
   return learning_ ? agent_.selectAction(state, epsilon) : agent_.greedyAction(state);
 }
@@ -51,8 +55,8 @@ double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size
   e.number = episodes_.size() == 1 ? last_.episode + 1 : e.ended + 1;
   e.steps = 0;
   e.episode_return = 0.0;
-  e.state = agent_.discretiser().index(start_state);
-  e.action = chooseAction(e.state, e.epsilon);
+  agent_.activeRows(start_state, e.rows[e.current]);
+  e.action = chooseAction(e.state(), e.epsilon);
   return agent_.table().actions()[e.action];
 }
 
@@ -63,21 +67,22 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   ++e.steps;
   decision.outcome = task_.evaluate(state, e.steps);
   e.episode_return += decision.outcome.reward;
-  const std::size_t next_state = agent_.discretiser().index(state);
+  agent_.activeRows(state, e.next());
   if (learning_)
   {
     const QUpdate update =
-        agent_.update(e.state, e.action, decision.outcome.reward, next_state, decision.outcome.terminated, e.alpha);
+        agent_.update(e.state(), e.action, decision.outcome.reward, e.next(), decision.outcome.terminated, e.alpha);
     ++agent_.table().steps;
     if (trace_)
     {
       TraceStep step;
       step.episode = e.number;
       step.step = e.steps;
-      step.state = e.state;
+      // One row per state: the trace is for bins (features tiles refuse it, see traceRefusal).
+      step.state = e.state().rows[0];
       step.action = e.action;
       step.reward = decision.outcome.reward;
-      step.next_state = next_state;
+      step.next_state = e.next().rows[0];
       step.terminal = decision.outcome.terminated;
       step.truncated = decision.outcome.truncated;
       step.alpha = e.alpha;
@@ -89,8 +94,8 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
 
   if (!decision.outcome.done())
   {
-    e.state = next_state;
-    e.action = chooseAction(e.state, e.epsilon);
+    e.current ^= 1;
+    e.action = chooseAction(e.state(), e.epsilon);
     decision.action = e.action;
     decision.effort = agent_.table().actions()[e.action];
     return decision;
@@ -111,6 +116,7 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   last_.mean_return_window = returns_.mean();
   last_.epsilon = e.epsilon;
   last_.alpha = e.alpha;
+  last_.gamma = agent_.params().gamma;
   last_.terminated = decision.outcome.terminated;
   last_.truncated = decision.outcome.truncated;
   last_.solved = returns_.full() && last_.mean_return_window >= task_.params().solved_mean_return;
@@ -120,6 +126,16 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   last_.robot_mean_return_window = e.returns.mean();
   last_.robot_total_steps = e.total_steps;
   return decision;
+}
+
+std::string TrainingSession::setLearning(const LearningSettings& settings)
+{
+  std::string error = settings.validate();
+  if (error.empty())
+    error = agent_.setLearning(settings.gamma, settings.effectiveEpsilon(), settings.effectiveAlpha());
+  if (error.empty())
+    learning_settings_ = settings;
+  return error;
 }
 
 std::string TrainingSession::replaceTable(QTable table)

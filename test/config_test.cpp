@@ -100,6 +100,37 @@ TEST(Config, BadValuesNameTheKeyTheValueAndTheRange)
   EXPECT_NE(std::string::npos, errorOf("training: {max_episodes: 0}").find("training/max_episodes = 0"));
 }
 
+TEST(Config, TileCodingKeys)
+{
+  EXPECT_EQ(FeatureKind::Bins, parse("").agent.features);  // the default
+  const TrainingConfig c = parse(
+      "learning:\n  features: tiles\n  tilings: 4\n  tiles: [1, 2, 6, 12]\n"
+      "  lower_bounds: [-2.4, -2.0, -0.2, -1.0]\n  upper_bounds: [2.4, 2.0, 0.2, 1.0]\n");
+  EXPECT_EQ(FeatureKind::Tiles, c.agent.features);
+  EXPECT_EQ(4u, c.agent.tilings);
+  EXPECT_EQ(2u, c.agent.tiles[1]);
+  EXPECT_EQ(-2.0, c.agent.featureParams().tileCoder().lower[1]);  // the bounds are the bins' keys
+  EXPECT_EQ(1.0, c.agent.featureParams().tileCoder().upper[3]);
+
+  const std::string kind = errorOf("learning: {features: tile}");
+  EXPECT_NE(std::string::npos, kind.find("learning/features = 'tile' is not allowed (allowed: bins, tiles)")) << kind;
+  const std::string tilings = errorOf("learning: {features: tiles, tilings: 0}");
+  EXPECT_NE(std::string::npos, tilings.find("learning/tilings = 0 is not allowed (must be a whole number in [1, 64])"))
+      << tilings;
+  EXPECT_NE(std::string::npos, errorOf("learning: {tilings: 65}").find("learning/tilings = 65")) << tilings;
+  EXPECT_NE(std::string::npos, errorOf("learning: {tiles: [1, 1, 6]}").find("learning/tiles")) << tilings;
+  EXPECT_NE(std::string::npos, errorOf("learning: {tiles: [1, 1, 0, 6]}").find("learning/tiles = [1, 1, 0, 6]"));
+  // Too many tiles in all: refused before anything is allocated, naming the key.
+  const std::string many = errorOf("learning: {features: tiles, tilings: 64, tiles: [20, 20, 20, 20]}");
+  EXPECT_NE(std::string::npos, many.find("learning/tiles give 12446784 tiles")) << many;
+  // Bounds a used tile dimension needs, checked only when tiles are in use.
+  const std::string bounds = "lower_bounds: [0, 0, 0, 1]\n  upper_bounds: [1, 1, 1, 1]\n  bins: [1, 1, 2, 1]\n";
+  EXPECT_EQ("", errorOf("learning:\n  tiles: [1, 1, 1, 2]\n  " + bounds));
+  const std::string tile_bounds = errorOf("learning:\n  features: tiles\n  tiles: [1, 1, 1, 2]\n  " + bounds);
+  EXPECT_NE(std::string::npos, tile_bounds.find("learning/lower_bounds[3], upper_bounds[3] (theta_dot) = 1, 1"))
+      << tile_bounds;
+}
+
 TEST(Config, WrongTypesAreRefused)
 {
   EXPECT_NE(std::string::npos, errorOf("physics: {gravity: strong}").find("physics/gravity = 'strong'"));

@@ -54,7 +54,8 @@ LoadQTable::Response load(const std::string& ns, const std::string& path)
   return srv.response;
 }
 
-// Bad files in a controller's directory: missing (none), corrupt, of another shape.
+// Bad files in a controller's directory: missing (none), corrupt, of another shape, of tiles
+// (the controllers here use bins).
 void writeBadFiles(const std::string& dir)
 {
   fs::create_directories(dir);
@@ -63,6 +64,9 @@ void writeBadFiles(const std::string& dir)
   DiscretiserParams other;
   other.bins = {{1, 1, 3, 6}};
   saveQTableFile(QTable(other, {-10.0, 10.0}), dir + "/other_shape.yaml");
+  FeatureParams tiles;
+  tiles.kind = FeatureKind::Tiles;
+  saveQTableFile(QTable(tiles, {-10.0, 10.0}), dir + "/tiles.yaml");
   std::ofstream(fs::path(dir).parent_path() / "outside.yaml") << "placeholder";
   // A few hundred bytes whose header claims 10^12 states.
   std::string huge = formatQTable(QTable(DiscretiserParams(), {-10.0, 10.0}));
@@ -93,6 +97,10 @@ TEST(ControllerServices, EvaluateSaveLoadRoundTripAndRefusalsKeepTheTable)
   const LoadQTable::Response shape = load("eval", "other_shape.yaml");
   expectRefused(shape, "other shape");
   EXPECT_NE(std::string::npos, shape.message.find("bins")) << shape.message;
+  const LoadQTable::Response tiles = load("eval", "tiles.yaml");
+  expectRefused(tiles, "a tiles table");
+  EXPECT_NE(std::string::npos, tiles.message.find("does not fit this controller: features tiles differ from bins"))
+      << tiles.message;
   const LoadQTable::Response huge = load("eval", "huge_header.yaml");
   expectRefused(huge, "a header claiming 10^12 states");
   EXPECT_NE(std::string::npos, huge.message.find("states")) << huge.message;

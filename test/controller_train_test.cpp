@@ -1,6 +1,8 @@
 // train.launch's nodes, lockstep, seed 0: the controller solves CartPole-v1 over ROS topics,
 // writes the same table as train_headless, and a fresh greedy controller balances with it.
+// With ~config (controller_train_tiles.test: tiles.yaml) the same over that config.
 #include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/q_table_file.h"
 
 #include "ros_test_support.h"
@@ -33,6 +35,14 @@ std::string qTableDir()
   std::string dir;
   ros::param::get("~q_table_dir", dir);
   return dir;
+}
+
+// The config file loaded over cartpole.yaml in the controller's namespace.
+std::string configFile()
+{
+  std::string file = "cartpole.yaml";
+  ros::param::get("~config", file);
+  return file;
 }
 }  // namespace
 
@@ -80,12 +90,44 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
   EXPECT_EQ(solved.episode, table.episodes);
   EXPECT_EQ(solved.total_steps, table.steps);
   const std::string headless = qTableDir() + "/headless.yaml";
-  const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " +
-                              CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
+  const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " + CARTPOLE_CONFIG_DIR "/" +
+                              configFile() + " --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
   EXPECT_EQ(fileText(headless), fileText(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
+  // The table is of the features the config asks for, as the test names them.
+  std::string features;
+  ros::param::get("~features", features);
+  EXPECT_EQ(features, toString(table.features().kind));
+  const auto source = cartpole_qlearning::loadYamlParameters(CARTPOLE_CONFIG_DIR "/" + configFile());
+  EXPECT_EQ("", cartpole_qlearning::QTable(cartpole_qlearning::readAgent(*source).featureParams(), table.actions())
+                    .shapeMismatch(table));
 
-  // 3. A fresh controller in evaluate mode loads the table and balances a full 500-step episode.
+  // 3. The run's learning curve: episodes.csv beside its checkpoint, a header and one row per
+  //    episode, each the episode_stats message of that episode.
+  std::vector<fs::path> runs;
+  for (const auto& entry : fs::directory_iterator(qTableDir() + "/runs"))
+    runs.push_back(entry.path());
+  ASSERT_EQ(1u, runs.size());
+  std::istringstream csv(fileText((runs.front() / "episodes.csv").string()));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line)) << "no episodes.csv in " << runs.front();
+  EXPECT_EQ(0u, line.find("episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,"));
+  std::vector<std::string> rows;
+  while (std::getline(csv, line))
+    rows.push_back(line);
+  ASSERT_EQ(solved.episode, rows.size()) << "one row per episode";
+  for (const EpisodeStats& m : stats_)
+  {
+    std::ostringstream expected;
+    expected << m.episode << ",," << m.steps << "," << m.steps << ",";
+    EXPECT_EQ(0u, rows.at(m.episode - 1).find(expected.str())) << rows.at(m.episode - 1);
+  }
+  const auto flag = [](bool value) { return std::string(value ? "true" : "false"); };
+  EXPECT_NE(std::string::npos, rows.back().find("," + flag(solved.terminated) + "," + flag(solved.truncated) +
+                                                ",true," + std::to_string(solved.total_steps) + ","))
+      << "the last row is not the solved episode: " << rows.back();
+
+  // 4. A fresh controller in evaluate mode loads the table and balances a full 500-step episode.
   const std::size_t before = stats_.size();
   const pid_t pid = ::fork();
   ASSERT_GE(pid, 0);

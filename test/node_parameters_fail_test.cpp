@@ -213,6 +213,13 @@ TEST_F(NodeParametersTest, ControllerRefusesBinsWithThreeEntries)
                 "learning/bins\\b.*\\[\\s*1(\\.0*)?\\s*,\\s*6(\\.0*)?\\s*,\\s*12(\\.0*)?\\s*\\]");
 }
 
+TEST_F(NodeParametersTest, ControllerRefusesATraceOfTiles)
+{
+  expectRefused(kController, "/ko_controller_trace_tiles",
+                {{"qlearning_controller/trace", XmlRpcValue(true)}, {"learning/features", XmlRpcValue("tiles")}},
+                "[/~]trace\\b.*features bins only");
+}
+
 TEST_F(NodeParametersTest, ControllerRefusesANegativeCheckpointInterval)
 {
   expectRefused(kController, "/ko_controller_checkpoint", {{"qlearning_controller/checkpoint_every", XmlRpcValue(-5)}},
@@ -225,6 +232,19 @@ TEST_F(NodeParametersTest, ControllerRefusesAMissingTableToLoadOnStart)
                 {{"qlearning_controller/q_table_dir", XmlRpcValue(dir_.string())},
                  {"qlearning_controller/load_on_start", XmlRpcValue("no_such_table.yaml")}},
                 "no_such_table\\.yaml");
+}
+TEST_F(NodeParametersTest, ControllerRefusesAStatsCsvOutsideItsFolderOrThatCannotBeOpened)
+{
+  expectRefused(kController, "/ko_controller_stats_csv",
+                {{"qlearning_controller/q_table_dir", XmlRpcValue(dir_.string())},
+                 {"qlearning_controller/stats_csv", XmlRpcValue("../curve.csv")}},
+                "[/~]stats_csv\\b.*\\.\\./curve\\.csv");
+  fs::create_directories(dir_ / "a_folder");
+  expectRefused(kController, "/ko_controller_stats_csv_folder",
+                {{"qlearning_controller/q_table_dir", XmlRpcValue(dir_.string())},
+                 {"qlearning_controller/stats_csv", XmlRpcValue((dir_ / "a_folder").string())}},
+                "[/~]stats_csv\\b.*a_folder");
+  EXPECT_FALSE(fs::exists(dir_ / "runs")) << "a refused controller started a run";
 }
 }  // namespace
 

@@ -102,9 +102,9 @@ TEST_F(QTableFileTest, FileDescribesItself)
 {
   saveQTableFile(awkwardTable(), path("table.yaml"));
   const std::string text = readFile(path("table.yaml"));
-  for (const char* key : {"format: cartpole_qlearning/q_table", "version: 1", "bins: [1, 1, 6, 12]",
+  for (const char* key : {"format: cartpole_qlearning/q_table", "version: 2", "features: bins", "bins: [1, 1, 6, 12]",
                           "lower_bounds:", "upper_bounds:", "actions: [-10, 10]", "episodes: 1234", "steps: 98765",
-                          "states: 72", "checksum: fnv1a64:", "values:"})
+                          "rows: 72", "checksum: fnv1a64:", "values:"})
     EXPECT_NE(std::string::npos, text.find(key)) << key;
 }
 
@@ -195,16 +195,16 @@ TEST_F(QTableFileTest, WrongVersionIsRefusedWithTheVersion)
 {
   saveQTableFile(awkwardTable(), path("t.yaml"));
   std::string text = readFile(path("t.yaml"));
-  text.replace(text.find("version: 1"), 10, "version: 2");
+  text.replace(text.find("version: 2"), 10, "version: 3");
   write(path("t.yaml"), text);
   try
   {
     loadQTableFile(path("t.yaml"));
-    FAIL() << "version 2 was accepted";
+    FAIL() << "version 3 was accepted";
   }
   catch (const QTableFileError& e)
   {
-    EXPECT_NE(std::string::npos, std::string(e.what()).find("version 2 is not supported")) << e.what();
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("version 3 is not supported")) << e.what();
   }
 }
 
@@ -213,7 +213,7 @@ TEST_F(QTableFileTest, WrongShapeIsRefused)
   saveQTableFile(awkwardTable(), path("t.yaml"));
   std::string text = readFile(path("t.yaml"));
   std::string fewer_states = text;
-  fewer_states.replace(fewer_states.find("states: 72"), 10, "states: 71");
+  fewer_states.replace(fewer_states.find("rows: 72"), 8, "rows: 71");
   write(path("states.yaml"), fewer_states);
   EXPECT_THROW(loadQTableFile(path("states.yaml")), QTableFileError);
 
@@ -281,4 +281,153 @@ TEST_F(QTableFileTest, MissingFileIsRefusedWithItsPath)
   {
     EXPECT_NE(std::string::npos, std::string(e.what()).find("nope.yaml")) << e.what();
   }
+}
+
+namespace
+{
+// A version 1 file as the build before tile coding wrote it (test/fuzz/corpus/q_table/tiny.yaml).
+const char* const kVersion1Table =
+    R"(# Q-table of cartpole_qlearning. The checksum covers every number below: edit by hand and the
+# file will be refused.
+format: cartpole_qlearning/q_table
+version: 1
+# Discretisation: uniform bins per state dimension; values outside the bounds go to the end bins.
+dimensions: [x, x_dot, theta, theta_dot]
+bins: [1, 1, 2, 2]
+lower_bounds: [-2.4, -3, -0.20943951023931953, -0.8726646259971648]
+upper_bounds: [2.4, 3, 0.20943951023931953, 0.8726646259971648]
+# The effort [N] of each action: one column of values per action.
+actions: [-10, 10]
+# Training that produced this table.
+episodes: 5
+steps: 73
+states: 4
+checksum: fnv1a64:21088f60d2624369
+# One row per state: the bins combined in mixed radix, x most significant.
+values:
+  - [16.54862385499124, 1]
+  - [5.8519850599, 13.994164535871148]
+  - [1, 0]
+  - [1, 31.744540498961268]
+)";
+
+// 4 tilings of [1, 2, 6, 12] tiles with narrower x_dot bounds, 3 actions, awkward values.
+QTable tilesTable()
+{
+  FeatureParams f;
+  f.kind = FeatureKind::Tiles;
+  f.tilings = 4;
+  f.tiles = {{1, 2, 6, 12}};
+  f.discretiser.lower[1] = -1.5;
+  f.discretiser.upper[1] = 1.5;
+  QTable table(f, {-10.0, 0.0, 10.0});
+  std::vector<double> values(table.values().size());
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = 1.0 / (7.0 + static_cast<double>(i)) - 0.01 * static_cast<double>(i % 13);
+  table.setValues(values);
+  table.episodes = 42;
+  table.steps = 4242;
+  return table;
+}
+}  // namespace
+
+TEST_F(QTableFileTest, ATileCodedTableRoundTripsAndSaysWhatItIs)
+{
+  const QTable table = tilesTable();
+  ASSERT_EQ(4u * 3u * 7u * 13u, table.stateCount());
+  saveQTableFile(table, path("tiles.yaml"));
+  const std::string text = readFile(path("tiles.yaml"));
+  for (const char* key : {"version: 2", "features: tiles", "tilings: 4", "tiles: [1, 2, 6, 12]",
+                          "lower_bounds: [-2.4, -1.5,", "actions: [-10, 0, 10]", "rows: 1092"})
+    EXPECT_NE(std::string::npos, text.find(key)) << key;
+  EXPECT_EQ(std::string::npos, text.find("bins:"));
+  const QTable loaded = loadQTableFile(path("tiles.yaml"));
+  EXPECT_EQ(FeatureKind::Tiles, loaded.features().kind);
+  EXPECT_EQ("", table.shapeMismatch(loaded));
+  EXPECT_TRUE(bitIdentical(table.values(), loaded.values()));
+  EXPECT_EQ(42u, loaded.episodes);
+  saveQTableFile(loaded, path("again.yaml"));
+  EXPECT_EQ(text, readFile(path("again.yaml")));
+
+  // The checksum covers the tiling: a file that says 8 tilings over 4 tilings' rows is refused,
+  // and so is one whose rows do not match its tilings.
+  std::string tilings = text;
+  tilings.replace(tilings.find("tilings: 4"), 10, "tilings: 2");
+  tilings.replace(tilings.find("rows: 1092"), 10, "rows: 546");
+  write(path("tilings.yaml"), tilings);
+  EXPECT_THROW(loadQTableFile(path("tilings.yaml")), QTableFileError);
+  std::string huge = text;
+  huge.replace(huge.find("tiles: [1, 2, 6, 12]"), 20, "tiles: [1000, 1000, 1000, 1000]");
+  write(path("huge.yaml"), huge);
+  try
+  {
+    loadQTableFile(path("huge.yaml"));
+    FAIL() << "a header asking for 4 * 1001^4 tiles was accepted";
+  }
+  catch (const QTableFileError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("more than the 10000000 allowed")) << e.what();
+  }
+}
+
+TEST_F(QTableFileTest, AVersion1TableStillLoadsAsBins)
+{
+  write(path("v1.yaml"), kVersion1Table);
+  const QTable table = loadQTableFile(path("v1.yaml"));
+  EXPECT_EQ(FeatureKind::Bins, table.features().kind);
+  EXPECT_EQ(4u, table.stateCount());
+  EXPECT_EQ(31.744540498961268, table.at(3, 1));
+  EXPECT_EQ(73u, table.steps);
+  // Saved again it becomes version 2 with the same values and the same checksum.
+  saveQTableFile(table, path("v2.yaml"));
+  const std::string text = readFile(path("v2.yaml"));
+  EXPECT_NE(std::string::npos, text.find("version: 2\n")) << text;
+  EXPECT_NE(std::string::npos, text.find("checksum: fnv1a64:21088f60d2624369")) << text;
+  EXPECT_TRUE(bitIdentical(table.values(), loadQTableFile(path("v2.yaml")).values()));
+}
+
+TEST_F(QTableFileTest, ATableOfOtherFeaturesIsRefusedSayingWhatDiffers)
+{
+  AgentParams bins;
+  TrainingSession bins_session(TaskParams(), bins, 0);
+  AgentParams tiles;
+  tiles.features = FeatureKind::Tiles;
+  tiles.tilings = 4;
+  tiles.tiles = {{1, 2, 6, 12}};
+  tiles.discretiser.lower[1] = -1.5;
+  tiles.discretiser.upper[1] = 1.5;
+  tiles.actions = {-10.0, 0.0, 10.0};
+  TrainingSession tiles_session(TaskParams(), tiles, 0);
+  const std::vector<double> bins_live = bins_session.table().values();
+  const std::vector<double> tiles_live = tiles_session.table().values();
+
+  saveQTableFile(tilesTable(), path("tiles.yaml"));
+  EXPECT_EQ("features tiles differ from bins", loadInto(bins_session, path("tiles.yaml")));
+  EXPECT_EQ("", loadInto(tiles_session, path("tiles.yaml")));
+  tiles_session.replaceTable(QTable(tiles.featureParams(), tiles.actions));  // back to zeros
+  saveQTableFile(awkwardTable(), path("bins.yaml"));
+  EXPECT_EQ("features bins differ from tiles", loadInto(tiles_session, path("bins.yaml")));
+
+  FeatureParams other = tilesTable().features();
+  other.tilings = 8;
+  saveQTableFile(QTable(other, tilesTable().actions()), path("tilings.yaml"));
+  EXPECT_EQ("tilings 8 differ from 4", loadInto(tiles_session, path("tilings.yaml")));
+  other = tilesTable().features();
+  other.tiles = {{1, 2, 6, 10}};
+  saveQTableFile(QTable(other, tilesTable().actions()), path("tiles10.yaml"));
+  EXPECT_EQ("tiles [1, 2, 6, 10] differ from [1, 2, 6, 12]", loadInto(tiles_session, path("tiles10.yaml")));
+  other = tilesTable().features();
+  other.discretiser.upper[1] = 2.0;
+  saveQTableFile(QTable(other, tilesTable().actions()), path("bounds.yaml"));
+  const std::string bounds = loadInto(tiles_session, path("bounds.yaml"));
+  EXPECT_EQ(0u, bounds.find("tile bounds lower [-2.3999999999999999, -1.5, ")) << bounds;
+  EXPECT_NE(std::string::npos, bounds.find("upper [2.3999999999999999, 2, ")) << bounds;
+  // The bins of a tiles table, and the bounds of an ignored dimension, play no part.
+  other = tilesTable().features();
+  other.discretiser.bins = {{3, 3, 3, 3}};
+  other.discretiser.lower[0] = -1.0;
+  saveQTableFile(QTable(other, {-10.0, 0.0, 10.0}), path("same.yaml"));
+  EXPECT_EQ("", loadInto(tiles_session, path("same.yaml")));
+
+  EXPECT_TRUE(bitIdentical(bins_live, bins_session.table().values()));
 }

@@ -118,6 +118,72 @@ TEST_F(TrainHeadlessTest, ARelativeSaveGoesWhereTheControllerLooksAndNoSaveSaysS
       << unsaved.output;
 }
 
+// The fields of a CSV line (no quoting: the package's own rows have none).
+std::vector<std::string> fields(const std::string& line)
+{
+  std::vector<std::string> found;
+  std::istringstream in(line);
+  for (std::string f; std::getline(in, f, ',');)
+    found.push_back(f);
+  if (!line.empty() && line.back() == ',')
+    found.push_back("");
+  return found;
+}
+
+TEST_F(TrainHeadlessTest, TheStatsCsvHasOneRowPerEpisodeEndingWhereTheResultLineSays)
+{
+  const std::string csv = file("curve/episodes.csv");  // a folder that does not exist yet
+  const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --stats-csv " + csv);
+  ASSERT_EQ(0, run.status) << run.output;
+  std::smatch result;
+  const std::string last = run.lastLine();
+  ASSERT_TRUE(std::regex_match(last, result, std::regex("solved=true episodes=([0-9]+) steps=([0-9]+) wall_s=.*")))
+      << last;
+  const unsigned long episodes = std::stoul(result[1]);
+  const unsigned long steps = std::stoul(result[2]);
+
+  std::istringstream in(fileText(csv));
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(
+      "episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,terminated,truncated,solved,total_steps,"
+      "wall_time",
+      line);
+  unsigned long rows = 0;
+  unsigned long summed_steps = 0;
+  std::vector<std::string> row;
+  while (std::getline(in, line))
+  {
+    row = fields(line);
+    ASSERT_EQ(12u, row.size()) << line;
+    ++rows;
+    EXPECT_EQ(std::to_string(rows), row[0]) << "rows out of order or missing at " << line;
+    summed_steps += std::stoul(row[2]);
+    EXPECT_EQ(std::to_string(summed_steps), row[10]) << line;
+    // Every episode of this task earns +1 a step (gymnasium rewards).
+    EXPECT_EQ(std::stod(row[2]), std::stod(row[3])) << line;
+    EXPECT_NE(row[8] == "true", row[7] == "true") << "an episode ends terminated or truncated: " << line;
+    if (rows < episodes)
+    {
+      EXPECT_EQ("false", row[9]) << "solved before the last episode: " << line;
+    }
+  }
+  EXPECT_EQ(episodes, rows);
+  EXPECT_EQ(steps, summed_steps);
+  EXPECT_EQ("true", row.at(9)) << "the last row is not the solved episode";
+  EXPECT_GE(std::stod(row.at(4)), 475.0);
+}
+
+TEST_F(TrainHeadlessTest, AStatsCsvThatCannotBeWrittenStopsBeforeTraining)
+{
+  fs::create_directories(dir_ / "a_folder");
+  const CommandRun run = trainHeadless(config() + " --stats-csv " + (dir_ / "a_folder").string());
+  EXPECT_EQ(2, run.status) << run.output;
+  EXPECT_NE(std::string::npos, run.output.find("--stats-csv")) << run.output;
+  EXPECT_NE(std::string::npos, run.output.find("a_folder")) << run.output;
+  EXPECT_EQ(std::string::npos, run.output.find("solved=")) << run.output;
+}
+
 TEST_F(TrainHeadlessTest, UnsolvedRunSaysSo)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
@@ -246,6 +312,22 @@ TEST_F(TrainHeadlessTest, BadReplayFileNamesTheLineAndRunsNothing)
     EXPECT_NE(std::string::npos, run.output.find(replay + " " + c.second)) << run.output;
     EXPECT_EQ(std::string::npos, run.output.find("episode 1 step")) << run.output;
     EXPECT_FALSE(fs::exists(saved)) << c.first;
+  }
+}
+
+// The trace prints one table row per state: a tile-coded config has none, and is told so
+// before anything runs.
+TEST_F(TrainHeadlessTest, TraceAndReplayRefuseATileCodedConfig)
+{
+  const std::string tiles = std::string(" --config ") + CARTPOLE_CONFIG_DIR + "/tiles.yaml";
+  const std::vector<std::string> options{" --trace",
+                                         std::string(" --replay ") + CARTPOLE_CONFIG_DIR + "/tutorial_10_steps.yaml"};
+  for (const std::string& option : options)
+  {
+    const CommandRun run = trainHeadless(tiles + option);
+    EXPECT_EQ(2, run.status) << run.output;
+    EXPECT_NE(std::string::npos, run.output.find("it needs learning/features bins")) << run.output;
+    EXPECT_EQ(std::string::npos, run.output.find("solved=")) << run.output;
   }
 }
 

@@ -14,6 +14,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -149,6 +150,24 @@ void expectGoesOnFromItsCheckpoint(const Launch& run, Episodes& episodes, const 
   for (std::size_t i = before; i < episodes.seen.size(); ++i)
     EXPECT_GT(episodes.seen[i], checkpoint) << "the episode counter went back";
   EXPECT_EQ(1u, runFolders(ns).size());
+
+  // The run's learning curve goes on in the same file: one header, every episode once, in order
+  // (the rows after the checkpoint, which the run played again, were replaced). The last line
+  // may be in the middle of being written.
+  const std::string csv = fileText((folder / "episodes.csv").string());
+  std::istringstream lines(csv.substr(0, csv.rfind('\n') + 1));
+  std::string line;
+  ASSERT_TRUE(std::getline(lines, line)) << "no episodes.csv in " << folder;
+  EXPECT_EQ(0u, line.find("episode,robot,steps,")) << line;
+  std::uint64_t rows = 0;
+  while (std::getline(lines, line))
+  {
+    ++rows;
+    ASSERT_EQ(std::to_string(rows) + ",", line.substr(0, line.find(',') + 1))
+        << "row " << rows << " of " << folder / "episodes.csv"
+        << " after the restart";
+  }
+  EXPECT_GT(rows, checkpoint);
 }
 
 TEST(TrainLaunch, ASolvedRunEndsCleanlyAndLaterUnsolvedRunsLeaveItsTable)

@@ -39,6 +39,23 @@ TEST(HeadlessTrainer, DefaultConfigSolvesCartPoleOnSeedsZeroToNineInAMedianOfAtM
   EXPECT_LE(median, 300.0);
 }
 
+TEST(HeadlessTrainer, TilesConfigSolvesSeedsZeroToNineInAMedianOfAtMost150Episodes)
+{
+  const TrainingConfig config = readTrainingConfig(*loadYamlParameters(CARTPOLE_CONFIG_DIR "/tiles.yaml"));
+  ASSERT_EQ(FeatureKind::Tiles, config.agent.features);
+  std::vector<std::uint64_t> episodes;
+  for (std::uint64_t seed = 0; seed < 10; ++seed)
+  {
+    HeadlessTrainer trainer(config, seed);
+    const TrainingResult result = trainer.run();
+    EXPECT_TRUE(result.solved) << "seed " << seed;
+    EXPECT_EQ(FeatureKind::Tiles, trainer.session().table().features().kind);
+    episodes.push_back(result.episodes);
+  }
+  std::sort(episodes.begin(), episodes.end());
+  EXPECT_LE((episodes[4] + episodes[5]) / 2.0, 150.0);
+}
+
 TEST(HeadlessTrainer, SameSeedGivesTheSameTableBitForBit)
 {
   TrainingConfig config = shippedConfig();

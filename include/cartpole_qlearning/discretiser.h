@@ -30,6 +30,27 @@ struct DiscretiserParams
   bool operator==(const DiscretiserParams& other) const;
 };
 
+// The bin of a value among n uniform bins over [lower, upper): bin i covers
+// [lower + i*w, lower + (i+1)*w) with w = (upper - lower) / n; values below lower (and NaN) go to
+// bin 0, values at or above upper to bin n - 1. A value on an edge always lands in the bin that
+// starts there, even where the division rounds across it. n >= 1, lower < upper.
+inline unsigned uniformBin(double value, double lower, double upper, unsigned n)
+{
+  if (!(value >= lower))  // below the range, or NaN
+    return 0;
+  if (value >= upper)
+    return n - 1;
+  const double width = (upper - lower) / n;
+  unsigned i = static_cast<unsigned>((value - lower) / width);
+  if (i >= n)
+    i = n - 1;
+  if (value < lower + i * width)
+    --i;
+  else if (i + 1 < n && value >= lower + (i + 1) * width)
+    ++i;
+  return i;
+}
+
 class Discretiser
 {
 public:
@@ -46,8 +67,7 @@ public:
     return state_count_;
   }
 
-  // The bin of one dimension's value. Bin i covers [lower + i*w, lower + (i+1)*w) with
-  // w = (upper - lower) / bins; a NaN goes to bin 0. No allocation.
+  // The bin of one dimension's value (uniformBin over that dimension's bins and bounds). No allocation.
   unsigned bin(std::size_t dimension, double value) const;
 
   // The row of a state: the bins combined in mixed radix, first dimension most significant.

@@ -1,11 +1,15 @@
-// Tabular Q-learning with epsilon-greedy exploration over a fixed set of efforts.
+// Q-learning with epsilon-greedy exploration over a fixed set of efforts, on bins (tabular) or
+// tiles (linear in the tiles' weights). A state is given as the rows it activates (ActiveRows);
+// Q(s, a) is the sum of their weights for a, one row for bins.
 #pragma once
 
 #include "cartpole_qlearning/discretiser.h"
+#include "cartpole_qlearning/features.h"
 #include "cartpole_qlearning/q_table.h"
 #include "cartpole_qlearning/random.h"
 #include "cartpole_qlearning/schedule.h"
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -14,7 +18,12 @@ namespace cartpole_qlearning
 {
 struct AgentParams
 {
+  // What the learner sees of the state (features.h). The bins are used by bins only, the bounds
+  // by both, tilings and tiles (per dimension) by tiles only.
+  FeatureKind features = FeatureKind::Bins;
   DiscretiserParams discretiser;
+  unsigned tilings = 8;
+  std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
   std::vector<double> actions{-10.0, 10.0};   // [N] the effort of each action
   double gamma = 0.99;                        // discount, in [0, 1]
   ScheduleParams epsilon = defaultEpsilon();  // exploration rate per episode
@@ -27,6 +36,8 @@ struct AgentParams
   // over 150 episodes, alpha on the log schedule from 1.0 to 0.05 over ~150.
   static ScheduleParams defaultEpsilon();
   static ScheduleParams defaultAlpha();
+
+  FeatureParams featureParams() const;
 
   // Empty when valid, else a message naming the first bad field, its value and the allowed range.
   std::string validate() const;
@@ -53,9 +64,19 @@ public:
   {
     return params_;
   }
+  const FeatureMap& features() const
+  {
+    return features_;
+  }
+  // Bins only (the default discretiser for tiles).
   const Discretiser& discretiser() const
   {
-    return discretiser_;
+    return features_.discretiser();
+  }
+  // The rows a state activates. No allocation.
+  void activeRows(const CartPoleState& state, ActiveRows& active) const
+  {
+    features_.activeRows(state, active);
   }
   const QTable& table() const
   {
@@ -75,26 +96,55 @@ public:
     return alpha_.value(episode);
   }
 
+  // Replaces the discount and the schedules of a running agent (live tuning), checked as the
+  // configuration is (AgentParams::validate); on a bad value returns the message and changes
+  // nothing. The schedules are then read at the table's episode count, as if they had applied
+  // from the start.
+  std::string setLearning(double gamma, const ScheduleParams& epsilon, const ScheduleParams& alpha);
+
+  // Q(s, a): the sum of the active rows' weights for the action.
+  double value(const ActiveRows& state, std::size_t action) const;
+
   // With probability epsilon a uniformly drawn action, else the greedy one. Always takes one
   // draw for the coin and, when exploring, one for the action.
-  std::size_t selectAction(std::size_t state, double epsilon);
+  std::size_t selectAction(const ActiveRows& state, double epsilon);
+  // The first action with the largest Q (ties go to the lowest index, as numpy's argmax).
+  std::size_t greedyAction(const ActiveRows& state) const;
+  // The same for a bins state given as its row.
+  std::size_t selectAction(std::size_t state, double epsilon)
+  {
+    return selectAction(ActiveRows::single(state), epsilon);
+  }
   std::size_t greedyAction(std::size_t state) const
   {
     return table_.argmax(state);
   }
 
-  // Q(s,a) += alpha * (reward + gamma * max_a' Q(s',a') - Q(s,a)); the max term is dropped when
-  // next_is_terminal (a fall has no future), kept on truncation. Returns what it did (the trace).
+  // Q(s,a) += alpha * (target - Q(s,a)) with target = reward + gamma * max_a' Q(s',a'); the max
+  // term is dropped when next_is_terminal (a fall has no future), kept on truncation. With N
+  // active rows each of their weights moves by alpha / N of the error, so Q(s,a) moves by alpha
+  // of it whatever N is (alpha keeps its meaning across bins and tilings). Returns what it did
+  // (the trace).
+  QUpdate update(const ActiveRows& state, std::size_t action, double reward, const ActiveRows& next_state,
+                 bool next_is_terminal, double alpha);
+  // The same for bins states given as their rows.
   QUpdate update(std::size_t state, std::size_t action, double reward, std::size_t next_state, bool next_is_terminal,
-                 double alpha);
+                 double alpha)
+  {
+    return update(ActiveRows::single(state), action, reward, ActiveRows::single(next_state), next_is_terminal, alpha);
+  }
 
-  // Replaces the table after checking it has this agent's discretisation and actions; on a
+  // Replaces the table after checking it has this agent's features and actions; on a
   // mismatch returns what differs and leaves the table in use as it was.
   std::string replaceTable(QTable table);
 
 private:
+  // Over several rows: the greedy action, and its Q in best_q when given.
+  std::size_t greedyAction(const ActiveRows& state, double* best_q) const;
+  double maxValue(const ActiveRows& state) const;
+
   AgentParams params_;
-  Discretiser discretiser_;
+  FeatureMap features_;
   Schedule epsilon_;
   Schedule alpha_;
   QTable table_;

@@ -1,8 +1,10 @@
-// The Q-table and what it takes to interpret it: the discretisation that numbers its rows,
-// the efforts that name its columns, and how much training produced it.
+// The Q-table and what it takes to interpret it: the features that number its rows (bins: one
+// row per state; tiles: one row of weights per tile, Q the sum over the active tiles), the
+// efforts that name its columns, and how much training produced it.
 #pragma once
 
 #include "cartpole_qlearning/discretiser.h"
+#include "cartpole_qlearning/features.h"
 
 #include <cstdint>
 #include <string>
@@ -19,7 +21,10 @@ public:
   QTable() = default;
   // A table of zeros with one row per discretiser state and one column per action effort.
   QTable(const DiscretiserParams& discretiser, const std::vector<double>& actions);
+  // A table of zeros with one row per feature row (state or tile) and one column per action.
+  QTable(const FeatureParams& features, const std::vector<double>& actions);
 
+  // Rows: states for bins, tiles of all tilings for tiles.
   std::size_t stateCount() const
   {
     return state_count_;
@@ -42,9 +47,14 @@ public:
   std::size_t argmax(std::size_t state) const;
   double max(std::size_t state) const;
 
+  const FeatureParams& features() const
+  {
+    return features_;
+  }
+  // The bins and the bounds (the bounds serve tiles too).
   const DiscretiserParams& discretiser() const
   {
-    return discretiser_;
+    return features_.discretiser;
   }
   const std::vector<double>& actions() const
   {
@@ -62,11 +72,12 @@ public:
   std::uint64_t episodes = 0;
   std::uint64_t steps = 0;
 
-  // Empty when the other table has the same discretisation and actions, else what differs.
+  // Empty when the other table has the same features (kind, bins or tilings and tiles, bounds)
+  // and actions, else what differs.
   std::string shapeMismatch(const QTable& other) const;
 
 private:
-  DiscretiserParams discretiser_;
+  FeatureParams features_;
   std::vector<double> actions_;
   std::size_t state_count_ = 0;
   std::vector<double> values_;

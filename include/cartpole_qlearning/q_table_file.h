@@ -12,7 +12,9 @@ namespace cartpole_qlearning
 // Anything wrong with a path or a table file; the message says what, and nothing was changed.
 using QTableFileError = FileError;
 
-constexpr int kQTableFormatVersion = 1;
+// Version 2 says which features number the rows (bins or tiles, with their parameters);
+// version 1 (bins only) is still read, as bins.
+constexpr int kQTableFormatVersion = 2;
 
 // Saves atomically (see file_access.h: the target is either the old file or the complete new
 // one, whatever happens). Creates missing parent directories. Throws QTableFileError.

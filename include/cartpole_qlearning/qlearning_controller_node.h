@@ -4,19 +4,24 @@
 // TrainingSession), answers on joint_command stamped with the state's stamp, ends episodes by
 // calling that robot's reset service (or, for a robot without one, waits for it to be stood
 // up), and publishes episode_stats. Several robots are served in lockstep rounds (RobotRounds)
-// unless ~sync is false. It saves and loads its Q-table through services.
+// unless ~sync is false. It saves and loads its Q-table through services, and serves its learning
+// settings (epsilon, alpha, gamma and their schedules) for live tuning with dynamic_reconfigure.
 #pragma once
 
 #include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/LearningConfig.h"
 #include "cartpole_qlearning/LoadQTable.h"
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/episode_csv.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
 #include "cartpole_qlearning/robot_rounds.h"
 #include "cartpole_qlearning/training_run.h"
 #include "cartpole_qlearning/training_session.h"
 #include "cartpole_qlearning/wall_throttle.h"
 
+#include <boost/thread/recursive_mutex.hpp>
+#include <dynamic_reconfigure/server.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
@@ -70,10 +75,22 @@ private:
   };
 
   void readParameters();
+  // Serves the learning settings in use on ~set_parameters (dynamic_reconfigure). Called with
+  // mutex_ free: the server calls onReconfigure at once, which takes it.
+  void startLiveTuning();
+  // A change from a dynamic_reconfigure client: applied when the core accepts it, else refused
+  // with the values in use put back into config (what the server then keeps and reports).
+  void onReconfigure(LearningConfig& config, std::uint32_t level);
   // Training: starts this run's folder, or continues it when this process is a respawn of the
   // controller that started it (the same ~run_id).
   void openRun();
   void resumeRun();
+  // ~stats_csv: the file a user named is opened before the run starts (a bad one stops the node
+  // naming the parameter); the curve itself starts once the run is known (fresh, or going on
+  // from the checkpoint a respawn resumed).
+  void openStatsFile();
+  void startStatsCsv();
+  void writeStatsRow(const Robot& robot, const EpisodeSummary& summary);
   // Saves the table and the run record into the run's folder; returns the message to log.
   bool checkpoint(const std::string& finished, std::string& message);
   // Puts a loaded table in place (checked; on a mismatch returns what differs, nothing changed).
@@ -122,8 +139,15 @@ private:
   std::string q_table_dir_;
   std::string q_table_path_ = "q_table.yaml";
   std::string load_on_start_;
-  std::string run_id_;      // ~run_id: the launch's own id (train.launch: $(anon run))
-  std::string run_folder_;  // this run's folder, relative to q_table_dir_ ("" when evaluating)
+  std::string run_id_;        // ~run_id: the launch's own id (train.launch: $(anon run))
+  std::string run_folder_;    // this run's folder, relative to q_table_dir_ ("" when evaluating)
+  bool resumed_run_ = false;  // this process is a respawn going on with its run
+  // ~stats_csv: "" the run's folder/episodes.csv (training; none when evaluating), "none" no
+  // file, else a path (relative: under q_table_dir_).
+  std::string stats_csv_;
+  std::unique_ptr<AppendingFile> stats_file_;  // opened, its curve not started yet
+  std::unique_ptr<EpisodeCsvWriter> stats_csv_writer_;
+  bool stats_csv_pending_ = false;  // the default file, opened at the first episode's end
   RunRecord run_;
   std::uint64_t evaluation_episodes_ = 10;  // evaluate: the verdict after this many episodes (0: never)
   std::uint64_t evaluated_balanced_ = 0;
@@ -136,6 +160,8 @@ private:
   ControllerProtocolParams protocol_params_;
   bool trace_ = false;                    // ~trace: log every update and the table at each episode end
   std::vector<std::string> state_names_;  // as the trace names the rows (trace.h)
+
+  bool respawned_ = false;  // this process goes on with the run of a controller that died (openRun)
 
   std::unique_ptr<TrainingSession> session_;
   std::vector<Robot> robots_;
@@ -158,6 +184,10 @@ private:
   ros::ServiceServer save_srv_;
   ros::ServiceServer load_srv_;
   ros::SteadyTimer watchdog_;
+  // Given to the server so that its updates and its callback never run at the same time.
+  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<LearningConfig>> reconfigure_;
+  bool reconfigure_started_ = false;  // the server's first callback (at its start) has run
 
   std::mutex reset_mutex_;
   std::condition_variable reset_wanted_;

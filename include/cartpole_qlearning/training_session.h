@@ -11,9 +11,11 @@
 #pragma once
 
 #include "cartpole_qlearning/cartpole_task.h"
+#include "cartpole_qlearning/learning_settings.h"
 #include "cartpole_qlearning/q_learning_agent.h"
 #include "cartpole_qlearning/trace.h"
 
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -30,6 +32,7 @@ struct EpisodeSummary
   double mean_return_window = 0.0;  // over the last solved_window episodes (fewer at the start)
   double epsilon = 0.0;
   double alpha = 0.0;
+  double gamma = 0.0;  // the discount in force when the episode ended (live tuning may change it)
   bool terminated = false;
   bool truncated = false;
   bool solved = false;  // a full window whose mean return reaches solved_mean_return
@@ -136,6 +139,17 @@ public:
     return agent_;
   }
 
+  // The learning settings in use: at first the configuration's, no override.
+  const LearningSettings& learningSettings() const
+  {
+    return learning_settings_;
+  }
+  // Live tuning: checks the settings (LearningSettings::validate); on a bad value returns the
+  // message and changes nothing. Else they apply at once: gamma from the next update, epsilon
+  // and alpha (fixed for an episode when it begins) from the next episode that begins, each
+  // schedule read at the table's episode count (it resumes there, it does not start over).
+  std::string setLearning(const LearningSettings& settings);
+
   // The table with its training counters brought up to date.
   const QTable& table() const
   {
@@ -159,9 +173,20 @@ private:
   struct Episode
   {
     explicit Episode(unsigned window) : returns(window) {}
+    // The rows of the state the action was taken in, and of the state it led to: two buffers
+    // swapped at each step, so that a step copies no rows.
+    const ActiveRows& state() const
+    {
+      return rows[current];
+    }
+    ActiveRows& next()
+    {
+      return rows[current ^ 1];
+    }
     bool running = false;
     std::uint64_t number = 0;  // as the trace numbers it (TraceStep::episode)
-    std::size_t state = 0;
+    std::array<ActiveRows, 2> rows{};
+    unsigned current = 0;
     std::size_t action = 0;
     unsigned steps = 0;
     double episode_return = 0.0;
@@ -172,10 +197,11 @@ private:
     ReturnWindow returns;
   };
 
-  std::size_t chooseAction(std::size_t state, double epsilon);
+  std::size_t chooseAction(const ActiveRows& state, double epsilon);
 
   CartPoleTask task_;
   QLearningAgent agent_;
+  LearningSettings learning_settings_;
   bool learning_;
   std::vector<Episode> episodes_;
   ReturnWindow returns_;  // every robot's episodes

@@ -1,0 +1,36 @@
+// The learning settings a running learner may change (live tuning): the discount and the
+// epsilon and alpha schedules, each with an optional override that holds its rate constant.
+// The discretisation and the actions are not among them: they fix the table's shape.
+#pragma once
+
+#include "cartpole_qlearning/q_learning_agent.h"
+#include "cartpole_qlearning/schedule.h"
+
+#include <optional>
+#include <string>
+
+namespace cartpole_qlearning
+{
+struct LearningSettings
+{
+  double gamma = 0.99;
+  ScheduleParams epsilon = AgentParams::defaultEpsilon();
+  ScheduleParams alpha = AgentParams::defaultAlpha();
+  std::optional<double> epsilon_override;  // set: epsilon is this every episode, whatever the schedule says
+  std::optional<double> alpha_override;    // set: alpha is this every episode
+
+  // The configuration's settings, no override.
+  static LearningSettings of(const AgentParams& agent);
+
+  // Empty when valid, else a message naming the first bad field ("gamma", "epsilon/min",
+  // "alpha_override", ...), its value and what is allowed. gamma and both schedules get the
+  // config file's checks (AgentParams::validate), a schedule even while it is overridden, so that
+  // going back to it always finds it valid.
+  std::string validate() const;
+
+  // What applies: the override as a constant schedule, else the schedule.
+  ScheduleParams effectiveEpsilon() const;
+  ScheduleParams effectiveAlpha() const;
+};
+
+}  // namespace cartpole_qlearning
