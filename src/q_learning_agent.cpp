@@ -11,9 +11,10 @@ namespace cartpole_qlearning
 ScheduleParams AgentParams::defaultEpsilon()
 {
   ScheduleParams schedule;
-  schedule.type = ScheduleType::Log;
+  schedule.type = ScheduleType::Linear;
   schedule.start = 1.0;
-  schedule.min = 0.01;
+  schedule.min = 0.03;
+  schedule.decay_episodes = 150.0;
   schedule.log_divisor = 25.0;
   return schedule;
 }

@@ -22,7 +22,7 @@ void usage(std::ostream& out)
 {
   out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--save PATH] [--ns NS] [--max-episodes N] "
          "[--stats-csv FILE] [--quiet]\n"
-         "                      [--trace] [--replay FILE]\n"
+         "                      [--returns] [--trace] [--replay FILE]\n"
          "  --config FILE     physics, task, learning and training parameters (YAML);\n"
          "                    default: the package's config/cartpole.yaml\n"
          "  --seed N          seed of the start states and of exploration (default 0)\n"
@@ -38,6 +38,8 @@ void usage(std::ostream& out)
          "                    (relative to the current directory); an earlier curve there is replaced, any\n"
          "                    other file refused\n"
          "  --quiet           no progress lines, only the result line\n"
+         "  --returns         before the result line, one line \"returns=R1 R2 ...\": every episode's return, in "
+         "order\n"
          "  --trace           print every update as the tutorial works it (state, action, reward, next state,\n"
          "                    old Q, target, new Q) and the Q-table at each episode's end\n"
          "  --replay FILE     train on nothing else than the transitions listed in FILE ([state, action, reward,\n"
@@ -79,6 +81,7 @@ int run(int argc, char** argv)
   std::uint64_t max_episodes = 0;
   std::uint64_t robots = 1;
   bool quiet = false;
+  bool print_returns = false;
   bool trace = false;
   std::string replay_path;
   for (int i = 1; i < argc; ++i)
@@ -92,6 +95,8 @@ int run(int argc, char** argv)
     }
     else if (arg == "--quiet")
       quiet = true;
+    else if (arg == "--returns")
+      print_returns = true;
     else if (arg == "--trace")
       trace = true;
     else if (arg == "--replay" && has_value)
@@ -277,7 +282,14 @@ int run(int argc, char** argv)
   const std::uint64_t every = quiet ? 0 : config.limits.progress_every;
   std::uint64_t last_steps = 0;
   auto last_time = start;
+  std::string returns;
   const TrainingResult result = trainer.run([&](const EpisodeSummary& s) {
+    if (print_returns)
+    {
+      char text[32];
+      std::snprintf(text, sizeof text, "%s%.17g", returns.empty() ? "" : " ", s.episode_return);
+      returns += text;
+    }
     if (trace)
     {
       const std::string which = robots > 1 ? "robot " + std::to_string(s.robot) + "'s episode " +
@@ -314,7 +326,10 @@ int run(int argc, char** argv)
     last_time = now;
   });
   const int status = save(trainer.session().table());
-  std::printf("solved=%s episodes=%llu steps=%llu wall_s=%.3f\n", result.solved ? "true" : "false",
+  if (print_returns)
+    std::printf("returns=%s\n", returns.c_str());
+  // Microseconds: a run to solved takes a few milliseconds.
+  std::printf("solved=%s episodes=%llu steps=%llu wall_s=%.6f\n", result.solved ? "true" : "false",
               static_cast<unsigned long long>(result.episodes), static_cast<unsigned long long>(result.steps),
               result.wall_s);
   return status;

@@ -44,8 +44,12 @@ TEST(Config, ShippedFileLoadsWithTheDocumentedDefaults)
   EXPECT_EQ(defaults.agent.gamma, config.agent.gamma);
   EXPECT_EQ(defaults.agent.actions, config.agent.actions);
   EXPECT_TRUE(defaults.agent.discretiser == config.agent.discretiser);
+  EXPECT_EQ(defaults.agent.epsilon.type, config.agent.epsilon.type);
+  EXPECT_EQ(defaults.agent.epsilon.start, config.agent.epsilon.start);
   EXPECT_EQ(defaults.agent.epsilon.min, config.agent.epsilon.min);
+  EXPECT_EQ(defaults.agent.epsilon.decay_episodes, config.agent.epsilon.decay_episodes);
   EXPECT_EQ(defaults.agent.epsilon.log_divisor, config.agent.epsilon.log_divisor);
+  EXPECT_EQ(defaults.agent.alpha.type, config.agent.alpha.type);
   EXPECT_EQ(defaults.agent.alpha.min, config.agent.alpha.min);
   EXPECT_EQ(defaults.agent.alpha.log_divisor, config.agent.alpha.log_divisor);
   EXPECT_EQ(defaults.limits.max_episodes, config.limits.max_episodes);

@@ -169,7 +169,7 @@ TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume
   const std::size_t resumed = firstStats(changed, [](const EpisodeStats& s) { return s.gamma == 0.96; });
   ASSERT_LT(resumed, stats.size()) << "no episode with gamma 0.96";
   ASSERT_TRUE(spinUntil([&] { return stats.size() >= resumed + 4; }, 60.0));
-  ScheduleParams epsilon;  // learning/epsilon of config/cartpole.yaml, min as the launch sets it
+  ScheduleParams epsilon;  // learning/epsilon of config/cartpole.yaml, schedule and min as the launch sets them
   epsilon.type = ScheduleType::Log;
   epsilon.start = 1.0;
   epsilon.min = 0.02;

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -190,6 +191,37 @@ TEST_F(TrainHeadlessTest, UnsolvedRunSaysSo)
   EXPECT_EQ(0, run.status);
   EXPECT_TRUE(std::regex_match(run.lastLine(), std::regex("solved=false episodes=5 steps=[0-9]+ wall_s=[0-9.]+")))
       << run.lastLine();
+}
+
+TEST_F(TrainHeadlessTest, WallTimeHasMicrosecondsSoAFewMillisecondsCanBeRead)
+{
+  const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
+  EXPECT_TRUE(
+      std::regex_match(run.lastLine(), std::regex("solved=false episodes=5 steps=[0-9]+ wall_s=[0-9]+\\.[0-9]{6}")))
+      << run.lastLine();
+}
+
+TEST_F(TrainHeadlessTest, ReturnsListsEveryEpisodesReturnBeforeTheResultLine)
+{
+  const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 7 --returns");
+  EXPECT_EQ(0, run.status) << run.output;
+  std::smatch result;
+  const std::string last = run.lastLine();
+  ASSERT_TRUE(std::regex_match(last, result, std::regex("solved=false episodes=7 steps=([0-9]+) wall_s=[0-9.]+")))
+      << run.output;
+  std::smatch returns;
+  ASSERT_TRUE(std::regex_search(run.output, returns, std::regex("returns=([0-9 ]+)\n"))) << run.output;
+  std::istringstream values(returns[1].str());
+  std::vector<double> episode_returns{std::istream_iterator<double>(values), std::istream_iterator<double>()};
+  ASSERT_EQ(7u, episode_returns.size()) << returns[1];
+  // The default reward is +1 a step, so the returns add up to the steps run.
+  double sum = 0.0;
+  for (const double r : episode_returns)
+    sum += r;
+  EXPECT_EQ(std::stod(result[1].str()), sum);
+
+  const CommandRun without = trainHeadless(config() + " --seed 0 --quiet --max-episodes 7");
+  EXPECT_EQ(std::string::npos, without.output.find("returns=")) << without.output;
 }
 
 TEST_F(TrainHeadlessTest, BadConfigStopsWithTheKeyTheValueAndTheRange)
