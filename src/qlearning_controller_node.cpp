@@ -1104,22 +1104,35 @@ void QLearningControllerNode::resetLoop()
       reset_pending_[r] = false;
     }
     Robot& robot = robots_[r];
-    // Connected when first needed (the sim may come up after this node), and again after its
-    // sim restarted. Persistent: a new connection per episode would cost a master lookup and a
-    // TCP set-up.
-    if (!robot.reset_client.isValid())
-      robot.reset_client = robot.nh.serviceClient<Reset>(reset_service_, true);
     Reset reset;  // empty state: a random start
-    if (robot.reset_client.call(reset) && reset.response.success)
+    bool answered = false;
+    if (failing[r])
+    {
+      // While the sim is away or restarting, each try makes a connection of its own: roscpp's
+      // persistent links can hang across a server's restart (ros/ros_comm#149, #152), and a hung
+      // call here would stop every later reset. The persistent link is made again once the sim
+      // answers.
+      robot.reset_client = ros::ServiceClient();
+      answered = robot.nh.serviceClient<Reset>(reset_service_, false).call(reset) && reset.response.success;
+    }
+    else
+    {
+      // Connected when first needed (the sim may come up after this node). Persistent: a new
+      // connection per episode would cost a master lookup and a TCP set-up.
+      if (!robot.reset_client.isValid())
+        robot.reset_client = robot.nh.serviceClient<Reset>(reset_service_, true);
+      answered = robot.reset_client.call(reset) && reset.response.success;
+    }
+    if (answered)
     {
       if (failing[r])
-        ROS_INFO("qlearning_controller: %s answers again; going on", robot.reset_client.getService().c_str());
+        ROS_INFO("qlearning_controller: %s answers again; going on", robot.nh.resolveName(reset_service_).c_str());
       failing[r] = false;
       continue;
     }
     if (!failing[r])
       ROS_WARN("qlearning_controller: reset call to %s failed%s; retrying until it answers",
-               robot.reset_client.getService().c_str(),
+               robot.nh.resolveName(reset_service_).c_str(),
                reset.response.message.empty() ? "" : (": " + reset.response.message).c_str());
     failing[r] = true;
     std::lock_guard<std::mutex> lock(reset_mutex_);
