@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 namespace cartpole_qlearning
 {
@@ -60,6 +62,78 @@ ScheduleParams LearningSettings::effectiveEpsilon() const
 ScheduleParams LearningSettings::effectiveAlpha() const
 {
   return effective(alpha, alpha_override);
+}
+
+namespace
+{
+// Each field as the server names it, with its value as text.
+std::vector<std::pair<std::string, std::string>> fieldsOf(const LearningSettings& s)
+{
+  const auto number = [](double value) {
+    std::ostringstream out;
+    out << value;
+    return out.str();
+  };
+  const auto override = [&](const std::optional<double>& value) { return value ? number(*value) : "none"; };
+  std::vector<std::pair<std::string, std::string>> fields{{"epsilon_override", override(s.epsilon_override)},
+                                                          {"alpha_override", override(s.alpha_override)},
+                                                          {"gamma", number(s.gamma)}};
+  for (const auto& [name, p] : {std::make_pair("epsilon_", &s.epsilon), std::make_pair("alpha_", &s.alpha)})
+  {
+    fields.emplace_back(name + std::string("schedule"), toString(p->type));
+    fields.emplace_back(name + std::string("start"), number(p->start));
+    fields.emplace_back(name + std::string("min"), number(p->min));
+    fields.emplace_back(name + std::string("decay_episodes"), number(p->decay_episodes));
+    fields.emplace_back(name + std::string("decay_rate"), number(p->decay_rate));
+    fields.emplace_back(name + std::string("log_divisor"), number(p->log_divisor));
+  }
+  return fields;
+}
+
+std::string scheduleText(const ScheduleParams& p)
+{
+  std::ostringstream out;
+  out << toString(p.type) << " " << p.start;
+  if (p.type == ScheduleType::Linear)
+    out << " -> " << p.min << " over " << p.decay_episodes << " episodes";
+  if (p.type == ScheduleType::Exponential)
+    out << " -> " << p.min << " by x" << p.decay_rate << " per episode";
+  if (p.type == ScheduleType::Log)
+    out << " -> " << p.min << " (log_divisor " << p.log_divisor << ")";
+  return out.str();
+}
+
+}  // namespace
+
+// "gamma 0.99 -> 0.95, epsilon_override none -> 0" ("" when nothing differs).
+std::string learningChangesText(const LearningSettings& before, const LearningSettings& after)
+{
+  const auto old_fields = fieldsOf(before);
+  const auto new_fields = fieldsOf(after);
+  std::string text;
+  for (std::size_t i = 0; i < old_fields.size(); ++i)
+  {
+    if (old_fields[i].second != new_fields[i].second)
+      text +=
+          (text.empty() ? "" : ", ") + old_fields[i].first + " " + old_fields[i].second + " -> " + new_fields[i].second;
+  }
+  return text;
+}
+
+// "epsilon 0 (override; schedule log 1 -> 0.01 (log_divisor 25)), alpha log 1 -> 0.05 (...), gamma 0.99"
+std::string learningSettingsText(const LearningSettings& s)
+{
+  const auto rate = [](const ScheduleParams& schedule, const std::optional<double>& value) {
+    if (!value)
+      return scheduleText(schedule);
+    std::ostringstream out;
+    out << *value << " (override; schedule " << scheduleText(schedule) << ")";
+    return out.str();
+  };
+  std::ostringstream out;
+  out << "epsilon " << rate(s.epsilon, s.epsilon_override) << ", alpha " << rate(s.alpha, s.alpha_override)
+      << ", gamma " << s.gamma;
+  return out.str();
 }
 
 }  // namespace cartpole_qlearning

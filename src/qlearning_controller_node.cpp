@@ -129,74 +129,6 @@ std::string fromConfig(const LearningConfig& c, LearningSettings& s)
   return "";
 }
 
-// Each field as the server names it, with its value as text.
-std::vector<std::pair<std::string, std::string>> fieldsOf(const LearningSettings& s)
-{
-  const auto number = [](double value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
-  };
-  const auto override = [&](const std::optional<double>& value) { return value ? number(*value) : "none"; };
-  std::vector<std::pair<std::string, std::string>> fields{{"epsilon_override", override(s.epsilon_override)},
-                                                          {"alpha_override", override(s.alpha_override)},
-                                                          {"gamma", number(s.gamma)}};
-  for (const auto& [name, p] : {std::make_pair("epsilon_", &s.epsilon), std::make_pair("alpha_", &s.alpha)})
-  {
-    fields.emplace_back(name + std::string("schedule"), toString(p->type));
-    fields.emplace_back(name + std::string("start"), number(p->start));
-    fields.emplace_back(name + std::string("min"), number(p->min));
-    fields.emplace_back(name + std::string("decay_episodes"), number(p->decay_episodes));
-    fields.emplace_back(name + std::string("decay_rate"), number(p->decay_rate));
-    fields.emplace_back(name + std::string("log_divisor"), number(p->log_divisor));
-  }
-  return fields;
-}
-
-// "gamma 0.99 -> 0.95, epsilon_override none -> 0" ("" when nothing differs).
-std::string changesText(const LearningSettings& before, const LearningSettings& after)
-{
-  const auto old_fields = fieldsOf(before);
-  const auto new_fields = fieldsOf(after);
-  std::string text;
-  for (std::size_t i = 0; i < old_fields.size(); ++i)
-  {
-    if (old_fields[i].second != new_fields[i].second)
-      text +=
-          (text.empty() ? "" : ", ") + old_fields[i].first + " " + old_fields[i].second + " -> " + new_fields[i].second;
-  }
-  return text;
-}
-
-std::string scheduleText(const ScheduleParams& p)
-{
-  std::ostringstream out;
-  out << toString(p.type) << " " << p.start;
-  if (p.type == ScheduleType::Linear)
-    out << " -> " << p.min << " over " << p.decay_episodes << " episodes";
-  if (p.type == ScheduleType::Exponential)
-    out << " -> " << p.min << " by x" << p.decay_rate << " per episode";
-  if (p.type == ScheduleType::Log)
-    out << " -> " << p.min << " (log_divisor " << p.log_divisor << ")";
-  return out.str();
-}
-
-// "epsilon 0 (override; schedule log 1 -> 0.01 (log_divisor 25)), alpha log 1 -> 0.05 (...), gamma 0.99"
-std::string settingsText(const LearningSettings& s)
-{
-  const auto rate = [](const ScheduleParams& schedule, const std::optional<double>& value) {
-    if (!value)
-      return scheduleText(schedule);
-    std::ostringstream out;
-    out << *value << " (override; schedule " << scheduleText(schedule) << ")";
-    return out.str();
-  };
-  std::ostringstream out;
-  out << "epsilon " << rate(s.epsilon, s.epsilon_override) << ", alpha " << rate(s.alpha, s.alpha_override)
-      << ", gamma " << s.gamma;
-  return out.str();
-}
-
 // The core names a schedule's field as the config file does ("epsilon/min"); the server's field
 // is "epsilon_min".
 std::string asServerField(std::string message)
@@ -1005,7 +937,7 @@ void QLearningControllerNode::startLiveTuning()
       left.__fromServer__(pnh_);  // only the fields present there change
       LearningSettings left_settings = running;
       fromConfig(left, left_settings);
-      const std::string replaced = changesText(left_settings, running);
+      const std::string replaced = learningChangesText(left_settings, running);
       if (!replaced.empty())
         ROS_INFO(
             "qlearning_controller: a new run: live-tuning values left on the parameter server replaced by "
@@ -1037,13 +969,14 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
       ROS_WARN(
           "qlearning_controller: restarted; the live tuning left by the controller before the restart is refused "
           "(%s): this run goes on with its configuration's: %s",
-          asServerField(error).c_str(), settingsText(in_use).c_str());
+          asServerField(error).c_str(), learningSettingsText(in_use).c_str());
     else
       ROS_WARN("qlearning_controller: live tuning refused (asked: %s): %s; nothing changed, in use: %s",
-               changesText(in_use, wanted).c_str(), asServerField(error).c_str(), settingsText(in_use).c_str());
+               learningChangesText(in_use, wanted).c_str(), asServerField(error).c_str(),
+               learningSettingsText(in_use).c_str());
     return;
   }
-  const std::string changes = changesText(in_use, wanted);
+  const std::string changes = learningChangesText(in_use, wanted);
   if (changes.empty())
     return;
   const char* applies = learning_ ? "gamma from the next update, epsilon and alpha from the next episode"

@@ -149,3 +149,24 @@ TEST(QLearningAgent, SetLearningChangesTheDiscountOfTheNextUpdate)
   EXPECT_NE("", agent.setLearning(0.9, params.epsilon, bad));
   EXPECT_EQ(0.5, agent.params().gamma);
 }
+
+// What the controller announces: only the fields that changed, named as dynparam names them.
+TEST(LearningSettings, ChangesAreSaidFieldByFieldAndNothingWhenNothingChanged)
+{
+  LearningSettings before = LearningSettings::of(AgentParams());
+  EXPECT_EQ("", learningChangesText(before, before));
+  LearningSettings after = before;
+  after.epsilon_override = 0.0;
+  after.gamma = 0.95;
+  after.alpha.min = 0.2;
+  EXPECT_EQ("epsilon_override none -> 0, gamma 0.99 -> 0.95, alpha_min 0.05 -> 0.2",
+            learningChangesText(before, after));
+  EXPECT_EQ("epsilon_override 0 -> none, gamma 0.95 -> 0.99, alpha_min 0.2 -> 0.05",
+            learningChangesText(after, before));
+
+  after.alpha.type = ScheduleType::Constant;
+  after.alpha.start = 0.5;
+  const std::string text = learningSettingsText(after);
+  EXPECT_EQ(0u, text.find("epsilon 0 (override; schedule ")) << text;
+  EXPECT_NE(std::string::npos, text.find(", alpha constant 0.5, gamma 0.95")) << text;
+}

@@ -33,4 +33,11 @@ struct LearningSettings
   ScheduleParams effectiveAlpha() const;
 };
 
+// What differs, field by field in the names of the live-tuning server and of the parameters:
+// "gamma 0.99 -> 0.95, epsilon_override none -> 0" ("" when nothing differs).
+std::string learningChangesText(const LearningSettings& before, const LearningSettings& after);
+// The settings in use, for the console: "epsilon 0 (override; schedule log 1 -> 0.01
+// (log_divisor 25)), alpha log 1 -> 0.05 (log_divisor 15), gamma 0.99".
+std::string learningSettingsText(const LearningSettings& settings);
+
 }  // namespace cartpole_qlearning
