@@ -97,6 +97,16 @@ std::vector<fs::path> runFolders(const std::string& ns)
   return folders;
 }
 
+// True once `pid` has exited: no such process, or a zombie its parent has not reaped yet.
+bool processGone(int pid)
+{
+  std::string stat = fileText("/proc/" + std::to_string(pid) + "/stat");
+  // The state follows the command name in parentheses, which may itself hold ") ".
+  const std::size_t name_end = stat.rfind(')');
+  return stat.empty() || name_end == std::string::npos || stat.compare(name_end + 1, 3, " Z ") == 0 ||
+         stat.compare(name_end + 1, 3, " X ") == 0;
+}
+
 // Episode numbers from ns/episode_stats, in order of arrival.
 struct Episodes
 {
@@ -127,12 +137,18 @@ void expectGoesOnFromItsCheckpoint(const Launch& run, Episodes& episodes, const 
   ASSERT_GT(pid, 0) << node;
   ::kill(pid, SIGKILL);
   const ros::WallTime killed = ros::WallTime::now();
+  // kill() only sends the signal: the checkpoint is read once the process is gone (or a zombie
+  // that roslaunch has yet to reap), when it can no longer write one more.
+  ASSERT_TRUE(spinUntil([&] { return processGone(pid); }, 10.0)) << node << " did not die";
   ASSERT_EQ(1u, runFolders(ns).size());
   const fs::path folder = runFolders(ns).front();
-  // The dead controller writes nothing more: its record is the checkpoint to go on from.
+  // The checkpoint to go on from is the run's table: a kill between the table's save and the
+  // record's leaves the record one checkpoint behind, and the controller takes the table.
   const std::uint64_t checkpoint =
-      cartpole_qlearning::parseRunRecord(fileText((folder / "run.yaml").string())).episodes;
+      cartpole_qlearning::loadQTableFile((folder / cartpole_qlearning::kRunTableFile).string()).episodes;
   ASSERT_GE(checkpoint, 100u);
+  // What the dead node sent before it died is still arriving: it counts as before the restart.
+  spinUntil([] { return false; }, 0.5);
   const std::size_t before = episodes.seen.size();
   const std::string resumed = "goes on from its checkpoint: episode " + std::to_string(checkpoint) + ",";
   ASSERT_TRUE(spinUntil([&] { return run.output().find(resumed) != std::string::npos; }, 60.0))
