@@ -8,6 +8,7 @@
 #include "cartpole_qlearning/cartpole_simulation.h"
 #include "cartpole_qlearning/cartpole_task.h"
 #include "cartpole_qlearning/q_table_file.h"
+#include "ros_test_support.h"
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -18,6 +19,7 @@
 #include <vector>
 
 using namespace cartpole_qlearning;
+using cartpole_qlearning::test::spinUntil;
 
 TEST(RobotPerson, EpisodesStartWhenThePersonStandsThePoleUpAndTheGapsTeachNothing)
 {
@@ -43,13 +45,17 @@ TEST(RobotPerson, EpisodesStartWhenThePersonStandsThePoleUpAndTheGapsTeachNothin
       boost::function<void(const EpisodeStatsConstPtr&)>([&](const EpisodeStatsConstPtr& m) { stats.push_back(*m); }));
   ros::Publisher state_pub = nh.advertise<sensor_msgs::JointState>("/my_robot/sensors/joint_states", 10);
   const ros::WallTime connect_deadline = ros::WallTime::now() + ros::WallDuration(30.0);
-  while (ros::ok() && (state_pub.getNumSubscribers() == 0 || command_sub.getNumPublishers() == 0) &&
+  // episode_stats too: a report lost before this node is connected would be missing from the sums below.
+  while (ros::ok() &&
+         (state_pub.getNumSubscribers() == 0 || command_sub.getNumPublishers() == 0 ||
+          stats_sub.getNumPublishers() == 0) &&
          ros::WallTime::now() < connect_deadline)
   {
     ros::spinOnce();
     ros::WallDuration(0.01).sleep();
   }
   ASSERT_GT(state_pub.getNumSubscribers(), 0u) << "the controller never subscribed to the remapped joint_states";
+  ASSERT_GT(stats_sub.getNumPublishers(), 0u) << "this node never connected to episode_stats";
 
   // The gaps, by the stamps of the states: from the first fallen state to the stand-up.
   struct Gap
@@ -98,8 +104,16 @@ TEST(RobotPerson, EpisodesStartWhenThePersonStandsThePoleUpAndTheGapsTeachNothin
     if (std::fabs(robot.state()[2]) > 1.5)  // the pole rests on the cart
       robot.reset(CartPoleState(robot.state()[0], 0.0, std::copysign(1.5, robot.state()[2]), 0.0));
   }
-  ros::WallDuration(0.3).sleep();
-  ros::spinOnce();
+  // What the controller learnt, and (once they are all here) the episodes it reported: the pole
+  // is down and the robot silent now, so no episode ends after this save.
+  std::string dir;
+  ASSERT_TRUE(ros::param::get("/my_robot/qlearning_controller/q_table_dir", dir));
+  SaveQTable save;
+  save.request.path = "after.yaml";
+  ASSERT_TRUE(ros::service::call("/my_robot/qlearning_controller/save_q_table", save));
+  ASSERT_TRUE(save.response.success) << save.response.message;
+  const QTable table = loadQTableFile(dir + "/after.yaml");
+  spinUntil([&] { return stats.size() >= table.episodes; }, 10.0);
   ASSERT_GE(stats.size(), 5u) << "the controller did not start episode after episode";
 
   // Through every gap the controller commanded zero, and it did command.
@@ -126,13 +140,6 @@ TEST(RobotPerson, EpisodesStartWhenThePersonStandsThePoleUpAndTheGapsTeachNothin
     EXPECT_TRUE(s.terminated) << "episode " << s.episode << " did not end by a fall";
     episode_steps += s.steps;
   }
-  std::string dir;
-  ASSERT_TRUE(ros::param::get("/my_robot/qlearning_controller/q_table_dir", dir));
-  SaveQTable save;
-  save.request.path = "after.yaml";
-  ASSERT_TRUE(ros::service::call("/my_robot/qlearning_controller/save_q_table", save));
-  ASSERT_TRUE(save.response.success) << save.response.message;
-  const QTable table = loadQTableFile(dir + "/after.yaml");
   EXPECT_EQ(episode_steps, table.steps) << "steps were learnt outside the episodes";
   EXPECT_EQ(stats.size(), table.episodes);
 }
