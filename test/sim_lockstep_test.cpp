@@ -518,8 +518,8 @@ TEST_F(SimLockstepRepeatTest, AnUnansweredStateIsPublishedAgainUnchangedAndOneAn
   EXPECT_NEAR(kTau, (observed.stamp - stamp).toSec(), 1e-9);
   expectClock(observed.stamp);
 
-  spinFor(1.0);
-  EXPECT_GT(states_.size(), next + 1) << "the new state was not published again";
+  spinFor(1.0);  // long enough for a second step to show, had the one answer made two
+  EXPECT_TRUE(spinUntil([&] { return states_.size() > next + 1; })) << "the new state was not published again";
   for (std::size_t i = next; i < states_.size(); ++i)
   {
     EXPECT_EQ(observed.stamp, states_[i].header.stamp) << "one answer stepped more than once";
