@@ -317,17 +317,20 @@ class FollowTest(PictureTest):
             env=environment,
         )
         try:
+            # Each batch of rows in one write: written line by line (writelines goes through an
+            # 8 KiB buffer), the follower could draw a part of a batch and the picture checked
+            # below would be of fewer rows than the test wrote.
             with open(csv, "w") as stream:
-                stream.writelines(text[:1])
+                stream.write(text[0])
                 stream.flush()
                 time.sleep(1.0)
                 self.assertFalse(os.path.exists(png), "a picture with no episode in it")
-                stream.writelines(text[1:121])
+                stream.write("".join(text[1:121]))
                 stream.flush()
                 first = self.wait_for_png(png, None)
                 # Early on: rising a little, nothing solved yet.
                 self.assert_rising_curve(png, rise=0.03)
-                stream.writelines(text[121:])
+                stream.write("".join(text[121:]))
                 stream.flush()
                 second = self.wait_for_png(png, first)
             self.assert_rising_curve(png, solved_at=270, last=300)
