@@ -264,6 +264,15 @@ void replaceIn(const Descriptor& folder, const std::string& name, const std::str
 }
 }  // namespace
 
+std::string expandHome(const std::string& path, const std::string& home)
+{
+  if (path != "~" && path.rfind("~/", 0) != 0)
+    return path;
+  if (home.empty())
+    refuse("cannot expand " + path + ": HOME is not set");
+  return home + path.substr(1);
+}
+
 std::string relativePathUnder(const std::string& directory, const std::string& path)
 {
   if (path.empty())

@@ -67,6 +67,21 @@ TEST_F(FileAccessTest, RelativePathsResolveUnderTheDirectory)
   EXPECT_EQ("runs/q.yaml", relativePathUnder(tables_, base + "/runs/q.yaml"));
 }
 
+// roslaunch passes q_table_dir:=~/tables on as it is: the nodes expand "~" as a shell would.
+TEST(ExpandHome, ATildeAloneOrFollowedByASlashIsTheHome)
+{
+  EXPECT_EQ("/home/ada", expandHome("~", "/home/ada"));
+  EXPECT_EQ("/home/ada/tables/q.yaml", expandHome("~/tables/q.yaml", "/home/ada"));
+  // Anything else is a name like any other: relative, absolute, or "~" inside or later on.
+  EXPECT_EQ("~ada/tables", expandHome("~ada/tables", "/home/ada"));
+  EXPECT_EQ("tables/~/q.yaml", expandHome("tables/~/q.yaml", "/home/ada"));
+  EXPECT_EQ("/tmp/~", expandHome("/tmp/~", "/home/ada"));
+  EXPECT_EQ("", expandHome("", "/home/ada"));
+  // Without a home a path that needs one is refused, not taken as a folder named "~".
+  EXPECT_EQ("q.yaml", expandHome("q.yaml", ""));
+  EXPECT_THROW(expandHome("~/tables", ""), FileError);
+}
+
 TEST_F(FileAccessTest, PathsLeavingTheDirectoryAreRefusedBeforeAnythingIsTouched)
 {
   for (const std::string& escape :
