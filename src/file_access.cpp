@@ -255,7 +255,8 @@ void replaceIn(const Descriptor& folder, const std::string& name, const std::str
   }
   // The data must be on disk before the rename makes it the file; else a crash could leave an
   // empty file under the final name.
-  if (::fchmod(fd.get(), 0644) != 0 || ::fsync(fd.get()) != 0 || fd.close() != 0)
+  // (Its mode is 0644 less the umask, as any new file's: a user's umask 077 keeps tables private.)
+  if (::fsync(fd.get()) != 0 || fd.close() != 0)
     fail("cannot flush the temporary file for");
   if (::renameat(folder.get(), temp.c_str(), folder.get(), name.c_str()) != 0)
     fail("cannot rename the temporary file to");

@@ -82,6 +82,26 @@ TEST(ExpandHome, ATildeAloneOrFollowedByASlashIsTheHome)
   EXPECT_THROW(expandHome("~/tables", ""), FileError);
 }
 
+TEST_F(FileAccessTest, ASavedFileHasTheModeTheUsersUmaskGives)
+{
+  const auto mode_of = [](const fs::path& file) {
+    struct stat status
+    {
+    };
+    EXPECT_EQ(0, ::stat(file.c_str(), &status)) << file;
+    return status.st_mode & 07777;
+  };
+  const mode_t old_mask = ::umask(077);
+  writeFileUnder(tables_, "private.yaml", "a: 1\n");
+  writeFileAtomically((dir_ / "private_too.yaml").string(), "a: 1\n");
+  ::umask(022);
+  writeFileUnder(tables_, "shared.yaml", "a: 1\n");
+  ::umask(old_mask);
+  EXPECT_EQ(0600u, mode_of(dir_ / "tables" / "private.yaml"));
+  EXPECT_EQ(0600u, mode_of(dir_ / "private_too.yaml"));
+  EXPECT_EQ(0644u, mode_of(dir_ / "tables" / "shared.yaml"));
+}
+
 TEST_F(FileAccessTest, PathsLeavingTheDirectoryAreRefusedBeforeAnythingIsTouched)
 {
   for (const std::string& escape :
