@@ -381,11 +381,24 @@ Descriptor openForAppending(const Descriptor& folder, const std::string& name, c
 
 void writeFileAtomically(const std::string& path, const std::string& text)
 {
-  const fs::path target(path);
+  // A link at the name is followed, as the shell's `>` would: the file it points to gets the
+  // text (made if missing) and the link stays. Replacing the link itself would cut it loose.
+  fs::path target(path);
+  std::error_code ec;
+  for (int hops = 0; fs::is_symlink(fs::symlink_status(target, ec)); ++hops)
+  {
+    if (hops == 40)
+      refuse("cannot save to " + path + ": too many levels of symbolic links");
+    const fs::path link = fs::read_symlink(target, ec);
+    if (ec)
+      refuse("cannot save to " + path + ": cannot read the link " + target.string() + ": " + ec.message());
+    target = link.is_absolute() ? link : target.parent_path() / link;
+  }
   if (target.filename().empty() || target.filename() == "." || target.filename() == "..")
     refuse("cannot save to " + path + ": it names a directory");
   const std::string folder = target.has_parent_path() ? target.parent_path().string() : ".";
-  replaceIn(openDirectory(folder, true), target.filename().string(), path, text, false);
+  replaceIn(openDirectory(folder, true), target.filename().string(),
+            target.string() == path ? path : path + " (" + target.string() + ")", text, false);
 }
 
 AppendingFile::AppendingFile(int fd, std::string path) : fd_(fd), path_(std::move(path)) {}

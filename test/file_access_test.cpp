@@ -102,6 +102,25 @@ TEST_F(FileAccessTest, ASavedFileHasTheModeTheUsersUmaskGives)
   EXPECT_EQ(0644u, mode_of(dir_ / "tables" / "shared.yaml"));
 }
 
+TEST_F(FileAccessTest, ACommandLineSaveThroughALinkWritesItsTargetAndKeepsTheLink)
+{
+  // latest.yaml -> runs/today.yaml (relative), and an absolute link to a file not there yet.
+  fs::create_directories(dir_ / "runs");
+  write(dir_ / "runs" / "today.yaml", "old\n");
+  fs::create_symlink("runs/today.yaml", dir_ / "latest.yaml");
+  fs::create_symlink(dir_ / "runs" / "new.yaml", dir_ / "next.yaml");
+  writeFileAtomically((dir_ / "latest.yaml").string(), "new\n");
+  writeFileAtomically((dir_ / "next.yaml").string(), "made\n");
+  EXPECT_TRUE(fs::is_symlink(dir_ / "latest.yaml"));
+  EXPECT_TRUE(fs::is_symlink(dir_ / "next.yaml"));
+  EXPECT_EQ("new\n", readFile((dir_ / "runs" / "today.yaml").string()));
+  EXPECT_EQ("made\n", readFile((dir_ / "runs" / "new.yaml").string()));
+  // A loop of links is refused with a message, not followed for ever.
+  fs::create_symlink("loop_b", dir_ / "loop_a");
+  fs::create_symlink("loop_a", dir_ / "loop_b");
+  EXPECT_THROW(writeFileAtomically((dir_ / "loop_a").string(), "x\n"), FileError);
+}
+
 TEST_F(FileAccessTest, PathsLeavingTheDirectoryAreRefusedBeforeAnythingIsTouched)
 {
   for (const std::string& escape :
