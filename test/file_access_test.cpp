@@ -12,6 +12,7 @@
 #include <random>
 #include <thread>
 
+#include <poll.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -52,6 +53,18 @@ protected:
     }
     std::sort(found.begin(), found.end());
     return found;
+  }
+
+  // A file beside q.yaml in tables/: a save's temporary file.
+  bool temporaryFileThere() const
+  {
+    std::error_code error;
+    for (fs::directory_iterator it(dir_ / "tables", error), end; !error && it != end; it.increment(error))
+    {
+      if (it->path().filename() != "q.yaml")
+        return true;
+    }
+    return false;
   }
 
   fs::path dir_;
@@ -226,6 +239,8 @@ TEST_F(FileAccessTest, AProcessKilledMidSaveLeavesTheOldFileOrTheNewOneWhole)
   constexpr int kTrials = 12;
   for (int trial = 0; trial < kTrials; ++trial)
   {
+    int started[2];
+    ASSERT_EQ(0, ::pipe(started));
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0)
@@ -233,14 +248,34 @@ TEST_F(FileAccessTest, AProcessKilledMidSaveLeavesTheOldFileOrTheNewOneWhole)
       // Built once: the child's time goes into saving them, not into making them.
       const std::string b = version('b');
       const std::string c = version('c');
+      const char ready = 'r';
+      if (::write(started[1], &ready, 1) != 1)
+        ::_exit(1);
       for (bool odd = false;; odd = !odd)
         writeFileAtomically(path, odd ? c : b);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20 + random() % 180));
+    ::close(started[1]);
+    // The random pause counts from when the child starts saving: on a loaded machine the fork
+    // and the two versions alone outlast it, and a kill before any save proves nothing. Then the
+    // kill waits for a save under way (its temporary file there): about a third of each save's
+    // cycle is its rename and the folder's fsync, where a kill interrupts nothing.
+    char ready = 0;
+    pollfd from_child{started[0], POLLIN, 0};
+    const bool started_saving = ::poll(&from_child, 1, 60000) == 1 && ::read(started[0], &ready, 1) == 1;
+    ::close(started[0]);
+    if (started_saving)
+    {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20 + random() % 180));
+      const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+      while (!temporaryFileThere() && std::chrono::steady_clock::now() < give_up)
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
     ::kill(child, SIGKILL);
     int status = 0;
     ::waitpid(child, &status, 0);
+    ASSERT_TRUE(started_saving) << "trial " << trial << ": the child did not start saving within 60 s";
     const std::string text = readFile(path);
+    ASSERT_GT(text.size(), 8u) << "trial " << trial << ": the file is cut short: " << text.size() << " bytes";
     ASSERT_EQ(version(text.at(8)), text) << "trial " << trial << ": the file is not one whole version";
     // A temporary file left behind: this kill interrupted a save.
     for (const auto& entry : fs::directory_iterator(dir_ / "tables"))
