@@ -255,7 +255,8 @@ void replaceIn(const Descriptor& folder, const std::string& name, const std::str
   }
   // The data must be on disk before the rename makes it the file; else a crash could leave an
   // empty file under the final name.
-  if (::fchmod(fd.get(), 0644) != 0 || ::fsync(fd.get()) != 0 || fd.close() != 0)
+  // (Its mode is 0644 less the umask, as any new file's: a user's umask 077 keeps tables private.)
+  if (::fsync(fd.get()) != 0 || fd.close() != 0)
     fail("cannot flush the temporary file for");
   if (::renameat(folder.get(), temp.c_str(), folder.get(), name.c_str()) != 0)
     fail("cannot rename the temporary file to");
@@ -263,6 +264,15 @@ void replaceIn(const Descriptor& folder, const std::string& name, const std::str
   ::fsync(folder.get());
 }
 }  // namespace
+
+std::string expandHome(const std::string& path, const std::string& home)
+{
+  if (path != "~" && path.rfind("~/", 0) != 0)
+    return path;
+  if (home.empty())
+    refuse("cannot expand " + path + ": HOME is not set");
+  return home + path.substr(1);
+}
 
 std::string relativePathUnder(const std::string& directory, const std::string& path)
 {
@@ -371,11 +381,24 @@ Descriptor openForAppending(const Descriptor& folder, const std::string& name, c
 
 void writeFileAtomically(const std::string& path, const std::string& text)
 {
-  const fs::path target(path);
+  // A link at the name is followed, as the shell's `>` would: the file it points to gets the
+  // text (made if missing) and the link stays. Replacing the link itself would cut it loose.
+  fs::path target(path);
+  std::error_code ec;
+  for (int hops = 0; fs::is_symlink(fs::symlink_status(target, ec)); ++hops)
+  {
+    if (hops == 40)
+      refuse("cannot save to " + path + ": too many levels of symbolic links");
+    const fs::path link = fs::read_symlink(target, ec);
+    if (ec)
+      refuse("cannot save to " + path + ": cannot read the link " + target.string() + ": " + ec.message());
+    target = link.is_absolute() ? link : target.parent_path() / link;
+  }
   if (target.filename().empty() || target.filename() == "." || target.filename() == "..")
     refuse("cannot save to " + path + ": it names a directory");
   const std::string folder = target.has_parent_path() ? target.parent_path().string() : ".";
-  replaceIn(openDirectory(folder, true), target.filename().string(), path, text, false);
+  replaceIn(openDirectory(folder, true), target.filename().string(),
+            target.string() == path ? path : path + " (" + target.string() + ")", text, false);
 }
 
 AppendingFile::AppendingFile(int fd, std::string path) : fd_(fd), path_(std::move(path)) {}

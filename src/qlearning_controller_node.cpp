@@ -291,7 +291,21 @@ void QLearningControllerNode::readParameters()
   priv.read("q_table_dir", q_table_dir_);
   if (q_table_dir_.empty())
     priv.fail("q_table_dir", "''", "must name a directory");
+  // Paths given as "~/..." (roslaunch passes them on unexpanded) name the user's home.
+  const char* home = std::getenv("HOME");
+  const auto expand_home = [&](const std::string& name, std::string& path) {
+    try
+    {
+      path = expandHome(path, home ? home : "");
+    }
+    catch (const FileError& e)
+    {
+      priv.fail(name, "'" + path + "'", e.what());
+    }
+  };
+  expand_home("q_table_dir", q_table_dir_);
   priv.read("q_table_path", q_table_path_);
+  expand_home("q_table_path", q_table_path_);
   try
   {
     resolve(q_table_path_);
@@ -301,7 +315,9 @@ void QLearningControllerNode::readParameters()
     priv.fail("q_table_path", "'" + q_table_path_ + "'", e.what());
   }
   priv.read("load_on_start", load_on_start_);
+  expand_home("load_on_start", load_on_start_);
   priv.read("stats_csv", stats_csv_);
+  expand_home("stats_csv", stats_csv_);
   if (stats_csv_ != "none" && !stats_csv_.empty() && stats_csv_.front() != '/')
   {
     try

@@ -80,6 +80,60 @@ TEST_F(FileAccessTest, RelativePathsResolveUnderTheDirectory)
   EXPECT_EQ("runs/q.yaml", relativePathUnder(tables_, base + "/runs/q.yaml"));
 }
 
+// roslaunch passes q_table_dir:=~/tables on as it is: the nodes expand "~" as a shell would.
+TEST(ExpandHome, ATildeAloneOrFollowedByASlashIsTheHome)
+{
+  EXPECT_EQ("/home/ada", expandHome("~", "/home/ada"));
+  EXPECT_EQ("/home/ada/tables/q.yaml", expandHome("~/tables/q.yaml", "/home/ada"));
+  // Anything else is a name like any other: relative, absolute, or "~" inside or later on.
+  EXPECT_EQ("~ada/tables", expandHome("~ada/tables", "/home/ada"));
+  EXPECT_EQ("tables/~/q.yaml", expandHome("tables/~/q.yaml", "/home/ada"));
+  EXPECT_EQ("/tmp/~", expandHome("/tmp/~", "/home/ada"));
+  EXPECT_EQ("", expandHome("", "/home/ada"));
+  // Without a home a path that needs one is refused, not taken as a folder named "~".
+  EXPECT_EQ("q.yaml", expandHome("q.yaml", ""));
+  EXPECT_THROW(expandHome("~/tables", ""), FileError);
+}
+
+TEST_F(FileAccessTest, ASavedFileHasTheModeTheUsersUmaskGives)
+{
+  const auto mode_of = [](const fs::path& file) {
+    struct stat status
+    {
+    };
+    EXPECT_EQ(0, ::stat(file.c_str(), &status)) << file;
+    return status.st_mode & 07777;
+  };
+  const mode_t old_mask = ::umask(077);
+  writeFileUnder(tables_, "private.yaml", "a: 1\n");
+  writeFileAtomically((dir_ / "private_too.yaml").string(), "a: 1\n");
+  ::umask(022);
+  writeFileUnder(tables_, "shared.yaml", "a: 1\n");
+  ::umask(old_mask);
+  EXPECT_EQ(0600u, mode_of(dir_ / "tables" / "private.yaml"));
+  EXPECT_EQ(0600u, mode_of(dir_ / "private_too.yaml"));
+  EXPECT_EQ(0644u, mode_of(dir_ / "tables" / "shared.yaml"));
+}
+
+TEST_F(FileAccessTest, ACommandLineSaveThroughALinkWritesItsTargetAndKeepsTheLink)
+{
+  // latest.yaml -> runs/today.yaml (relative), and an absolute link to a file not there yet.
+  fs::create_directories(dir_ / "runs");
+  write(dir_ / "runs" / "today.yaml", "old\n");
+  fs::create_symlink("runs/today.yaml", dir_ / "latest.yaml");
+  fs::create_symlink(dir_ / "runs" / "new.yaml", dir_ / "next.yaml");
+  writeFileAtomically((dir_ / "latest.yaml").string(), "new\n");
+  writeFileAtomically((dir_ / "next.yaml").string(), "made\n");
+  EXPECT_TRUE(fs::is_symlink(dir_ / "latest.yaml"));
+  EXPECT_TRUE(fs::is_symlink(dir_ / "next.yaml"));
+  EXPECT_EQ("new\n", readFile((dir_ / "runs" / "today.yaml").string()));
+  EXPECT_EQ("made\n", readFile((dir_ / "runs" / "new.yaml").string()));
+  // A loop of links is refused with a message, not followed for ever.
+  fs::create_symlink("loop_b", dir_ / "loop_a");
+  fs::create_symlink("loop_a", dir_ / "loop_b");
+  EXPECT_THROW(writeFileAtomically((dir_ / "loop_a").string(), "x\n"), FileError);
+}
+
 TEST_F(FileAccessTest, PathsLeavingTheDirectoryAreRefusedBeforeAnythingIsTouched)
 {
   for (const std::string& escape :

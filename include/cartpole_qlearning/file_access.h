@@ -27,6 +27,13 @@ public:
 // The largest file read: a table of the most states allowed is written in well under this.
 constexpr std::uint64_t kMaxFileBytes = std::uint64_t(1) << 30;
 
+// "~" and "~/..." stand for `home` (the caller passes $HOME), as a shell would have expanded
+// them: roslaunch hands `q_table_dir:=~/tables` to a node as it is, and the literal folder "~"
+// it would otherwise make lies in the node's working directory. Any other path is returned as
+// it is ("~name" too: other users' homes are not looked up). Throws FileError when the path
+// needs a home and `home` is empty.
+std::string expandHome(const std::string& path, const std::string& home);
+
 // Checks a user-given path lexically and returns it relative to the directory: a relative path
 // is taken from the directory; an absolute one must lie inside it; ".." components, an empty
 // path and the directory itself are refused. The directory is the user's own choice (links in
