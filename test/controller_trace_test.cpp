@@ -9,20 +9,11 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
-#include <chrono>
 #include <filesystem>
 #include <string>
-#include <thread>
 #include <vector>
 
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 namespace fs = std::filesystem;
-using cartpole_qlearning::test::fileText;
-using cartpole_qlearning::test::runCommand;
-using cartpole_qlearning::test::startProcess;
 using cartpole_qlearning::test::TraceReading;
 
 namespace
@@ -32,30 +23,13 @@ std::string rosHome()
   return cartpole_qlearning::test::privateParam("ros_home");
 }
 
-// roslaunch train.launch ARGS to its end (or a time limit); its whole output, nodes included.
+// roslaunch train.launch ARGS to its end (at most 90 s; then Ctrl-C); its output, nodes included.
 std::string launchToTheEnd(const std::string& name, const std::string& args, int& status)
 {
-  const std::string log = rosHome() + "/" + name + ".log";
   fs::create_directories(rosHome());
-  const std::string roslaunch = runCommand("command -v roslaunch").lastLine();
-  const pid_t pid = startProcess(
-      "/bin/sh", {"-c", "exec " + roslaunch + " cartpole_qlearning train.launch " + args + " >" + log + " 2>&1"},
-      {"ROS_HOME=" + rosHome(), "PYTHONUNBUFFERED=1"});
-  status = -1;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(90);
-  while (std::chrono::steady_clock::now() < deadline)
-  {
-    int raw = 0;
-    if (::waitpid(pid, &raw, WNOHANG) == pid)
-    {
-      status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
-      return fileText(log);
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  ::kill(pid, SIGINT);
-  ::waitpid(pid, nullptr, 0);
-  return fileText(log);
+  cartpole_qlearning::test::TrainLaunch run(rosHome(), name, args);
+  status = run.waitFor(90.0);
+  return run.output();
 }
 
 const std::vector<std::string> kTutorialNames{"S1 tilted left", "S0 upright", "S2 tilted right", "S3 fallen"};

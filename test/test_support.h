@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <signal.h>
@@ -133,6 +134,59 @@ public:
 
 private:
   pid_t pid_ = -1;
+};
+
+// `roslaunch cartpole_qlearning train.launch ARGS` in the background, as a user runs it, with
+// ROS_HOME set to `ros_home` (tables, logs) and its whole output, nodes included, in
+// ros_home/NAME.log. Ended with Ctrl-C (SIGINT) if still running when it goes out of scope.
+class TrainLaunch
+{
+public:
+  TrainLaunch(const std::string& ros_home, const std::string& name, const std::string& args)
+    : log_(ros_home + "/" + name + ".log")
+  {
+    const std::string roslaunch = runCommand("command -v roslaunch").lastLine();
+    pid_ = startProcess(
+        "/bin/sh", {"-c", "exec " + roslaunch + " cartpole_qlearning train.launch " + args + " >" + log_ + " 2>&1"},
+        {"ROS_HOME=" + ros_home, "PYTHONUNBUFFERED=1"});
+  }
+  ~TrainLaunch()
+  {
+    if (pid_ > 0)
+    {
+      ::kill(pid_, SIGINT);
+      waitFor(30.0);
+    }
+  }
+  TrainLaunch(const TrainLaunch&) = delete;
+  TrainLaunch& operator=(const TrainLaunch&) = delete;
+
+  // The exit status (128 + N for signal N), or -1 when it did not end in time.
+  int waitFor(double seconds)
+  {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (pid_ > 0 && std::chrono::steady_clock::now() < deadline)
+    {
+      int status = 0;
+      if (::waitpid(pid_, &status, WNOHANG) == pid_)
+      {
+        pid_ = -1;
+        status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        return status_;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return pid_ > 0 ? -1 : status_;
+  }
+  std::string output() const
+  {
+    return fileText(log_);
+  }
+
+private:
+  pid_t pid_ = -1;
+  int status_ = -1;
+  std::string log_;
 };
 
 }  // namespace test

@@ -26,9 +26,7 @@
 namespace fs = std::filesystem;
 using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::pidOf;
-using cartpole_qlearning::test::runCommand;
 using cartpole_qlearning::test::spinUntil;
-using cartpole_qlearning::test::startProcess;
 
 namespace
 {
@@ -37,48 +35,10 @@ std::string rosHome()
   return cartpole_qlearning::test::privateParam("ros_home");
 }
 
-// roslaunch train.launch in the background, its output (nodes included) in a file.
-struct Launch
+// train.launch ARGS with this test's ROS_HOME, its output in ROS_HOME/NAME.log.
+struct Launch : cartpole_qlearning::test::TrainLaunch
 {
-  pid_t pid = -1;
-  std::string log;
-
-  Launch(const std::string& name, const std::string& args)
-  {
-    log = rosHome() + "/" + name + ".log";
-    const std::string roslaunch = runCommand("command -v roslaunch").lastLine();
-    pid = startProcess("/bin/sh",
-                       {"-c", "exec " + roslaunch + " cartpole_qlearning train.launch " + args + " >" + log + " 2>&1"},
-                       {"ROS_HOME=" + rosHome(), "PYTHONUNBUFFERED=1"});
-  }
-  ~Launch()
-  {
-    if (pid > 0)
-    {
-      ::kill(pid, SIGINT);
-      waitFor(30.0);
-    }
-  }
-  // The exit status, or -1 when it did not end in time.
-  int waitFor(double seconds)
-  {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (std::chrono::steady_clock::now() < deadline)
-    {
-      int status = 0;
-      if (::waitpid(pid, &status, WNOHANG) == pid)
-      {
-        pid = -1;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    return -1;
-  }
-  std::string output() const
-  {
-    return fileText(log);
-  }
+  Launch(const std::string& name, const std::string& args) : TrainLaunch(rosHome(), name, args) {}
 };
 
 std::string tables(const std::string& ns)
