@@ -11,10 +11,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <condition_variable>
 #include <cstdlib>
 #include <ctime>
 #include <sstream>
 #include <tuple>
+#include <utility>
 
 #include <unistd.h>
 
@@ -22,6 +24,9 @@ namespace cartpole_qlearning
 {
 namespace
 {
+// [s] A reset call is given up after max(this, 2 x ~sim_timeout) (README: Resets and hung calls).
+constexpr double kMinResetGiveUp = 5.0;
+
 // ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
 // the learner's own namespace (N = 1), or robot_0 ... robot_<N-1> (train.launch robots:=N).
 void readRobots(const ros::NodeHandle& pnh, SectionReader& priv, std::vector<std::string>& names)
@@ -192,8 +197,13 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   setUpRobots(state_queue);
   if (protocol_params_.reset_service)
   {
-    reset_pending_.assign(robots_.size(), false);
-    reset_thread_ = std::thread(&QLearningControllerNode::resetLoop, this);
+    // Long enough for a sim that is merely slow (loaded, or far away) to answer, since giving a
+    // call up leaves a thread and a connection behind; ~sim_timeout is how long the user lets a
+    // sim be silent before calling it gone.
+    const auto give_up_after = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(std::max(kMinResetGiveUp, 2.0 * sim_timeout_)));
+    for (Robot& robot : robots_)
+      robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(reset_service_), give_up_after);
   }
   watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, sim_timeout_ / 2.0)),
                                     &QLearningControllerNode::onWatchdog, this);
@@ -248,13 +258,10 @@ QLearningControllerNode::~QLearningControllerNode()
 {
   // First, with mutex_ free: a reconfigure call under way ends (it takes mutex_), no other starts.
   reconfigure_.reset();
-  {
-    std::lock_guard<std::mutex> lock(reset_mutex_);
-    stopping_ = true;
-  }
-  reset_wanted_.notify_all();
-  if (reset_thread_.joinable())
-    reset_thread_.join();
+  // Resets end here; a call under way is given up, not waited for (it may hang for minutes), so
+  // the save below still happens.
+  for (Robot& robot : robots_)
+    robot.resetter.reset();
   // No state callback may run during the save (in a nodelet they run on another thread).
   for (Robot& robot : robots_)
     robot.state_sub.shutdown();
@@ -1007,87 +1014,165 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
 
 void QLearningControllerNode::requestReset(std::size_t robot)
 {
-  {
-    std::lock_guard<std::mutex> lock(reset_mutex_);
-    reset_pending_.at(robot) = true;
-  }
-  reset_wanted_.notify_one();
+  robots_.at(robot).resetter->request();
 }
 
-void QLearningControllerNode::resetLoop()
+// What a ResetCaller and its calling threads share. A calling thread that was given up holds it
+// after the ResetCaller is gone, so it is all the thread may touch.
+struct ResetCaller::Shared
 {
-  // Robots whose reset failed are called again no sooner than this later, so that one dead
-  // robot does not hold up the others' resets.
-  const auto retry_after = std::chrono::milliseconds(200);
-  std::vector<std::chrono::steady_clock::time_point> retry_at(robots_.size());
-  std::vector<bool> failing(robots_.size(), false);
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool pending = false;   // a reset is wanted
+  bool stopping = false;  // the ResetCaller is going away
+  // The one calling thread whose answers count; a thread given up sees another number and ends.
+  std::uint64_t generation = 0;
+  // A call handed to the current thread, and its answer.
+  bool asked = false;
+  bool persistent = true;
+  bool done = false;
+  bool answered = false;
+  std::string message;
+};
+
+ResetCaller::ResetCaller(std::string service, std::chrono::steady_clock::duration give_up_after)
+  : service_(std::move(service)), give_up_after_(give_up_after), shared_(std::make_shared<Shared>())
+{
+  caller_ = std::thread(&ResetCaller::callLoop, shared_, shared_->generation, service_);
+  thread_ = std::thread(&ResetCaller::run, this);
+}
+
+ResetCaller::~ResetCaller()
+{
+  {
+    std::lock_guard<std::mutex> lock(shared_->mutex);
+    shared_->stopping = true;
+  }
+  shared_->changed.notify_all();
+  thread_.join();
+}
+
+void ResetCaller::request()
+{
+  {
+    std::lock_guard<std::mutex> lock(shared_->mutex);
+    shared_->pending = true;
+  }
+  shared_->changed.notify_all();
+}
+
+void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t generation, const std::string& service)
+{
+  // Made by name (resolved already), not through a NodeHandle: a thread given up may outlive the
+  // node and its handles.
+  ros::ServiceClient persistent_client;
   for (;;)
   {
-    std::size_t r = robots_.size();
+    bool persistent = true;
     {
-      std::unique_lock<std::mutex> lock(reset_mutex_);
-      for (;;)
-      {
-        if (stopping_)
-          return;
-        const auto now = std::chrono::steady_clock::now();
-        auto next_retry = std::chrono::steady_clock::time_point::max();
-        for (std::size_t i = 0; i < robots_.size() && r == robots_.size(); ++i)
-        {
-          if (!reset_pending_[i])
-            continue;
-          if (retry_at[i] <= now)
-            r = i;
-          else
-            next_retry = std::min(next_retry, retry_at[i]);
-        }
-        if (r < robots_.size())
-          break;
-        if (next_retry == std::chrono::steady_clock::time_point::max())
-          reset_wanted_.wait(lock);
-        else
-          reset_wanted_.wait_until(lock, next_retry);
-      }
-      // Taken before the call: a request made while the call is under way (a short episode
-      // can end before this thread sees the answer) is then served by the next call, not lost.
-      reset_pending_[r] = false;
+      std::unique_lock<std::mutex> lock(shared->mutex);
+      shared->changed.wait(lock, [&] { return shared->stopping || shared->generation != generation || shared->asked; });
+      if (shared->stopping || shared->generation != generation)
+        return;
+      shared->asked = false;
+      persistent = shared->persistent;
     }
-    Robot& robot = robots_[r];
     Reset reset;  // empty state: a random start
     bool answered = false;
-    if (failing[r])
-    {
-      // While the sim is away or restarting, each try makes a connection of its own: roscpp's
-      // persistent links can hang across a server's restart (ros/ros_comm#149, #152), and a hung
-      // call here would stop every later reset. The persistent link is made again once the sim
-      // answers.
-      robot.reset_client = ros::ServiceClient();
-      answered = robot.nh.serviceClient<Reset>(reset_service_, false).call(reset) && reset.response.success;
-    }
-    else
+    if (persistent)
     {
       // Connected when first needed (the sim may come up after this node). Persistent: a new
       // connection per episode would cost a master lookup and a TCP set-up.
-      if (!robot.reset_client.isValid())
-        robot.reset_client = robot.nh.serviceClient<Reset>(reset_service_, true);
-      answered = robot.reset_client.call(reset) && reset.response.success;
+      if (!persistent_client.isValid())
+        persistent_client = ros::ServiceClient(service, true, ros::M_string(), ros::service_traits::md5sum<Reset>());
+      answered = persistent_client.call(reset) && reset.response.success;
     }
-    if (answered)
+    else
     {
-      if (failing[r])
-        ROS_INFO("qlearning_controller: %s answers again; going on", robot.nh.resolveName(reset_service_).c_str());
-      failing[r] = false;
+      // While the sim is away or restarting, each try makes a connection of its own: roscpp's
+      // persistent links can hang across a server's restart (ros/ros_comm#149, #152). The
+      // persistent link is made again once the sim answers.
+      persistent_client = ros::ServiceClient();
+      answered =
+          ros::ServiceClient(service, false, ros::M_string(), ros::service_traits::md5sum<Reset>()).call(reset) &&
+          reset.response.success;
+    }
+    {
+      std::lock_guard<std::mutex> lock(shared->mutex);
+      if (shared->stopping || shared->generation != generation)
+        return;  // given up while the call hung: nobody waits for this answer any more
+      shared->done = true;
+      shared->answered = answered;
+      shared->message = reset.response.message;
+    }
+    shared->changed.notify_all();
+  }
+}
+
+void ResetCaller::run()
+{
+  // A failing robot is called again no sooner than this later, not in a tight loop.
+  const auto retry_after = std::chrono::milliseconds(200);
+  auto retry_at = std::chrono::steady_clock::time_point::min();
+  bool failing = false;
+  std::unique_lock<std::mutex> lock(shared_->mutex);
+  for (;;)
+  {
+    while (!shared_->stopping && !(shared_->pending && std::chrono::steady_clock::now() >= retry_at))
+    {
+      if (shared_->pending)
+        shared_->changed.wait_until(lock, retry_at);
+      else
+        shared_->changed.wait(lock);
+    }
+    if (shared_->stopping)
+      break;
+    // Taken before the call: a request made while the call is under way (a short episode can
+    // end before the answer comes) is then served by the next call, not lost.
+    shared_->pending = false;
+    shared_->asked = true;
+    shared_->persistent = !failing;
+    shared_->done = false;
+    shared_->changed.notify_all();
+    const auto give_up_at = std::chrono::steady_clock::now() + give_up_after_;
+    if (!shared_->changed.wait_until(lock, give_up_at, [&] { return shared_->done || shared_->stopping; }))
+    {
+      ++shared_->generation;
+      caller_.detach();
+      ROS_WARN(
+          "qlearning_controller: reset call to %s has not returned after %.1f s; giving it up and retrying on a "
+          "new connection",
+          service_.c_str(), std::chrono::duration<double>(give_up_after_).count());
+      failing = true;
+      shared_->pending = true;
+      retry_at = std::chrono::steady_clock::now();
+      caller_ = std::thread(&ResetCaller::callLoop, shared_, shared_->generation, service_);
       continue;
     }
-    if (!failing[r])
-      ROS_WARN("qlearning_controller: reset call to %s failed%s; retrying until it answers",
-               robot.nh.resolveName(reset_service_).c_str(),
-               reset.response.message.empty() ? "" : (": " + reset.response.message).c_str());
-    failing[r] = true;
-    std::lock_guard<std::mutex> lock(reset_mutex_);
-    reset_pending_[r] = true;
-    retry_at[r] = std::chrono::steady_clock::now() + retry_after;
+    if (!shared_->done)
+    {
+      // Stopping while a call is under way: it is given up, as a hung one, without a wait.
+      ++shared_->generation;
+      caller_.detach();
+      return;
+    }
+    if (shared_->answered)
+    {
+      if (failing)
+        ROS_INFO("qlearning_controller: %s answers again; going on", service_.c_str());
+      failing = false;
+      continue;
+    }
+    if (!failing)
+      ROS_WARN("qlearning_controller: reset call to %s failed%s; retrying until it answers", service_.c_str(),
+               shared_->message.empty() ? "" : (": " + shared_->message).c_str());
+    failing = true;
+    shared_->pending = true;
+    retry_at = std::chrono::steady_clock::now() + retry_after;
   }
+  // No call under way: the calling thread sees stopping and ends at once.
+  lock.unlock();
+  caller_.join();
 }
 
 }  // namespace cartpole_qlearning

@@ -27,7 +27,7 @@
 #include <sensor_msgs/JointState.h>
 
 #include <chrono>
-#include <condition_variable>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -37,6 +37,43 @@
 
 namespace cartpole_qlearning
 {
+// Calls one robot's reset service (cartpole_qlearning/Reset, empty: a random start) whenever
+// asked, on threads of its own, so that a robot whose call hangs holds up no other robot.
+// roscpp's ServiceClient::call has no timeout: a sim stuck in its callback, a host gone with its
+// TCP connection half-open, or a persistent link that hangs across a server's restart
+// (ros/ros_comm#149, #152) can block a call for many minutes. A call still under way after
+// give_up_after is given up: its thread is left blocked (detached; it shares only state held by
+// shared_ptr, so it may outlive this object and the node) and a fresh thread retries on a new
+// connection.
+class ResetCaller
+{
+public:
+  // service: the service's resolved name.
+  ResetCaller(std::string service, std::chrono::steady_clock::duration give_up_after);
+  // Never waits for a call under way: gives it up as a hung one.
+  ~ResetCaller();
+
+  ResetCaller(const ResetCaller&) = delete;
+  ResetCaller& operator=(const ResetCaller&) = delete;
+
+  // A request made while a call is under way is served by the next call, not lost.
+  void request();
+
+private:
+  struct Shared;
+  // Hands each wanted reset to the current calling thread and waits for its answer, at most
+  // give_up_after; retries a failing robot.
+  void run();
+  // A calling thread: makes the calls it is handed while it is the current one (generation).
+  static void callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t generation, const std::string& service);
+
+  const std::string service_;
+  const std::chrono::steady_clock::duration give_up_after_;
+  std::shared_ptr<Shared> shared_;
+  std::thread caller_;  // the current calling thread; used by run() only, until it ends
+  std::thread thread_;  // run()
+};
+
 class QLearningControllerNode
 {
 public:
@@ -50,7 +87,7 @@ public:
   // QTableFileError for a bad ~load_on_start file.
   QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::function<void()> shutdown,
                           bool shutdown_by_default, ros::CallbackQueue* state_queue = nullptr);
-  // Saves the table when ~save_on_shutdown (training), and stops the reset thread.
+  // Saves the table when ~save_on_shutdown (training), after giving up any reset call under way.
   ~QLearningControllerNode();
 
   QLearningControllerNode(const QLearningControllerNode&) = delete;
@@ -65,9 +102,9 @@ private:
     std::unique_ptr<ControllerProtocol> protocol;
     ros::Subscriber state_sub;
     ros::Publisher command_pub;
-    ros::Publisher stats_pub;         // only for a robot in a namespace of its own
-    ros::ServiceClient reset_client;  // used by the reset thread only
-    ros::Time held_stamp;             // a new state waiting for its round
+    ros::Publisher stats_pub;               // only for a robot in a namespace of its own
+    std::unique_ptr<ResetCaller> resetter;  // none without a reset service
+    ros::Time held_stamp;                   // a new state waiting for its round
     CartPoleState held_state;
     std::chrono::steady_clock::time_point last_state_at;
     std::chrono::steady_clock::time_point last_episode_end;
@@ -119,10 +156,10 @@ private:
   std::string resolve(const std::string& path) const;
   std::string describe(const Robot& robot) const;
 
-  // Reset calls run on a thread of their own: a blocking service call from this node's
-  // callback would never return if the sim's service ran on the same single thread (nodelets).
+  // Reset calls run on threads of their own (ResetCaller, one per robot): a blocking service
+  // call from this node's callback would never return if the sim's service ran on the same
+  // single thread (nodelets), and a robot whose call hangs must not hold up the others.
   void requestReset(std::size_t robot);
-  void resetLoop();
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
@@ -188,12 +225,6 @@ private:
   boost::recursive_mutex reconfigure_mutex_;
   std::unique_ptr<dynamic_reconfigure::Server<LearningConfig>> reconfigure_;
   bool reconfigure_started_ = false;  // the server's first callback (at its start) has run
-
-  std::mutex reset_mutex_;
-  std::condition_variable reset_wanted_;
-  std::vector<bool> reset_pending_;
-  bool stopping_ = false;
-  std::thread reset_thread_;
 };
 
 }  // namespace cartpole_qlearning
