@@ -24,7 +24,7 @@ namespace cartpole_qlearning
 {
 namespace
 {
-// [s] A reset call is given up after max(this, 2 x ~sim_timeout) (README: Resets and hung calls).
+// [s] A reset call is given up after max(this, 2 x ~sim_timeout) (README: the ~reset_service row).
 constexpr double kMinResetGiveUp = 5.0;
 
 // ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
