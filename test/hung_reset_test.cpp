@@ -117,7 +117,7 @@ TEST(HungReset, AHungResetHoldsUpOnlyItsRobotAndIsGivenUp)
       << " episodes";
   // While robot_1's call hangs (it is given up only after 5 s), the other two go on.
   const auto at_hang = episodes;
-  EXPECT_TRUE(spinUntil([&] { return episodes[0] >= at_hang[0] + 20 && episodes[2] >= at_hang[2] + 20; }, 4.0))
+  EXPECT_TRUE(spinUntil([&] { return episodes[0] >= at_hang[0] + 10 && episodes[2] >= at_hang[2] + 10; }, 4.0))
       << "robot_0 and robot_2 stopped while robot_1's reset hung: " << episodes[0] - at_hang[0] << ", "
       << episodes[2] - at_hang[2] << " episodes since";
   EXPECT_TRUE(given_up.empty()) << "given up too soon: " << given_up;
