@@ -259,9 +259,13 @@ QLearningControllerNode::~QLearningControllerNode()
   // First, with mutex_ free: a reconfigure call under way ends (it takes mutex_), no other starts.
   reconfigure_.reset();
   // Resets end here; a call under way is given up, not waited for (it may hang for minutes), so
-  // the save below still happens.
-  for (Robot& robot : robots_)
-    robot.resetter.reset();
+  // the save below still happens. Under mutex_: a state callback or the watchdog may be asking
+  // for a reset at this moment (in a nodelet they run on other threads).
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (Robot& robot : robots_)
+      robot.resetter.reset();
+  }
   // No state callback may run during the save (in a nodelet they run on another thread).
   for (Robot& robot : robots_)
     robot.state_sub.shutdown();
@@ -1014,7 +1018,9 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
 
 void QLearningControllerNode::requestReset(std::size_t robot)
 {
-  robots_.at(robot).resetter->request();
+  // None once the destructor has begun.
+  if (robots_.at(robot).resetter)
+    robots_.at(robot).resetter->request();
 }
 
 // What a ResetCaller and its calling threads share. A calling thread that was given up holds it
