@@ -397,7 +397,9 @@ void writeFileAtomically(const std::string& path, const std::string& text)
   if (target.filename().empty() || target.filename() == "." || target.filename() == "..")
     refuse("cannot save to " + path + ": it names a directory");
   const std::string folder = target.has_parent_path() ? target.parent_path().string() : ".";
-  replaceIn(openDirectory(folder, true), target.filename().string(),
+  // Missing folders are made for the name given, not for a link's target: a link into a drive
+  // not mounted fails as the shell's > would, instead of saving beside the mount point.
+  replaceIn(openDirectory(folder, target.string() == path), target.filename().string(),
             target.string() == path ? path : path + " (" + target.string() + ")", text, false);
 }
 

@@ -26,6 +26,7 @@ namespace
 {
 // [s] A reset call is given up after max(this, 2 x ~sim_timeout) (README: the ~reset_service row).
 constexpr double kMinResetGiveUp = 5.0;
+constexpr double kMaxResetGiveUp = 3600.0;
 
 // ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
 // the learner's own namespace (N = 1), or robot_0 ... robot_<N-1> (train.launch robots:=N).
@@ -200,8 +201,9 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
     // Long enough for a sim that is merely slow (loaded, or far away) to answer, since giving a
     // call up leaves a thread and a connection behind; ~sim_timeout is how long the user lets a
     // sim be silent before calling it gone.
+    // (At most an hour: a huge ~sim_timeout must not overflow the clock's arithmetic.)
     const auto give_up_after = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(std::max(kMinResetGiveUp, 2.0 * sim_timeout_)));
+        std::chrono::duration<double>(std::min(kMaxResetGiveUp, std::max(kMinResetGiveUp, 2.0 * sim_timeout_))));
     for (Robot& robot : robots_)
       robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(reset_service_), give_up_after);
   }
@@ -1033,6 +1035,9 @@ struct ResetCaller::Shared
   bool stopping = false;  // the ResetCaller is going away
   // The one calling thread whose answers count; a thread given up sees another number and ends.
   std::uint64_t generation = 0;
+  // Given-up threads still blocked in their call. While one is, the next call is not given up
+  // too: a sim stuck in its callback would otherwise cost a thread and a socket every give-up.
+  int blocked = 0;
   // A call handed to the current thread, and its answer.
   bool asked = false;
   bool persistent = true;
@@ -1078,7 +1083,14 @@ void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t 
     {
       std::unique_lock<std::mutex> lock(shared->mutex);
       shared->changed.wait(lock, [&] { return shared->stopping || shared->generation != generation || shared->asked; });
-      if (shared->stopping || shared->generation != generation)
+      if (shared->generation != generation)
+      {
+        // Given up before it even took its call (a starved thread): counted as blocked all the same.
+        --shared->blocked;
+        shared->changed.notify_all();
+        return;
+      }
+      if (shared->stopping)
         return;
       shared->asked = false;
       persistent = shared->persistent;
@@ -1105,8 +1117,14 @@ void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t 
     }
     {
       std::lock_guard<std::mutex> lock(shared->mutex);
-      if (shared->stopping || shared->generation != generation)
-        return;  // given up while the call hung: nobody waits for this answer any more
+      if (shared->generation != generation)
+      {
+        --shared->blocked;  // given up while the call hung: nobody waits for this answer any more
+        shared->changed.notify_all();
+        return;
+      }
+      if (shared->stopping)
+        return;
       shared->done = true;
       shared->answered = answered;
       shared->message = reset.response.message;
@@ -1141,9 +1159,15 @@ void ResetCaller::run()
     shared_->done = false;
     shared_->changed.notify_all();
     const auto give_up_at = std::chrono::steady_clock::now() + give_up_after_;
-    if (!shared_->changed.wait_until(lock, give_up_at, [&] { return shared_->done || shared_->stopping; }))
+    // A call given up earlier and still blocked: this one is waited for as long as it takes (a
+    // third connection would hang behind the same stuck sim).
+    if (!shared_->changed.wait_until(lock, give_up_at, [&] { return shared_->done || shared_->stopping; }) &&
+        shared_->blocked > 0)
+      shared_->changed.wait(lock, [&] { return shared_->done || shared_->stopping; });
+    if (!shared_->done && !shared_->stopping)
     {
       ++shared_->generation;
+      ++shared_->blocked;
       caller_.detach();
       ROS_WARN(
           "qlearning_controller: reset call to %s has not returned after %.1f s; giving it up and retrying on a "
@@ -1159,6 +1183,7 @@ void ResetCaller::run()
     {
       // Stopping while a call is under way: it is given up, as a hung one, without a wait.
       ++shared_->generation;
+      ++shared_->blocked;
       caller_.detach();
       return;
     }

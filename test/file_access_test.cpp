@@ -128,6 +128,11 @@ TEST_F(FileAccessTest, ACommandLineSaveThroughALinkWritesItsTargetAndKeepsTheLin
   EXPECT_TRUE(fs::is_symlink(dir_ / "next.yaml"));
   EXPECT_EQ("new\n", readFile((dir_ / "runs" / "today.yaml").string()));
   EXPECT_EQ("made\n", readFile((dir_ / "runs" / "new.yaml").string()));
+  // A link into a folder that is not there (a drive not mounted) fails as > would; nothing is
+  // made on the way.
+  fs::create_symlink(dir_ / "unmounted" / "q.yaml", dir_ / "on_usb.yaml");
+  EXPECT_THROW(writeFileAtomically((dir_ / "on_usb.yaml").string(), "x\n"), FileError);
+  EXPECT_FALSE(fs::exists(dir_ / "unmounted"));
   // A loop of links is refused with a message, not followed for ever.
   fs::create_symlink("loop_b", dir_ / "loop_a");
   fs::create_symlink("loop_a", dir_ / "loop_b");
