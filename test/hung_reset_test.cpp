@@ -2,11 +2,13 @@
 // robot_1's reset service itself: the first call it gets never returns (a sim stuck in its
 // callback, or a host gone with the connection half-open), later calls go on to robot_1's real
 // sim. The learner must keep training robot_0 and robot_2 while that call hangs, give the call
-// up after max(5 s, 2 x ~sim_timeout) with a warning, and take robot_1 back.
+// up after max(5 s, 2 x ~sim_timeout) with a warning, and take robot_1 back. A Ctrl-C while a
+// call hangs still saves the table and ends the controller.
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/Reset.h"
 
 #include "ros_test_support.h"
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 #include <ros/callback_queue.h>
@@ -14,16 +16,23 @@
 #include <rosgraph_msgs/Log.h>
 
 #include <array>
+#include <filesystem>
 #include <atomic>
 #include <condition_variable>
 #include <mutex>
 #include <string>
 #include <vector>
 
+#include <signal.h>
+
 using cartpole_qlearning::EpisodeStats;
 using cartpole_qlearning::EpisodeStatsConstPtr;
 using cartpole_qlearning::Reset;
+using cartpole_qlearning::test::pidOf;
+using cartpole_qlearning::test::privateParam;
+using cartpole_qlearning::test::processGone;
 using cartpole_qlearning::test::spinUntil;
+namespace fs = std::filesystem;
 
 namespace
 {
@@ -31,7 +40,8 @@ constexpr std::size_t kRobots = 3;
 const char* const kHungService = "/hung_reset/robot_1/cartpole_sim/reset";
 const char* const kRealService = "/hung_reset/robot_1/real_sim/reset";
 
-// robot_1's reset service: the first call blocks until release(), the others are forwarded.
+// robot_1's reset service: the first call (and the next after hangNext()) blocks until
+// release(), the others are forwarded.
 class HangingReset
 {
 public:
@@ -50,7 +60,19 @@ public:
 
   bool hanging() const
   {
-    return hanging_;
+    return hangs_ > 0;
+  }
+  int hangs() const
+  {
+    return hangs_;
+  }
+  void hangNext()
+  {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      released_ = false;
+    }
+    hang_next_ = true;
   }
   void release()
   {
@@ -64,9 +86,9 @@ public:
 private:
   bool onReset(Reset::Request& request, Reset::Response& response)
   {
-    if (!first_taken_.exchange(true))
+    if (hang_next_.exchange(false))
     {
-      hanging_ = true;
+      ++hangs_;
       std::unique_lock<std::mutex> lock(mutex_);
       released_cv_.wait(lock, [this] { return released_; });
       return false;
@@ -82,8 +104,8 @@ private:
   ros::CallbackQueue queue_;
   ros::AsyncSpinner spinner_;
   ros::ServiceServer server_;
-  std::atomic<bool> first_taken_{false};
-  std::atomic<bool> hanging_{false};
+  std::atomic<bool> hang_next_{true};
+  std::atomic<int> hangs_{0};
   std::mutex mutex_;
   std::condition_variable released_cv_;
   bool released_ = false;
@@ -141,6 +163,27 @@ TEST(HungReset, AHungResetHoldsUpOnlyItsRobotAndIsGivenUp)
       },
       10.0))
       << "training did not go on once the given-up call returned";
+
+  // Ctrl-C while robot_1's next call hangs: the controller saves its table (its only save: no
+  // checkpoints in this launch) and ends, though the call would never return. (In this process
+  // roscpp's own shutdown drops the hung connection too; a nodelet's unload has no such help,
+  // and there only ResetCaller's giving up keeps the save from waiting.)
+  hanging_reset.hangNext();
+  ASSERT_TRUE(spinUntil([&] { return hanging_reset.hangs() == 2; }, 20.0)) << "robot_1's reset was not called again";
+  const int controller = pidOf("/hung_reset/qlearning_controller");
+  ASSERT_GT(controller, 0);
+  ::kill(controller, SIGINT);
+  const ros::WallTime interrupted = ros::WallTime::now();
+  EXPECT_TRUE(spinUntil([&] { return processGone(controller); }, 15.0))
+      << "the controller did not end on Ctrl-C while a reset call hung";
+  std::cout << "the controller ended " << (ros::WallTime::now() - interrupted).toSec()
+            << " s after Ctrl-C, with a reset call hanging\n";
+  bool saved = false;
+  std::error_code error;
+  const fs::path runs = fs::path(privateParam("q_table_dir")) / "runs";
+  for (const auto& run : fs::directory_iterator(runs, error))
+    saved = saved || fs::exists(run.path() / "q_table.yaml");
+  EXPECT_TRUE(saved) << "no table saved on shutdown under " << runs;
 }
 
 int main(int argc, char** argv)
@@ -148,5 +191,7 @@ int main(int argc, char** argv)
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "hung_reset_test");
   ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
+  const int result = RUN_ALL_TESTS();
+  fs::remove_all(privateParam("q_table_dir"));
+  return result;
 }

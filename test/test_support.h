@@ -60,6 +60,16 @@ inline std::string fileText(const std::string& path)
   return text.str();
 }
 
+// True once `pid` has exited: no such process, or a zombie its parent has not reaped yet.
+inline bool processGone(int pid)
+{
+  std::string stat = fileText("/proc/" + std::to_string(pid) + "/stat");
+  // The state follows the command name in parentheses, which may itself hold ") ".
+  const std::size_t name_end = stat.rfind(')');
+  return stat.empty() || name_end == std::string::npos || stat.compare(name_end + 1, 3, " Z ") == 0 ||
+         stat.compare(name_end + 1, 3, " X ") == 0;
+}
+
 // Starts an executable with arguments (and extra NAME=VALUE environment entries) in the
 // background; returns its pid.
 inline pid_t startProcess(const std::string& executable, const std::vector<std::string>& args,

@@ -26,6 +26,7 @@
 namespace fs = std::filesystem;
 using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::pidOf;
+using cartpole_qlearning::test::processGone;
 using cartpole_qlearning::test::spinUntil;
 
 namespace
@@ -55,16 +56,6 @@ std::vector<fs::path> runFolders(const std::string& ns)
       folders.push_back(entry.path());
   }
   return folders;
-}
-
-// True once `pid` has exited: no such process, or a zombie its parent has not reaped yet.
-bool processGone(int pid)
-{
-  std::string stat = fileText("/proc/" + std::to_string(pid) + "/stat");
-  // The state follows the command name in parentheses, which may itself hold ") ".
-  const std::size_t name_end = stat.rfind(')');
-  return stat.empty() || name_end == std::string::npos || stat.compare(name_end + 1, 3, " Z ") == 0 ||
-         stat.compare(name_end + 1, 3, " X ") == 0;
 }
 
 // Episode numbers from ns/episode_stats, in order of arrival.
