@@ -26,7 +26,7 @@ DEBIAN_PACKAGES=(
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure libeigen3-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev catkin-lint rviz
   python3-rospy xvfb imagemagick libgl1-mesa-dri python3-numpy python3-pil python3-yaml
-  clang-14 libclang-rt-14-dev
+  clang-14 libclang-rt-14-dev llvm-14
   python3-matplotlib python3-numpy python3-rosbag python3-rospy python3-genpy
 )
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sets everything up (scripts/setup.sh), builds and runs every test (gtest and rostest), then
-# again built with ASan + UBSan (scripts/sanitize.sh), and ends with one line
+# again built with ASan + UBSan (tools/sanitize.sh), and ends with one line
 # "N passed, N failed" counting every test case of both.
 set -eo pipefail
 # Whatever stops this script early (set-up, the build) still ends with the summary line.
@@ -28,7 +28,7 @@ if [ "${SANITIZE:-1}" != 0 ]; then
   echo "[test] the whole suite again under ASan + UBSan: build and run, about 4 to 8 minutes; log in $CARTPOLE_WS/sanitize.log"
   sanitized=build/test_results/cartpole_qlearning/sanitized
   SECONDS=0
-  if ! bash "$CARTPOLE_SRC/scripts/sanitize.sh" "$CARTPOLE_WS/$sanitized" >"$CARTPOLE_WS/sanitize.log" 2>&1; then
+  if ! bash "$CARTPOLE_SRC/tools/sanitize.sh" "$CARTPOLE_WS/$sanitized" >"$CARTPOLE_WS/sanitize.log" 2>&1; then
     grep -E "error|Error" "$CARTPOLE_WS/sanitize.log" | head -n 20
     tail -n 10 "$CARTPOLE_WS/sanitize.log"
     mkdir -p "$sanitized"
@@ -47,13 +47,13 @@ fi
 # verdicts join the results (a crash is a failed test). FUZZ_SECONDS=0 skips them.
 if [ "${FUZZ_SECONDS:-30}" -gt 0 ]; then
   echo "[test] fuzzing the table file and config parsers, ${FUZZ_SECONDS:-30} s each"
-  bash "$CARTPOLE_SRC/scripts/fuzz.sh" "${FUZZ_SECONDS:-30}" build/test_results/cartpole_qlearning || true
+  bash "$CARTPOLE_SRC/tools/fuzz.sh" "${FUZZ_SECONDS:-30}" build/test_results/cartpole_qlearning || true
 fi
 # The README's own check: its commands in order, in a fresh clone, home and workspace, with a
-# master of its own (scripts/first_hour.sh); one case per command. FIRST_HOUR=0 skips it.
+# master of its own (tools/first_hour.sh); one case per command. FIRST_HOUR=0 skips it.
 if [ "${FIRST_HOUR:-1}" != 0 ]; then
-  echo "[test] the README's commands in a fresh home (scripts/first_hour.sh, about 6 to 10 minutes); log in $CARTPOLE_WS/first_hour.log"
-  bash "$CARTPOLE_SRC/scripts/first_hour.sh" build/test_results/cartpole_qlearning >"$CARTPOLE_WS/first_hour.log" 2>&1 || true
+  echo "[test] the README's commands in a fresh home (tools/first_hour.sh, about 6 to 10 minutes); log in $CARTPOLE_WS/first_hour.log"
+  bash "$CARTPOLE_SRC/tools/first_hour.sh" build/test_results/cartpole_qlearning >"$CARTPOLE_WS/first_hour.log" 2>&1 || true
   grep -E "^\[first-hour\] +([0-9.]+ s|[0-9]+ passed)" "$CARTPOLE_WS/first_hour.log" | grep -E "FAIL|passed" || true
   if [ ! -s build/test_results/cartpole_qlearning/first_hour.xml ]; then
     tail -n 30 "$CARTPOLE_WS/first_hour.log"
@@ -72,4 +72,4 @@ if ! ls build/test_results/cartpole_qlearning/*.xml >/dev/null 2>&1; then
   exit 1
 fi
 # Prints each failure, then the last line: "N passed, N failed, N skipped".
-exec /usr/bin/env python3 "$CARTPOLE_SRC/scripts/count_test_results.py" build/test_results/cartpole_qlearning
+exec /usr/bin/env python3 "$CARTPOLE_SRC/tools/count_test_results.py" build/test_results/cartpole_qlearning

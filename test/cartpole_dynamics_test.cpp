@@ -47,7 +47,7 @@ TEST(CartPoleDynamics, EulerPositionsAdvanceWithOldVelocities)
   EXPECT_DOUBLE_EQ(0.05 + 0.02 * -0.3, next[2]);
 }
 
-// Trajectories printed by scripts/gymnasium_reference.py, which follows Gymnasium
+// Trajectories printed by tools/gymnasium_reference.py, which follows Gymnasium
 // CartPole-v1's step operation for operation. Start (0.01, -0.02, 0.03, -0.04).
 const std::vector<int> kReferenceActions = {1, 1, 0, 1, 0, 0, 0, 1, 1, 1, 0, 1, 0, 0, 1, 1, 0, 0, 0, 1};
 const std::vector<std::vector<double>> kGymnasiumEuler = {

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""RViz checked by its picture: scripts/rviz_screenshot's pictures of the sim held at theta = +0.2
+"""RViz checked by its picture: tools/rviz_screenshot's pictures of the sim held at theta = +0.2
 and -0.2 rad (one run of Xvfb, sim.launch mode:=lockstep rviz:=true and RViz, all its own) must
 show a drawn 3D view, the pole's colour, and the pole leaning the way theta says. The expected
 lean comes from the geometry alone: the URDF's pole joint axis and pole length, and the Orbit
@@ -20,15 +20,15 @@ import rostest
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def load_script(name):
-    loader = SourceFileLoader(name, os.path.join(PACKAGE_DIR, "scripts", name))
+def load_script(folder, name):
+    loader = SourceFileLoader(name, os.path.join(PACKAGE_DIR, folder, name))
     module = module_from_spec(spec_from_loader(name, loader))
     loader.exec_module(module)
     return module
 
 
-screenshot = load_script("rviz_screenshot")
-rviz_robots = load_script("rviz_robots")
+screenshot = load_script("tools", "rviz_screenshot")
+rviz_robots = load_script("scripts", "rviz_robots")
 
 THETA = 0.2
 # RViz needs several seconds to start under software OpenGL on a loaded machine; the picture is

@@ -1,7 +1,7 @@
-#include "cartpole_qlearning/cartpole_sim_node.h"
+#include "cartpole_qlearning/ros/cartpole_sim.h"
 
 #include "cartpole_qlearning/config.h"
-#include "cartpole_qlearning/ros_parameter_source.h"
+#include "cartpole_qlearning/ros/parameter_source.h"
 
 #include <geometry_msgs/TransformStamped.h>
 #include <rosgraph_msgs/Clock.h>

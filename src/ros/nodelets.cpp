@@ -8,9 +8,9 @@
 // manager's own queues each message would cross threads (its dispatcher, then a worker), which
 // costs about ten times more than the step itself (bench/run_benchmarks.sh). Timers and
 // services stay on the manager's threads; the node classes lock their state for that.
-#include "cartpole_qlearning/launch_control.h"
-#include "cartpole_qlearning/cartpole_sim_node.h"
-#include "cartpole_qlearning/qlearning_controller_node.h"
+#include "cartpole_qlearning/ros/cartpole_sim.h"
+#include "cartpole_qlearning/ros/qlearning_controller.h"
+#include "cartpole_qlearning/ros/start_up.h"
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
@@ -19,6 +19,8 @@
 #include <atomic>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 namespace cartpole_qlearning
@@ -81,20 +83,14 @@ public:
 private:
   void onInit() override
   {
-    try
-    {
-      lockstep_ = LockstepThread::acquire();
-      node_ = std::make_unique<CartPoleSimNode>(getNodeHandle(), getPrivateNodeHandle(), lockstep_->queue());
-    }
-    catch (const std::exception& e)
-    {
-      NODELET_FATAL("cartpole_sim: %s", e.what());
-      // Its loader would respawn into the same error: the launch that started the manager
-      // ends instead (as for the executables).
-      if (endParentLaunch())
-        NODELET_FATAL("cartpole_sim: ending the launch: this cannot work until the above is fixed");
-      throw;
-    }
+    // Its loader would respawn into the same error: startNode ends the launch that started the
+    // manager instead (as for the executables), and the manager is told it failed.
+    std::string reason;
+    if (!startNode("cartpole_sim", [&] {
+          lockstep_ = LockstepThread::acquire();
+          node_ = std::make_unique<CartPoleSimNode>(getNodeHandle(), getPrivateNodeHandle(), lockstep_->queue());
+        }, &reason))
+      throw std::runtime_error(reason);
   }
 
   std::shared_ptr<LockstepThread> lockstep_;
@@ -112,24 +108,16 @@ public:
 private:
   void onInit() override
   {
-    try
-    {
-      lockstep_ = LockstepThread::acquire();
-      // When training ends the controller saves, reports and stops acting; the manager and the
-      // other nodelets keep running unless ~shutdown_when_finished asks to end the manager
-      // (train.launch nodelet:=true, where the manager is the run's own).
-      node_ = std::make_unique<QLearningControllerNode>(
-          getNodeHandle(), getPrivateNodeHandle(), [] { ros::requestShutdown(); }, false, lockstep_->queue());
-    }
-    catch (const std::exception& e)
-    {
-      NODELET_FATAL("qlearning_controller: %s", e.what());
-      // Its loader would respawn into the same error: the launch that started the manager
-      // ends instead (as for the executables).
-      if (endParentLaunch())
-        NODELET_FATAL("qlearning_controller: ending the launch: this cannot work until the above is fixed");
-      throw;
-    }
+    // When training ends the controller saves, reports and stops acting; the manager and the
+    // other nodelets keep running unless ~shutdown_when_finished asks to end the manager
+    // (train.launch nodelet:=true, where the manager is the run's own).
+    std::string reason;
+    if (!startNode("qlearning_controller", [&] {
+          lockstep_ = LockstepThread::acquire();
+          node_ = std::make_unique<QLearningControllerNode>(
+              getNodeHandle(), getPrivateNodeHandle(), [] { ros::requestShutdown(); }, false, lockstep_->queue());
+        }, &reason))
+      throw std::runtime_error(reason);
   }
 
   std::shared_ptr<LockstepThread> lockstep_;

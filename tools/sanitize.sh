@@ -5,14 +5,19 @@
 # $WS/devel_sanitize), and runs the gtests and rostests there. Any sanitizer report, in a test or
 # in a node that roslaunch started, fails the run.
 #
-# usage: bash scripts/sanitize.sh [RESULTS_DIR]
+# usage: bash tools/sanitize.sh [RESULTS_DIR]
 #   The workspace is the one scripts/setup.sh chose (CARTPOLE_WS, or the one this clone is in);
 #   run scripts/setup.sh once first. RESULTS_DIR (default $WS/build_sanitize/sanitized_results)
 #   gets the JUnit files, each named sanitized-*.xml, and sanitized-reports.xml: one test case
 #   per sanitizer report file written (failed), or one passed case when none was.
 # Exit status: 0 when the tests could be built and run (the JUnit files say what failed), 2 when
-# the workspace or compiler is missing, another non-zero one when the build failed. Debian: clang-14
-# libclang-rt-14-dev (scripts/setup.sh installs them).
+# the workspace, the compiler or the symbolizer is missing, another non-zero one when the build
+# failed. Debian: clang-14 libclang-rt-14-dev llvm-14 (scripts/setup.sh installs them).
+#
+# The symbolizer (llvm-14's llvm-symbolizer, named by ASAN_SYMBOLIZER_PATH) is needed, not merely
+# nice: suppressions match function names, and without it a report's frames stay bare addresses,
+# so an upstream bug suppressed by name would count as ours. A report written without it fails
+# with a message that says so.
 #
 # clang rather than gcc: with gcc's separate libubsan, UBSan ignores log_path and its reports
 # would only reach stderr; gcc 12 also warns (-Werror) inside libstdc++ with the sanitizers.
@@ -78,10 +83,13 @@ wrapper="$DEVEL/lib/nodelet/nodelet"
 rm -rf "$DEVEL/lib/nodelet"  # (an empty folder there would hide Debian's from the search too)
 nodelet=$(python3 -c "import roslib.packages as p; print(p.find_node('nodelet', 'nodelet')[0])")
 runtime=$("$CXX" -print-file-name=libclang_rt.asan-x86_64.so)
+symbolizer=${ASAN_SYMBOLIZER_PATH:-$(command -v llvm-symbolizer-14 || echo /usr/lib/llvm-14/bin/llvm-symbolizer)}
+[ -x "$symbolizer" ] || { echo "sanitize.sh: no llvm-symbolizer at $symbolizer: reports would not be symbolized and suppressions could not match (Debian: llvm-14; or set ASAN_SYMBOLIZER_PATH)" >&2; exit 2; }
+export ASAN_SYMBOLIZER_PATH="$symbolizer" UBSAN_SYMBOLIZER_PATH="$symbolizer"
 [ -f "$runtime" ] || { echo "sanitize.sh: no $runtime (Debian: libclang-rt-14-dev)" >&2; exit 2; }
 mkdir -p "$(dirname "$wrapper")"
 # shellcheck disable=SC2016 # $LD_PRELOAD and $@ are the wrapper's
-printf '#!/bin/sh\n# scripts/sanitize.sh: %s with the ASan runtime preloaded\nexport LD_PRELOAD=%s${LD_PRELOAD:+:$LD_PRELOAD}\nexec %s "$@"\n' \
+printf '#!/bin/sh\n# tools/sanitize.sh: %s with the ASan runtime preloaded\nexport LD_PRELOAD=%s${LD_PRELOAD:+:$LD_PRELOAD}\nexec %s "$@"\n' \
   "$nodelet" "$runtime" "$nodelet" >"$wrapper"
 chmod +x "$wrapper"
 [ "$(python3 -c "import roslib.packages as p; print(p.find_node('nodelet', 'nodelet')[0])")" = "$wrapper" ] ||
@@ -120,8 +128,12 @@ mapfile -t logs < <(find "$LOGS" -type f | sort)
     echo '  <testcase classname="sanitizer_reports" name="no_sanitizer_report"/>'
   fi
   for log in "${logs[@]}"; do
-    what=$(grep -m1 -oE '(ERROR|SUMMARY): [A-Za-z]+Sanitizer: [^(]*|runtime error: .*' "$log" | head -c 200 |
-      sed 's/&/\&amp;/g; s/</\&lt;/g; s/>/\&gt;/g; s/"/\&quot;/g' || true)
+    what=$(grep -m1 -oE '(ERROR|SUMMARY): [A-Za-z]+Sanitizer: [^(]*|runtime error: .*' "$log" | head -c 200 || true)
+    # Frames without a function name: no symbolizer ran, so no suppression could have matched.
+    if grep -q 'invalid path to external symbolizer' "$log" || ! grep -qE '^ +#[0-9]+ 0x[0-9a-f]+ in ' "$log"; then
+      what="UNSYMBOLIZED report (no llvm-symbolizer: install llvm-14 or set ASAN_SYMBOLIZER_PATH; suppressions cannot match without it): $what"
+    fi
+    what=$(printf '%s' "$what" | sed 's/&/\&amp;/g; s/</\&lt;/g; s/>/\&gt;/g; s/"/\&quot;/g')
     echo "  <testcase classname=\"sanitizer_reports\" name=\"$(basename "$log")\"><failure message=\"$log: ${what:-a sanitizer report}\"/></testcase>"
   done
   echo '</testsuite>'

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# A newcomer's first hour, as the README's own check: a fresh clone of this repository in a
+# A newcomer's first hour, as the README's own check: a fresh copy of this repository in a
 # fresh home (so ~/cartpole_ws and ~/.ros are new), a master of its own on a free port, and the
 # README's commands in the README's order, each checked for what the README says it does.
 # Every command is looked up verbatim in README.md before it runs: a README change that alters
 # a command fails here until the command is tried again. Commands not run are listed with why.
 #
-# usage: bash scripts/first_hour.sh [RESULTS_DIR]   (one JUnit case per command goes there)
+# usage: bash tools/first_hour.sh [RESULTS_DIR]   (one JUnit case per command goes there)
 # Needs what scripts/setup.sh installs (the first command, scripts/train.sh, runs it).
 set -o pipefail
 SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -161,8 +161,15 @@ wait_for() {  # wait_for SECONDS FILE PATTERN
   return 1
 }
 
-echo "[first-hour] a fresh clone in a fresh home ($HOME), master on port $PORT"
-git clone -q "$SRC" "$HOME/cartpole_qlearning"
+echo "[first-hour] a fresh copy of the tree in a fresh home ($HOME), master on port $PORT"
+# What was committed (git archive) where there is a repository and git; else the tree as it is
+# (a release tarball or a "Download ZIP" has no .git, and a new machine may have no git).
+mkdir -p "$HOME/cartpole_qlearning"
+if command -v git >/dev/null 2>&1 && git -C "$SRC" rev-parse --is-inside-work-tree >/dev/null 2>&1; then
+  git -C "$SRC" archive HEAD | tar -x -C "$HOME/cartpole_qlearning"
+else
+  tar -C "$SRC" --exclude=.git -cf - . | tar -x -C "$HOME/cartpole_qlearning"
+fi
 cd "$HOME/cartpole_qlearning" || exit 1
 TABLES="$HOME/.ros/cartpole_qlearning/cartpole"
 
@@ -241,7 +248,7 @@ if start "sim.launch" "roslaunch cartpole_qlearning sim.launch"; then
 fi
 
 # RViz, by its picture: the README's picture made again here (Xvfb of its own: no display needed).
-run "rviz_screenshot" 120 0 "rosrun cartpole_qlearning rviz_screenshot --x 0.5 --theta 0.2 --out docs/images/rviz.png" \
+run "rviz_screenshot" 120 0 "tools/rviz_screenshot --x 0.5 --theta 0.2 --out docs/images/rviz.png" \
   "wrote docs/images/rviz.png"
 
 # Several robots, one learner.

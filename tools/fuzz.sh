@@ -4,7 +4,7 @@
 # from the seed corpus in test/fuzz/corpus/. Debian: clang-14 libclang-rt-14-dev libyaml-cpp-dev
 # libeigen3-dev (scripts/setup.sh installs them).
 #
-# usage: bash scripts/fuzz.sh [SECONDS_EACH (default 60)] [RESULTS_DIR]
+# usage: bash tools/fuzz.sh [SECONDS_EACH (default 60)] [RESULTS_DIR]
 #   RESULTS_DIR: also write one JUnit file per target there (for catkin_test_results).
 #   FUZZ_TARGETS: which targets (default "q_table config"); FUZZ_WORK: the work directory.
 # Prints per target: runs, seconds, corpus size and coverage, and exits 1 if any target found a

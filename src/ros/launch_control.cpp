@@ -1,4 +1,4 @@
-#include "cartpole_qlearning/launch_control.h"
+#include "cartpole_qlearning/ros/launch_control.h"
 
 #include <fstream>
 #include <iterator>

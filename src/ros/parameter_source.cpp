@@ -1,4 +1,4 @@
-#include "cartpole_qlearning/ros_parameter_source.h"
+#include "cartpole_qlearning/ros/parameter_source.h"
 
 #include <xmlrpcpp/XmlRpcValue.h>
 

@@ -1,0 +1,68 @@
+// The nodes' private parameters (~mode, ~q_table_dir, ~robots, ... for the controller; ~mode,
+// ~lockstep_timeout, ... for the sim), read and checked by the core through a ParameterSource,
+// so that every rule is a unit test with YAML text. The node passes in only what needs ROS.
+#pragma once
+
+#include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/lockstep_protocol.h"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace cartpole_qlearning
+{
+// What the application around the learner needs (run_application.h): the controller node fills
+// it from its private parameters, train_headless from its command line.
+struct RunSettings
+{
+  bool learning = true;  // ~mode: train (true) or evaluate (greedy, no learning)
+  std::uint64_t seed = 0;
+  std::string name_space = "/cartpole";  // the learner's namespace: its table folder by default, its run folders' names
+  // Tables are read and written under this folder (a relative path there; one that escapes it is
+  // refused). "~/" at its start is the user's home.
+  std::string q_table_dir;
+  std::string q_table_path = "q_table.yaml";  // the default table, relative to q_table_dir
+  std::string load_on_start;                  // a table to start from ("": none)
+  // "" the run's folder/episodes.csv (training; none when evaluating), "none" no file, else a
+  // path (relative: under q_table_dir; absolute: the user's own).
+  std::string stats_csv;
+  std::string run_id;                       // the launch's own id: a respawn finds its run by it
+  std::uint64_t evaluation_episodes = 10;   // evaluate: the verdict after this many episodes (0: never)
+  std::uint64_t checkpoint_every = 100;     // training: a checkpoint every this many episodes (0: none)
+  bool save_on_shutdown = true;             // training: save into the run's folder when stopped early
+  bool trace = false;                       // log every update and the table at each episode end
+};
+
+struct ControllerSettings
+{
+  TrainingConfig training;  // the shared sections, with ~stop_when_solved and ~max_episodes applied
+  RunSettings run;
+  bool shutdown_when_finished = true;                 // end the launch (or the node) when done
+  double sim_timeout = 2.0;                           // [s] wall: a robot silent this long is said to be
+  std::string reset_service = "cartpole_sim/reset";   // "": a robot that cannot be reset on command
+  std::vector<std::string> robots{""};                // namespaces relative to the learner's
+  bool sync = true;                                   // several robots: served in lockstep rounds
+  ControllerProtocolParams protocol;                  // reset_service, start_region, limits
+};
+
+// What only ROS knows, handed in by the node.
+struct ControllerContext
+{
+  std::string name_space = "/cartpole";  // the learner's namespace (the default table folder's name)
+  std::string home;                      // $HOME, for "~/" in paths ("": none)
+  bool shutdown_by_default = true;       // ~shutdown_when_finished's default (a nodelet: false)
+  // "" for a valid relative ROS name, else why it is not one (ros::names::validate).
+  std::function<std::string(const std::string&)> name_error;
+  // Private keys read by other means (dynamic_reconfigure's fields, ~run/...): not unknown.
+  std::vector<std::string> other_keys;
+};
+
+// Reads the shared sections from `shared` and the private parameters from `priv`. Throws
+// ConfigError naming the parameter, its value and what is allowed, on a bad value or an
+// unknown private key.
+ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& priv,
+                                          const ControllerContext& context);
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,32 @@
+#include "cartpole_qlearning/ros/start_up.h"
+
+#include "cartpole_qlearning/ros/launch_control.h"
+
+#include <ros/console.h>
+
+#include <exception>
+
+namespace cartpole_qlearning
+{
+bool startNode(const std::string& name, const std::function<void()>& start, std::string* reason)
+{
+  // Only the start-up is caught here: an exception from a callback later is a crash like any
+  // other, and under train.launch the node respawns.
+  try
+  {
+    start();
+    return true;
+  }
+  catch (const std::exception& e)
+  {
+    const std::string logger = std::string(ROSCONSOLE_DEFAULT_NAME) + "." + name;
+    ROS_FATAL_STREAM_NAMED(logger, name << ": " << e.what());
+    if (endParentLaunch())
+      ROS_FATAL_STREAM_NAMED(logger, name << ": ending the launch: this cannot work until the above is fixed");
+    if (reason != nullptr)
+      *reason = e.what();
+    return false;
+  }
+}
+
+}  // namespace cartpole_qlearning

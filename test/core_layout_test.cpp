@@ -1,0 +1,95 @@
+// The core (src/*.cpp, include/cartpole_qlearning/*.h: the top level of each) builds without ROS:
+// it may include the standard library, POSIX, Eigen, yaml-cpp and the core's own headers, and
+// nothing else. Debian installs the ROS headers on the default include path, so a stray
+// #include <ros/ros.h> would still compile; this test is what stops it.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+namespace fs = std::filesystem;
+
+const fs::path kSource = CARTPOLE_SOURCE_DIR;
+
+// The #include lines of a file's text that the core may not have, as "line N: #include ...".
+// core_header(name) tells whether "cartpole_qlearning/name" is a core header.
+template <typename CoreHeader>
+std::vector<std::string> foreignIncludes(const std::string& text, CoreHeader core_header)
+{
+  // <vector>, <cstdint>; <unistd.h>, <sys/stat.h>; <Eigen/Core>; <yaml-cpp/yaml.h>
+  static const std::regex allowed_system(R"(<([a-z_]+|[a-z_]+\.h|sys/[a-z_]+\.h|Eigen/[A-Za-z]+|yaml-cpp/[a-z_/]+\.h)>)");
+  static const std::regex include(R"re(^\s*#\s*include\s*([<"][^>"]*[>"]))re");
+  static const std::regex own(R"re("cartpole_qlearning/([a-z0-9_]+\.h)")re");
+  std::vector<std::string> foreign;
+  std::istringstream lines(text);
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number)
+  {
+    std::smatch m;
+    if (!std::regex_search(line, m, include))
+      continue;
+    const std::string target = m[1];
+    std::smatch o;
+    const bool ok = std::regex_match(target, allowed_system) ||
+                    (std::regex_match(target, o, own) && core_header(o[1].str()));
+    if (!ok)
+      foreign.push_back("line " + std::to_string(number) + ": " + line);
+  }
+  return foreign;
+}
+
+bool isCoreHeader(const std::string& name)
+{
+  return fs::is_regular_file(kSource / "include" / "cartpole_qlearning" / name);
+}
+
+std::string readText(const fs::path& path)
+{
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+TEST(CoreLayoutTest, TheCheckRefusesRosHeadersAndGeneratedMessages)
+{
+  const auto core = [](const std::string& name) { return name == "q_table.h"; };
+  EXPECT_TRUE(foreignIncludes("#include <vector>\n#include <Eigen/Core>\n#include \"cartpole_qlearning/q_table.h\"\n"
+                              "#include <sys/stat.h>\n#include <yaml-cpp/yaml.h>\n",
+                              core)
+                  .empty());
+  EXPECT_EQ(foreignIncludes("#include <vector>\n#include <ros/ros.h>\n", core),
+            std::vector<std::string>{"line 2: #include <ros/ros.h>"});
+  EXPECT_EQ(foreignIncludes("#include <sensor_msgs/JointState.h>\n", core).size(), 1u);
+  EXPECT_EQ(foreignIncludes("#include \"cartpole_qlearning/EpisodeStats.h\"\n", core).size(), 1u);
+  EXPECT_EQ(foreignIncludes("#include \"cartpole_qlearning/ros/start_up.h\"\n", core).size(), 1u);
+  EXPECT_EQ(foreignIncludes("  #  include <boost/thread.hpp>\n", core).size(), 1u);
+}
+
+TEST(CoreLayoutTest, NoCoreFileIncludesAHeaderFromOutsideTheCore)
+{
+  std::size_t files = 0;
+  for (const fs::path& folder : {kSource / "src", kSource / "include" / "cartpole_qlearning"})
+  {
+    ASSERT_TRUE(fs::is_directory(folder)) << folder;
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+    {
+      if (!entry.is_regular_file())
+        continue;  // src/ros/, src/cli/, include/cartpole_qlearning/ros/: not the core
+      ++files;
+      const std::vector<std::string> foreign = foreignIncludes(readText(entry.path()), isCoreHeader);
+      for (const std::string& line : foreign)
+        ADD_FAILURE() << entry.path().string() << " " << line
+                      << ": the core includes the standard library, POSIX, Eigen, yaml-cpp and its own headers only";
+    }
+  }
+  EXPECT_GT(files, 40u) << "the core's files were not found under " << kSource;
+}
+
+}  // namespace
