@@ -50,14 +50,14 @@ ResetCalls::Orders ResetCalls::onReturn(std::uint64_t generation, bool answered,
   if (answered)
   {
     if (failing_)
-      orders.say.push_back({ Say::Level::Info, service_ + " answers again; going on" });
+      orders.say.push_back({Say::Level::Info, service_ + " answers again; going on"});
     failing_ = false;
     return next(std::move(orders), now);
   }
   if (!failing_)
-    orders.say.push_back({ Say::Level::Warn, "reset call to " + service_ + " failed" +
-                                                 (message.empty() ? "" : ": " + message) +
-                                                 "; retrying until it answers" });
+    orders.say.push_back({Say::Level::Warn, "reset call to " + service_ + " failed" +
+                                                (message.empty() ? "" : ": " + message) +
+                                                "; retrying until it answers"});
   failing_ = true;
   wanted_ = true;
   retry_at_ = later(now, retry_after_);
@@ -87,8 +87,8 @@ ResetCalls::Orders ResetCalls::onTime(Clock::time_point now)
   give_up_at_.reset();
   char after[32];
   std::snprintf(after, sizeof after, "%.1f", std::chrono::duration<double>(give_up_after_).count());
-  orders.say.push_back({ Say::Level::Warn, "reset call to " + service_ + " has not returned after " + after +
-                                               " s; giving it up and retrying on a new connection" });
+  orders.say.push_back({Say::Level::Warn, "reset call to " + service_ + " has not returned after " + after +
+                                              " s; giving it up and retrying on a new connection"});
   failing_ = true;
   wanted_ = true;
   retry_at_ = now;
@@ -117,7 +117,7 @@ ResetCalls::Orders ResetCalls::next(Orders orders, Clock::time_point now)
     wanted_ = false;
     phase_ = Phase::Calling;
     give_up_at_ = later(now, give_up_after_);
-    orders.call = Call{ generation_, !failing_ };
+    orders.call = Call{generation_, !failing_};
   }
   if (phase_ == Phase::Calling && give_up_at_)
     orders.wake_at = *give_up_at_;

@@ -76,7 +76,7 @@ void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t 
       if (shared->generation != generation)
       {
         // Given up before it even took its call (a starved thread): it frees its slot all the same.
-        shared->returned.push_back({ generation, false, false, "" });
+        shared->returned.push_back({generation, false, false, ""});
         shared->changed.notify_all();
         return;
       }
@@ -106,7 +106,7 @@ void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t 
     }
     {
       std::lock_guard<std::mutex> lock(shared->mutex);
-      shared->returned.push_back({ generation, true, answered, reset.response.message });
+      shared->returned.push_back({generation, true, answered, reset.response.message});
       shared->changed.notify_all();
       if (shared->generation != generation || shared->stopping)
         return;
@@ -126,8 +126,8 @@ void ResetCaller::run()
       shared_->changed.wait_until(lock, wake_at_, woken);
     const auto now = ResetCalls::Clock::now();
     for (const Shared::Returned& back : std::exchange(shared_->returned, {}))
-      carryOut(back.called ? calls_.onReturn(back.generation, back.answered, back.message, now) :
-                             calls_.onThreadEnded(back.generation, now));
+      carryOut(back.called ? calls_.onReturn(back.generation, back.answered, back.message, now)
+                           : calls_.onThreadEnded(back.generation, now));
     if (shared_->stopping)
       break;
     if (std::exchange(shared_->requested, false))
