@@ -23,10 +23,6 @@ namespace cartpole_qlearning
 {
 namespace
 {
-// [s] A reset call is given up after max(this, 2 x ~sim_timeout) (README: the ~reset_service row).
-constexpr double kMinResetGiveUp = 5.0;
-constexpr double kMaxResetGiveUp = 3600.0;
-
 // ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
 // the learner's own namespace (N = 1), or robot_0 ... robot_<N-1> (train.launch robots:=N).
 void readRobots(const ros::NodeHandle& pnh, SectionReader& priv, std::vector<std::string>& names)
@@ -176,12 +172,8 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   setUpRobots(state_queue);
   if (protocol_params_.reset_service)
   {
-    // Long enough for a sim that is merely slow (loaded, or far away) to answer, since giving a
-    // call up leaves a thread and a connection behind; ~sim_timeout is how long the user lets a
-    // sim be silent before calling it gone.
-    // (At most an hour: a huge ~sim_timeout must not overflow the clock's arithmetic.)
-    const auto give_up_after = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(std::min(kMaxResetGiveUp, std::max(kMinResetGiveUp, 2.0 * sim_timeout_))));
+    // README: the ~reset_service row.
+    const auto give_up_after = resetGiveUpAfter(sim_timeout_);
     for (Robot& robot : robots_)
       robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(reset_service_), give_up_after);
   }
