@@ -2,15 +2,11 @@
 
 #include "cartpole_qlearning/Reset.h"
 #include "cartpole_qlearning/ros/launch_control.h"
-#include "cartpole_qlearning/q_table_file.h"
 #include "cartpole_qlearning/ros/parameter_source.h"
 
 #include <ros/names.h>
-#include <xmlrpcpp/XmlRpcValue.h>
 
 #include <algorithm>
-#include <array>
-#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
@@ -23,45 +19,6 @@ namespace cartpole_qlearning
 {
 namespace
 {
-// ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
-// the learner's own namespace (N = 1), or robot_0 ... robot_<N-1> (train.launch robots:=N).
-void readRobots(const ros::NodeHandle& pnh, SectionReader& priv, std::vector<std::string>& names)
-{
-  priv.know("robots");
-  XmlRpc::XmlRpcValue value;
-  if (!pnh.getParam("robots", value))
-    return;
-  const auto refuse = [&](const std::string& why) { refuseParameter(pnh, "robots", "'" + value.toXml() + "'", why); };
-  const char* allowed = "a whole number in [1, 1000] or a list of namespaces relative to the controller's";
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeInt)
-  {
-    const int count = static_cast<int>(value);
-    if (count < 1 || count > 1000)
-      refuse(allowed);
-    names.clear();
-    if (count == 1)
-      names.push_back("");
-    for (int i = 0; count > 1 && i < count; ++i)
-      names.push_back("robot_" + std::to_string(i));
-    return;
-  }
-  if (value.getType() != XmlRpc::XmlRpcValue::TypeArray || value.size() < 1 || value.size() > 1000)
-    refuse(allowed);
-  names.clear();
-  for (int i = 0; i < value.size(); ++i)
-  {
-    if (value[i].getType() != XmlRpc::XmlRpcValue::TypeString)
-      refuse(allowed);
-    const std::string name = static_cast<std::string>(value[i]);
-    std::string error;
-    if (!name.empty() && !ros::names::validate(name, error))
-      refuse("'" + name + "' is not a valid ROS name: " + error);
-    if (std::find(names.begin(), names.end(), name) != names.end())
-      refuse("'" + name + "' is listed twice");
-    names.push_back(name);
-  }
-}
-
 double secondsSince(std::chrono::steady_clock::time_point then)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - then).count();
@@ -150,18 +107,20 @@ std::string asServerField(std::string message)
 QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
                                                  std::function<void()> shutdown, bool shutdown_by_default,
                                                  ros::CallbackQueue* state_queue)
-  : nh_(nh), pnh_(pnh), shutdown_(std::move(shutdown)), shutdown_when_finished_(shutdown_by_default)
+  : nh_(nh), pnh_(pnh), shutdown_(std::move(shutdown))
 {
   std::unique_lock<std::mutex> lock(mutex_);
-  readParameters();
-  session_ = std::make_unique<TrainingSession>(config_.task, config_.agent, seed_, learning_, robot_names_.size());
-  if (trace_ && learning_)
+  readParameters(shutdown_by_default);
+  session_ = std::make_unique<TrainingSession>(settings_.training.task, settings_.training.agent, settings_.run.seed,
+                                               settings_.run.learning, settings_.robots.size());
+  if (settings_.run.trace && settings_.run.learning)
   {
-    state_names_ = stateNames(config_.agent);
+    state_names_ = stateNames(settings_.training.agent);
     session_->setTrace([this](std::size_t robot, const TraceStep& step) {
-      const std::string& name = robot_names_[robot];
+      const std::string& name = settings_.robots[robot];
       say({{Said::Level::Info,
-            (robot_names_.size() > 1 ? name + ": " : "") + traceLine(step, state_names_, config_.agent.actions),
+            (settings_.robots.size() > 1 ? name + ": " : "") +
+                traceLine(step, state_names_, settings_.training.agent.actions),
             false}});
     });
   }
@@ -170,14 +129,14 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
   load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
   setUpRobots(state_queue);
-  if (protocol_params_.reset_service)
+  if (settings_.protocol.reset_service)
   {
     // README: the ~reset_service row.
-    const auto give_up_after = resetGiveUpAfter(sim_timeout_);
+    const auto give_up_after = resetGiveUpAfter(settings_.sim_timeout);
     for (Robot& robot : robots_)
-      robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(reset_service_), give_up_after);
+      robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(settings_.reset_service), give_up_after);
   }
-  watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, sim_timeout_ / 2.0)),
+  watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, settings_.sim_timeout / 2.0)),
                                     &QLearningControllerNode::onWatchdog, this);
   std::string served;
   for (const Robot& robot : robots_)
@@ -188,11 +147,12 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
           ? std::to_string(features.tilings) + " tilings, " + std::to_string(session_->table().stateCount()) + " tiles"
           : std::to_string(session_->table().stateCount()) + " states";
   say(Said::Level::Info, "%s, seed %llu, %s x %zu actions, tables under %s; serving %s%s; %s",
-      learning_ ? "training" : "evaluating (greedy, no learning)", static_cast<unsigned long long>(seed_), rows.c_str(),
-      session_->table().actionCount(), app_->tableDirectory().c_str(), served.c_str(),
-      robots_.size() > 1 ? (sync_ ? " in lockstep rounds" : ", each as its states come") : "",
-      protocol_params_.reset_service ? ("resets by ~" + reset_service_).c_str()
-                                     : "no reset service: episodes start when the state is in ~start_region");
+      settings_.run.learning ? "training" : "evaluating (greedy, no learning)",
+      static_cast<unsigned long long>(settings_.run.seed), rows.c_str(), session_->table().actionCount(),
+      app_->tableDirectory().c_str(), served.c_str(),
+      robots_.size() > 1 ? (settings_.sync ? " in lockstep rounds" : ", each as its states come") : "",
+      settings_.protocol.reset_service ? ("resets by ~" + settings_.reset_service).c_str()
+                                       : "no reset service: episodes start when the state is in ~start_region");
   lock.unlock();
   startLiveTuning();
 }
@@ -200,15 +160,15 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
 void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
 {
   rounds_ = std::make_unique<RobotRounds>(
-      robot_names_.size(), sync_,
-      std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(sim_timeout_)));
-  robots_.resize(robot_names_.size());
+      settings_.robots.size(), settings_.sync,
+      std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(settings_.sim_timeout)));
+  robots_.resize(settings_.robots.size());
   const auto now = std::chrono::steady_clock::now();
   for (std::size_t r = 0; r < robots_.size(); ++r)
   {
     Robot& robot = robots_[r];
-    robot.name = robot_names_[r];
-    ControllerProtocolParams params = protocol_params_;
+    robot.name = settings_.robots[r];
+    ControllerProtocolParams params = settings_.protocol;
     params.robot = r;
     robot.protocol = std::make_unique<ControllerProtocol>(*session_, params);
     robot.nh = robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name);
@@ -247,106 +207,21 @@ QLearningControllerNode::~QLearningControllerNode()
     std::printf("%s\n", prefixed(said).c_str());
 }
 
-void QLearningControllerNode::readParameters()
+void QLearningControllerNode::readParameters(bool shutdown_by_default)
 {
-  const RosParameterSource shared(nh_);
-  config_ = readTrainingConfig(shared);
-
-  // Private parameters: the same reader and checks as the shared sections; a key it does not
-  // know (a typo) stops the node instead of being ignored.
-  const RosParameterSource source(pnh_);
-  SectionReader priv(source, "");
-  // The launch files' stop_when_solved and max_episodes arrive as private parameters; they
-  // override the shared training/ keys for this controller only.
-  priv.read("stop_when_solved", config_.limits.stop_when_solved);
-  priv.read("max_episodes", config_.limits.max_episodes, 1);
-
-  std::string mode = "train";
-  priv.readChoice("mode", mode, {"train", "evaluate"});
-  learning_ = mode == "train";
-  priv.read("seed", seed_, 0);
-
-  q_table_dir_ = defaultTableDirectory(nh_.getNamespace());
-  priv.read("q_table_dir", q_table_dir_);
-  if (q_table_dir_.empty())
-    priv.fail("q_table_dir", "''", "must name a directory");
-  // Paths given as "~/..." (roslaunch passes them on unexpanded) name the user's home.
+  ControllerContext context;
+  context.name_space = nh_.getNamespace();
   const char* home = std::getenv("HOME");
-  const auto expand_home = [&](const std::string& name, std::string& path) {
-    try
-    {
-      path = expandHome(path, home ? home : "");
-    }
-    catch (const FileError& e)
-    {
-      priv.fail(name, "'" + path + "'", e.what());
-    }
+  context.home = home ? home : "";
+  context.shutdown_by_default = shutdown_by_default;
+  context.name_error = [](const std::string& name) {
+    std::string error;
+    return ros::names::validate(name, error) ? std::string() : error;
   };
-  expand_home("q_table_dir", q_table_dir_);
-  priv.read("q_table_path", q_table_path_);
-  expand_home("q_table_path", q_table_path_);
-  try
-  {
-    resolve(q_table_path_);
-  }
-  catch (const QTableFileError& e)
-  {
-    priv.fail("q_table_path", "'" + q_table_path_ + "'", e.what());
-  }
-  priv.read("load_on_start", load_on_start_);
-  expand_home("load_on_start", load_on_start_);
-  priv.read("stats_csv", stats_csv_);
-  expand_home("stats_csv", stats_csv_);
-  if (stats_csv_ != "none" && !stats_csv_.empty() && stats_csv_.front() != '/')
-  {
-    try
-    {
-      relativePathUnder(q_table_dir_, stats_csv_);
-    }
-    catch (const FileError& e)
-    {
-      priv.fail("stats_csv", "'" + stats_csv_ + "'", e.what());
-    }
-  }
-  priv.read("run_id", run_id_);
-  // Set by the controller itself (openRun), for a respawn of it to find.
-  priv.know("run/id");
-  priv.know("run/launcher");
-  priv.know("run/folder");
-  priv.read("evaluation_episodes", evaluation_episodes_, 0);
-  priv.read("checkpoint_every", checkpoint_every_, 0);
-  priv.read("save_on_shutdown", save_on_shutdown_);
-  priv.read("shutdown_when_finished", shutdown_when_finished_);
-  priv.readAtLeast("sim_timeout", sim_timeout_, 0.0, true);
-  priv.read("reset_service", reset_service_);
-  protocol_params_.reset_service = !reset_service_.empty();
-  protocol_params_.start_region = CartPoleState::Constant(config_.start_state_bound);
-  std::array<double, kStateDimensions> region{};
-  for (std::size_t i = 0; i < kStateDimensions; ++i)
-    region[i] = protocol_params_.start_region[i];
-  priv.readDimensions("start_region", region, false);
-  for (std::size_t i = 0; i < kStateDimensions; ++i)
-  {
-    if (!(std::isfinite(region[i]) && region[i] > 0.0))
-      priv.fail("start_region", SectionReader::listText({region.begin(), region.end()}),
-                "must be 4 finite values > 0: |x|, |x_dot|, |theta|, |theta_dot| bounds");
-    protocol_params_.start_region[i] = region[i];
-  }
-  readRobots(pnh_, priv, robot_names_);
-  priv.read("sync", sync_);
-  priv.read("trace", trace_);
-  if (trace_ && config_.agent.features == FeatureKind::Tiles)
-    priv.fail("trace", "true", "the trace shows one table row per state: learning/features bins only");
   // Live tuning's values, which the controller's own dynamic_reconfigure server keeps there.
   for (const auto& param : LearningConfig::__getParamDescriptions__())
-    priv.know(param->name);
-  priv.refuseUnknown();
-  protocol_params_.limits = config_.limits;
-}
-
-std::string QLearningControllerNode::resolve(const std::string& path) const
-{
-  return resolvePathUnder(q_table_dir_, path.empty() ? q_table_path_ : path);
+    context.other_keys.push_back(param->name);
+  settings_ = readControllerSettings(RosParameterSource(nh_), RosParameterSource(pnh_), context);
 }
 
 bool QLearningControllerNode::extractState(const sensor_msgs::JointState& msg, CartPoleState& state) const
@@ -514,7 +389,7 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
 
 void QLearningControllerNode::endWhenFinished()
 {
-  if (!shutdown_when_finished_)
+  if (!settings_.shutdown_when_finished)
     return;
   if (endParentLaunch())
   {
@@ -525,27 +400,9 @@ void QLearningControllerNode::endWhenFinished()
     shutdown_();
 }
 
-RunSettings QLearningControllerNode::runSettings() const
-{
-  RunSettings settings;
-  settings.learning = learning_;
-  settings.seed = seed_;
-  settings.name_space = nh_.getNamespace();
-  settings.q_table_dir = q_table_dir_;
-  settings.q_table_path = q_table_path_;
-  settings.load_on_start = load_on_start_;
-  settings.stats_csv = stats_csv_;
-  settings.run_id = run_id_;
-  settings.evaluation_episodes = evaluation_episodes_;
-  settings.checkpoint_every = checkpoint_every_;
-  settings.save_on_shutdown = save_on_shutdown_;
-  settings.trace = trace_;
-  return settings;
-}
-
 void QLearningControllerNode::startRun()
 {
-  app_ = std::make_unique<RunApplication>(runSettings(), config_, *session_);
+  app_ = std::make_unique<RunApplication>(settings_.run, settings_.training, *session_);
   // A respawn finds the run id, the roslaunch (else the parent) and the folder of the process
   // that started the run; a node started by hand on a reused master has at most the id left there.
   RunIdentity previous;
@@ -570,7 +427,7 @@ void QLearningControllerNode::startRun()
   }
   // A respawn of a run that has finished stays up rather than exit (under respawn that would
   // only start it again), and ends the launch when asked to.
-  if (app_->finished() && shutdown_when_finished_ && endParentLaunch())
+  if (app_->finished() && settings_.shutdown_when_finished && endParentLaunch())
     say(Said::Level::Info, "ending the launch");
 }
 
@@ -601,11 +458,11 @@ void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
     return;
   for (Robot& robot : robots_)
   {
-    if (robot.silent_reported || secondsSince(robot.last_state_at) < sim_timeout_)
+    if (robot.silent_reported || secondsSince(robot.last_state_at) < settings_.sim_timeout)
       continue;
     robot.silent_reported = true;
     say(Said::Level::Warn, "no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting for it",
-        describe(robot).c_str(), sim_timeout_);
+        describe(robot).c_str(), settings_.sim_timeout);
   }
   const std::vector<std::size_t> dropped = rounds_->dropOuts(WallClock::now());
   for (const std::size_t r : dropped)
@@ -669,9 +526,10 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
   const std::string changes = learningChangesText(in_use, wanted);
   if (changes.empty())
     return;
-  const char* applies = learning_ ? "gamma from the next update, epsilon and alpha from the next episode"
-                                  : "evaluating, so none of it applies: actions stay greedy (epsilon 0), nothing "
-                                    "is learnt (alpha 0, gamma unused)";
+  const char* applies = settings_.run.learning
+                            ? "gamma from the next update, epsilon and alpha from the next episode"
+                            : "evaluating, so none of it applies: actions stay greedy (epsilon 0), nothing "
+                              "is learnt (alpha 0, gamma unused)";
   if (first && app_->respawned())
     say(Said::Level::Warn, "restarted; the live tuning of this run before the restart applies again: %s (%s)",
         changes.c_str(), applies);

@@ -18,6 +18,7 @@
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/ros/reset_caller.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
+#include "cartpole_qlearning/node_settings.h"
 #include "cartpole_qlearning/robot_rounds.h"
 #include "cartpole_qlearning/run_application.h"
 #include "cartpole_qlearning/training_session.h"
@@ -49,8 +50,8 @@ public:
   // shutdown_by_default), the controller ends the roslaunch that started it, as Ctrl-C would
   // (launch_control.h); when no roslaunch started it, it calls shutdown: the executable ends
   // there; a nodelet ends its manager only when asked. state_queue: where the joint_states callbacks queue (nullptr:
-  // nh's queue); a nodelet passes the queue its lockstep thread serves. Throws ConfigError naming a bad parameter,
-  // QTableFileError for a bad ~load_on_start file.
+  // nh's queue); a nodelet passes the queue its lockstep thread serves. Throws ConfigError naming a bad parameter
+  // (a ~load_on_start table or ~stats_csv that cannot be used included).
   QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::function<void()> shutdown,
                           bool shutdown_by_default, ros::CallbackQueue* state_queue = nullptr);
   // Saves the table when ~save_on_shutdown (training, RunApplication::shutdown), after giving up
@@ -77,15 +78,13 @@ private:
     bool silent_reported = false;
   };
 
-  void readParameters();
+  void readParameters(bool shutdown_by_default);
   // Serves the learning settings in use on ~set_parameters (dynamic_reconfigure). Called with
   // mutex_ free: the server calls onReconfigure at once, which takes it.
   void startLiveTuning();
   // A change from a dynamic_reconfigure client: applied when the core accepts it, else refused
   // with the values in use put back into config (what the server then keeps and reports).
   void onReconfigure(LearningConfig& config, std::uint32_t level);
-  // The run settings the parameters give (RunApplication's).
-  RunSettings runSettings() const;
   // Starts the run (fresh, or going on with the run of a controller this process respawns) and
   // stores what a respawn of it needs to find it (~run/id, ~run/launcher, ~run/folder).
   void startRun();
@@ -109,7 +108,6 @@ private:
   void endEpisode(Robot& robot, const ros::Time& stamp, bool training_finished);
   // Logs what the protocol did with a state that was not simply answered.
   void report(const Robot& robot, const Reaction& reaction, const ros::Time& stamp);
-  std::string resolve(const std::string& path) const;
   std::string describe(const Robot& robot) const;
 
   // Reset calls run on threads of their own (ResetCaller, one per robot): a blocking service
@@ -128,28 +126,9 @@ private:
   // services and timer on the manager's): each holds this while it runs.
   std::mutex mutex_;
   std::function<void()> shutdown_;
-  bool shutdown_when_finished_;
 
   // Parameters
-  TrainingConfig config_;
-  bool learning_ = true;  // ~mode: train (true) or evaluate
-  std::uint64_t seed_ = 0;
-  std::string q_table_dir_;
-  std::string q_table_path_ = "q_table.yaml";
-  std::string load_on_start_;
-  std::string run_id_;  // ~run_id: the launch's own id (train.launch: $(anon run))
-  // ~stats_csv: "" the run's folder/episodes.csv (training; none when evaluating), "none" no
-  // file, else a path (relative: under q_table_dir_).
-  std::string stats_csv_;
-  std::uint64_t evaluation_episodes_ = 10;  // evaluate: the verdict after this many episodes (0: never)
-  std::uint64_t checkpoint_every_ = 100;
-  bool save_on_shutdown_ = true;
-  double sim_timeout_ = 2.0;                          // [s] wall
-  std::string reset_service_ = "cartpole_sim/reset";  // "": a robot that cannot be reset on command
-  std::vector<std::string> robot_names_{""};
-  bool sync_ = true;
-  ControllerProtocolParams protocol_params_;
-  bool trace_ = false;                    // ~trace: log every update and the table at each episode end
+  ControllerSettings settings_;
   std::vector<std::string> state_names_;  // as the trace names the rows (trace.h)
 
   std::unique_ptr<TrainingSession> session_;
