@@ -1,9 +1,9 @@
 #include "cartpole_qlearning/ros/cartpole_sim.h"
 
 #include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/ros/conversions.h"
 #include "cartpole_qlearning/ros/parameter_source.h"
 
-#include <geometry_msgs/TransformStamped.h>
 #include <rosgraph_msgs/Clock.h>
 
 #include <algorithm>
@@ -135,17 +135,15 @@ bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
 void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const auto it = std::find(msg->name.begin(), msg->name.end(), "cart_joint");
-  const std::size_t index = static_cast<std::size_t>(it - msg->name.begin());
-  if (it == msg->name.end() || msg->effort.size() != msg->name.size())
+  const Reading<double> requested = effortFromCommand(*msg);
+  if (!requested)
   {
     if (bad_command_warning_.ready())
-      ROS_WARN("cartpole_sim: dropped a joint_command without an effort for cart_joint (names: %zu, efforts: %zu)",
-               msg->name.size(), msg->effort.size());
+      ROS_WARN("cartpole_sim: %s", requested.refusal.c_str());
     return;
   }
   double effort = 0.0;
-  if (!acceptEffort(msg->effort[index], effort))
+  if (!acceptEffort(*requested.value, effort))
     return;
   const WallClock::time_point now = WallClock::now();
   if (mode_ == Mode::Realtime)
@@ -284,12 +282,7 @@ void CartPoleSimNode::republishState()
 void CartPoleSimNode::publishState(const ros::Time& stamp)
 {
   const CartPoleState& s = simulation_->state();
-  auto msg = boost::make_shared<sensor_msgs::JointState>();
-  msg->header.stamp = stamp;
-  msg->name = {"cart_joint", "pole_joint"};
-  msg->position = {s[0], s[2]};
-  msg->velocity = {s[1], s[3]};
-  msg->effort = {simulation_->appliedForce(), 0.0};  // the pole joint is not actuated
+  auto msg = boost::make_shared<sensor_msgs::JointState>(jointStateFromState(s, simulation_->appliedForce(), stamp));
   if (position_noise_std_ > 0.0)
   {
     msg->position[0] += position_noise_std_ * noise_->normal();
@@ -309,21 +302,7 @@ void CartPoleSimNode::publishState(const ros::Time& stamp)
   if (mode_ == Mode::Lockstep && wall_now - last_tf_ < wallDuration(1.0 / tf_rate_))
     return;
   last_tf_ = wall_now;
-  geometry_msgs::TransformStamped cart;
-  cart.header.stamp = stamp;
-  cart.header.frame_id = world_frame_;
-  cart.child_frame_id = cart_frame_;
-  cart.transform.translation.x = s[0];
-  cart.transform.translation.y = track_y_;
-  cart.transform.rotation.w = 1.0;
-  geometry_msgs::TransformStamped pole;
-  pole.header.stamp = stamp;
-  pole.header.frame_id = cart_frame_;
-  pole.child_frame_id = pole_frame_;
-  // theta about +y: positive theta tips the pole's top toward +x.
-  pole.transform.rotation.y = std::sin(s[2] / 2.0);
-  pole.transform.rotation.w = std::cos(s[2] / 2.0);
-  tf_broadcaster_.sendTransform({cart, pole});
+  tf_broadcaster_.sendTransform(transformsFromState(s, track_y_, stamp, world_frame_, cart_frame_, pole_frame_));
 }
 
 }  // namespace cartpole_qlearning
