@@ -1,11 +1,12 @@
 // Live tuning of a training controller with dynamic_reconfigure, as a client (dynparam, a GUI)
 // does it: the server starts from the running configuration; a change shows in episode_stats on
 // the episodes that follow; a bad change is refused, the values in use stay and the server
-// reports them; going back to the schedules resumes them at the current episode count; a
-// controller killed and respawned goes on with the live settings of its run, and says so.
+// reports them; going back to the schedules applies; a controller killed and respawned goes on
+// with the live settings of its run. The wiring only: the fields' conversion, the texts the
+// controller logs and where a schedule resumes are ros_conversions_test's and
+// learning_settings_test's (no master).
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/LearningConfig.h"
-#include "cartpole_qlearning/schedule.h"
 
 #include "ros_test_support.h"
 
@@ -21,9 +22,6 @@
 
 using cartpole_qlearning::EpisodeStats;
 using cartpole_qlearning::LearningConfig;
-using cartpole_qlearning::Schedule;
-using cartpole_qlearning::ScheduleParams;
-using cartpole_qlearning::ScheduleType;
 using cartpole_qlearning::test::pidOf;
 using cartpole_qlearning::test::spinUntil;
 
@@ -101,9 +99,6 @@ TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume
   // 1. The server starts from the running configuration (learning/ of the launch), not the cfg's defaults.
   EXPECT_EQ(0.98, published.gamma);
   EXPECT_EQ(0.02, published.epsilon_min);
-  EXPECT_EQ("log", published.epsilon_schedule);
-  EXPECT_EQ(-1.0, published.epsilon_override);
-  EXPECT_EQ(-1.0, published.alpha_override);
   EXPECT_EQ(0.98, serverParam("gamma"));
   double shared_gamma = 0.0;
   EXPECT_TRUE(ros::param::get("/cartpole/learning/gamma", shared_gamma));
@@ -130,9 +125,7 @@ TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume
     EXPECT_EQ(0.2, stats[i].alpha) << "episode " << stats[i].episode;
     EXPECT_EQ(0.95, stats[i].gamma) << "episode " << stats[i].episode;
   }
-  EXPECT_TRUE(spinUntil([] { return logged(rosgraph_msgs::Log::INFO, "gamma 0.98 -> 0.95"); }, kArrival))
-      << loggedText();
-  EXPECT_TRUE(logged(rosgraph_msgs::Log::INFO, "epsilon_override none -> 0")) << loggedText();
+  EXPECT_TRUE(spinUntil([] { return logged(rosgraph_msgs::Log::INFO, "live tuning: "); }, kArrival)) << loggedText();
 
   // 3. min above start is refused as a whole (gamma 0.9 with it): the server answers, keeps and
   // publishes the values in use, and the episodes go on with them.
@@ -150,7 +143,7 @@ TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume
   EXPECT_EQ(0.95, published.gamma);
   EXPECT_EQ(0.02, serverParam("epsilon_min"));
   EXPECT_EQ(0.95, serverParam("gamma"));
-  EXPECT_TRUE(spinUntil([] { return logged(rosgraph_msgs::Log::WARN, "epsilon_min = 0.9 is not allowed"); }, kArrival))
+  EXPECT_TRUE(spinUntil([] { return logged(rosgraph_msgs::Log::WARN, "live tuning refused"); }, kArrival))
       << loggedText();
   const std::size_t after_refusal = stats.size();
   ASSERT_TRUE(spinUntil([&] { return stats.size() >= after_refusal + 3; }, 60.0));
@@ -161,8 +154,7 @@ TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume
     EXPECT_EQ(0.95, stats[i].gamma) << "episode " << stats[i].episode;
   }
 
-  // 4. Back to the schedules (gamma 0.96 marks the change): each episode's epsilon and alpha are
-  // the schedules' at the count of episodes before it, not restarted from 0.
+  // 4. Back to the schedules (gamma 0.96 marks the change): the overrides no longer hold.
   LearningConfig back = bad;
   back.epsilon_override = -1.0;
   back.alpha_override = -1.0;
@@ -172,22 +164,12 @@ TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume
   const std::size_t resumed = firstStats(changed, [](const EpisodeStats& s) { return s.gamma == 0.96; });
   ASSERT_LT(resumed, stats.size()) << "no episode with gamma 0.96";
   ASSERT_TRUE(spinUntil([&] { return stats.size() >= resumed + 4; }, 60.0));
-  ScheduleParams epsilon;  // learning/epsilon of config/cartpole.yaml, schedule and min as the launch sets them
-  epsilon.type = ScheduleType::Log;
-  epsilon.start = 1.0;
-  epsilon.min = 0.02;
-  epsilon.log_divisor = 25.0;
-  ScheduleParams alpha;
-  alpha.type = ScheduleType::Log;
-  alpha.start = 1.0;
-  alpha.min = 0.05;
-  alpha.log_divisor = 15.0;
   for (std::size_t i = resumed + 1; i < stats.size(); ++i)
   {
-    const std::uint64_t before = stats[i].episode - 1;
-    EXPECT_DOUBLE_EQ(Schedule(epsilon).value(before), stats[i].epsilon) << "episode " << stats[i].episode;
-    EXPECT_DOUBLE_EQ(Schedule(alpha).value(before), stats[i].alpha) << "episode " << stats[i].episode;
-    EXPECT_GT(stats[i].epsilon, 0.0);
+    // The log schedules (epsilon's floor 0.02, alpha's 0.05) never give exactly the overrides.
+    EXPECT_GE(stats[i].epsilon, 0.02) << "episode " << stats[i].episode;
+    EXPECT_NE(0.2, stats[i].alpha) << "episode " << stats[i].episode;
+    EXPECT_GE(stats[i].alpha, 0.05) << "episode " << stats[i].episode;
   }
 
   // 5. kill -9 and respawn (train.launch): the new process serves and uses the run's live

@@ -1,9 +1,9 @@
 #include "cartpole_qlearning/ros/cartpole_sim.h"
 
 #include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/ros/conversions.h"
 #include "cartpole_qlearning/ros/parameter_source.h"
 
-#include <geometry_msgs/TransformStamped.h>
 #include <rosgraph_msgs/Clock.h>
 
 #include <algorithm>
@@ -101,17 +101,15 @@ bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
 void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const auto it = std::find(msg->name.begin(), msg->name.end(), "cart_joint");
-  const std::size_t index = static_cast<std::size_t>(it - msg->name.begin());
-  if (it == msg->name.end() || msg->effort.size() != msg->name.size())
+  const Reading<double> requested = effortFromCommand(*msg);
+  if (!requested)
   {
     if (bad_command_warning_.ready())
-      ROS_WARN("cartpole_sim: dropped a joint_command without an effort for cart_joint (names: %zu, efforts: %zu)",
-               msg->name.size(), msg->effort.size());
+      ROS_WARN("cartpole_sim: %s", requested.refusal.c_str());
     return;
   }
   double effort = 0.0;
-  if (!acceptEffort(msg->effort[index], effort))
+  if (!acceptEffort(*requested.value, effort))
     return;
   const WallClock::time_point now = WallClock::now();
   if (settings_.mode == SimMode::Realtime)
@@ -252,12 +250,7 @@ void CartPoleSimNode::republishState()
 void CartPoleSimNode::publishState(const ros::Time& stamp)
 {
   const CartPoleState& s = simulation_->state();
-  auto msg = boost::make_shared<sensor_msgs::JointState>();
-  msg->header.stamp = stamp;
-  msg->name = {"cart_joint", "pole_joint"};
-  msg->position = {s[0], s[2]};
-  msg->velocity = {s[1], s[3]};
-  msg->effort = {simulation_->appliedForce(), 0.0};  // the pole joint is not actuated
+  auto msg = boost::make_shared<sensor_msgs::JointState>(jointStateFromState(s, simulation_->appliedForce(), stamp));
   if (settings_.position_noise_std > 0.0)
   {
     msg->position[0] += settings_.position_noise_std * noise_->normal();
@@ -277,21 +270,8 @@ void CartPoleSimNode::publishState(const ros::Time& stamp)
   if (settings_.mode == SimMode::Lockstep && wall_now - last_tf_ < wallDuration(1.0 / settings_.tf_rate))
     return;
   last_tf_ = wall_now;
-  geometry_msgs::TransformStamped cart;
-  cart.header.stamp = stamp;
-  cart.header.frame_id = settings_.world_frame;
-  cart.child_frame_id = settings_.cart_frame;
-  cart.transform.translation.x = s[0];
-  cart.transform.translation.y = settings_.track_y;
-  cart.transform.rotation.w = 1.0;
-  geometry_msgs::TransformStamped pole;
-  pole.header.stamp = stamp;
-  pole.header.frame_id = settings_.cart_frame;
-  pole.child_frame_id = settings_.pole_frame;
-  // theta about +y: positive theta tips the pole's top toward +x.
-  pole.transform.rotation.y = std::sin(s[2] / 2.0);
-  pole.transform.rotation.w = std::cos(s[2] / 2.0);
-  tf_broadcaster_.sendTransform({cart, pole});
+  tf_broadcaster_.sendTransform(transformsFromState(s, settings_.track_y, stamp, settings_.world_frame,
+                                                    settings_.cart_frame, settings_.pole_frame));
 }
 
 }  // namespace cartpole_qlearning

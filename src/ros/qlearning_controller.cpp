@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/ros/qlearning_controller.h"
 
 #include "cartpole_qlearning/Reset.h"
+#include "cartpole_qlearning/ros/conversions.h"
 #include "cartpole_qlearning/ros/launch_control.h"
 #include "cartpole_qlearning/ros/parameter_source.h"
 
@@ -10,7 +11,6 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
-#include <tuple>
 #include <utility>
 
 #include <unistd.h>
@@ -28,79 +28,6 @@ double secondsSince(std::chrono::steady_clock::time_point then)
 std::string prefixed(const Said& said)
 {
   return said.prefixed ? "qlearning_controller: " + said.text : said.text;
-}
-
-// Index of a joint by name, or -1.
-int jointIndex(const sensor_msgs::JointState& msg, const char* name)
-{
-  const auto it = std::find(msg.name.begin(), msg.name.end(), name);
-  return it == msg.name.end() ? -1 : static_cast<int>(it - msg.name.begin());
-}
-
-// Live tuning: the server's fields <-> the core's settings. An override is off when negative.
-LearningConfig toConfig(const LearningSettings& s)
-{
-  LearningConfig c = LearningConfig::__getDefault__();
-  c.epsilon_override = s.epsilon_override.value_or(-1.0);
-  c.alpha_override = s.alpha_override.value_or(-1.0);
-  c.gamma = s.gamma;
-  c.epsilon_schedule = toString(s.epsilon.type);
-  c.epsilon_start = s.epsilon.start;
-  c.epsilon_min = s.epsilon.min;
-  c.epsilon_decay_episodes = s.epsilon.decay_episodes;
-  c.epsilon_decay_rate = s.epsilon.decay_rate;
-  c.epsilon_log_divisor = s.epsilon.log_divisor;
-  c.alpha_schedule = toString(s.alpha.type);
-  c.alpha_start = s.alpha.start;
-  c.alpha_min = s.alpha.min;
-  c.alpha_decay_episodes = s.alpha.decay_episodes;
-  c.alpha_decay_rate = s.alpha.decay_rate;
-  c.alpha_log_divisor = s.alpha.log_divisor;
-  return c;
-}
-
-// Empty when every field could be read (the values themselves are the core's to check); a
-// schedule name the core does not know leaves that schedule's type as it was.
-std::string fromConfig(const LearningConfig& c, LearningSettings& s)
-{
-  const auto rate = [](double value) { return value < 0.0 ? std::nullopt : std::optional<double>(value); };
-  s.epsilon_override = rate(c.epsilon_override);
-  s.alpha_override = rate(c.alpha_override);
-  s.gamma = c.gamma;
-  s.epsilon.start = c.epsilon_start;
-  s.epsilon.min = c.epsilon_min;
-  s.epsilon.decay_episodes = c.epsilon_decay_episodes;
-  s.epsilon.decay_rate = c.epsilon_decay_rate;
-  s.epsilon.log_divisor = c.epsilon_log_divisor;
-  s.alpha.start = c.alpha_start;
-  s.alpha.min = c.alpha_min;
-  s.alpha.decay_episodes = c.alpha_decay_episodes;
-  s.alpha.decay_rate = c.alpha_decay_rate;
-  s.alpha.log_divisor = c.alpha_log_divisor;
-  const std::tuple<const char*, const std::string&, ScheduleType&> types[] = {
-      {"epsilon", c.epsilon_schedule, s.epsilon.type}, {"alpha", c.alpha_schedule, s.alpha.type}};
-  for (const auto& [name, text, type] : types)
-  {
-    try
-    {
-      type = scheduleTypeFromString(text);
-    }
-    catch (const std::invalid_argument& e)
-    {
-      return std::string(name) + "_schedule = '" + text + "' is not allowed (" + e.what() + ")";
-    }
-  }
-  return "";
-}
-
-// The core names a schedule's field as the config file does ("epsilon/min"); the server's field
-// is "epsilon_min".
-std::string asServerField(std::string message)
-{
-  const std::size_t slash = message.find('/');
-  if (slash < message.find(" = "))
-    message[slash] = '_';
-  return message;
 }
 }  // namespace
 
@@ -226,28 +153,14 @@ void QLearningControllerNode::readParameters(bool shutdown_by_default)
 
 bool QLearningControllerNode::extractState(const sensor_msgs::JointState& msg, CartPoleState& state) const
 {
-  const int cart = jointIndex(msg, "cart_joint");
-  const int pole = jointIndex(msg, "pole_joint");
-  if (cart < 0 || pole < 0)
+  const Reading<CartPoleState> reading = stateFromJointState(msg);
+  if (!reading)
   {
     if (bad_state_warning_.ready())
-      ROS_WARN("qlearning_controller: dropped joint_states without %s", cart < 0 ? "cart_joint" : "pole_joint");
+      say(Said::Level::Warn, "%s", reading.refusal.c_str());
     return false;
   }
-  if (msg.position.size() != msg.name.size() || msg.velocity.size() != msg.name.size())
-  {
-    if (bad_state_warning_.ready())
-      ROS_WARN("qlearning_controller: dropped joint_states with %zu names but %zu positions and %zu velocities",
-               msg.name.size(), msg.position.size(), msg.velocity.size());
-    return false;
-  }
-  state = CartPoleState(msg.position[cart], msg.velocity[cart], msg.position[pole], msg.velocity[pole]);
-  if (!state.allFinite())
-  {
-    if (bad_state_warning_.ready())
-      ROS_WARN("qlearning_controller: dropped joint_states with a non-finite position or velocity");
-    return false;
-  }
+  state = *reading.value;
   return true;
 }
 
@@ -259,11 +172,7 @@ std::string QLearningControllerNode::describe(const Robot& robot) const
 void QLearningControllerNode::command(Robot& robot, double effort, const ros::Time& stamp)
 {
   // A new message each time: in a nodelet manager the sim receives this very pointer.
-  auto msg = boost::make_shared<sensor_msgs::JointState>();
-  msg->header.stamp = stamp;
-  msg->name = {"cart_joint"};
-  msg->effort = {effort};
-  robot.command_pub.publish(msg);
+  robot.command_pub.publish(boost::make_shared<sensor_msgs::JointState>(commandMessage(effort, stamp)));
 }
 
 void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::JointStateConstPtr& msg)
@@ -357,30 +266,9 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
     pnh_.setParam("run/folder", *end.run_folder);
   const EpisodeSummary& s = session_->lastEpisode();
 
-  EpisodeStats stats;
-  stats.header.stamp = stamp;
-  stats.robot = robot.name;
-  stats.episode = static_cast<std::uint32_t>(s.episode);
-  stats.steps = s.steps;
-  stats.episode_return = s.episode_return;
-  stats.mean_return_100 = s.mean_return_window;
-  stats.epsilon = s.epsilon;
-  stats.alpha = s.alpha;
-  stats.gamma = s.gamma;
-  stats.terminated = s.terminated;
-  stats.truncated = s.truncated;
-  stats.solved = s.solved;
-  stats.total_steps = s.total_steps;
-  stats.steps_per_second = end.steps_per_second;
-  stats_pub_.publish(stats);
+  stats_pub_.publish(learnerEpisodeStats(s, robot.name, stamp, end.steps_per_second));
   if (robot.stats_pub)
-  {
-    stats.episode = static_cast<std::uint32_t>(s.robot_episode);
-    stats.mean_return_100 = s.robot_mean_return_window;
-    stats.total_steps = s.robot_total_steps;
-    stats.steps_per_second = end.robot_steps_per_second;
-    robot.stats_pub.publish(stats);
-  }
+    robot.stats_pub.publish(robotEpisodeStats(s, robot.name, stamp, end.robot_steps_per_second));
 
   say(end.said);
   if (end.finished)

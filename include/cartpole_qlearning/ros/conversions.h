@@ -1,0 +1,76 @@
+// The ROS layer's message conversions: joint states, joint commands, TF, episode_stats and the
+// live-tuning server's fields, to and from the core's types. Free functions with no node, no
+// master and no logging: a refused message comes back with the text the node logs.
+#pragma once
+
+#include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/LearningConfig.h"
+#include "cartpole_qlearning/cartpole_dynamics.h"
+#include "cartpole_qlearning/learning_settings.h"
+#include "cartpole_qlearning/training_session.h"
+
+#include <geometry_msgs/TransformStamped.h>
+#include <ros/time.h>
+#include <sensor_msgs/JointState.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cartpole_qlearning
+{
+// What a message said, or why it was refused ("dropped joint_states without pole_joint").
+template <typename T>
+struct Reading
+{
+  std::optional<T> value;
+  std::string refusal;  // empty when there is a value
+
+  explicit operator bool() const
+  {
+    return value.has_value();
+  }
+};
+
+// joint_states -> the state (x, x_dot, theta, theta_dot). The joints are found by name, in any
+// order and among any others; positions and velocities must be one per name and finite.
+Reading<CartPoleState> stateFromJointState(const sensor_msgs::JointState& msg,
+                                           const std::string& cart_joint = "cart_joint",
+                                           const std::string& pole_joint = "pole_joint");
+// The state -> joint_states as the sim publishes it: both joints' positions, velocities and
+// efforts (the cart's the force applied in the last step, the pole's 0: it is not actuated).
+sensor_msgs::JointState jointStateFromState(const CartPoleState& state, double applied_effort, const ros::Time& stamp,
+                                            const std::string& cart_joint = "cart_joint",
+                                            const std::string& pole_joint = "pole_joint");
+
+// The controller's joint_command: the cart's effort [N], stamped with the state it answers.
+sensor_msgs::JointState commandMessage(double effort, const ros::Time& stamp,
+                                       const std::string& cart_joint = "cart_joint");
+// joint_command -> the effort of the cart joint (as sent: the sim checks and clamps it).
+Reading<double> effortFromCommand(const sensor_msgs::JointState& msg, const std::string& cart_joint = "cart_joint");
+
+// TF world -> cart (x along the track, which lies at y = track_y) -> pole (theta about +y).
+std::vector<geometry_msgs::TransformStamped> transformsFromState(const CartPoleState& state, double track_y,
+                                                                 const ros::Time& stamp, const std::string& world_frame,
+                                                                 const std::string& cart_frame,
+                                                                 const std::string& pole_frame);
+
+// episode_stats at an episode's end. On the learner's topic: episode, mean return and total
+// steps over all robots; on a robot's own topic: that robot's. steps_per_second is the caller's.
+EpisodeStats learnerEpisodeStats(const EpisodeSummary& summary, const std::string& robot, const ros::Time& stamp,
+                                 double steps_per_second);
+EpisodeStats robotEpisodeStats(const EpisodeSummary& summary, const std::string& robot, const ros::Time& stamp,
+                               double steps_per_second);
+
+// Live tuning: the server's fields <-> the core's settings. An override is off when negative
+// (the server shows it as -1).
+LearningConfig toConfig(const LearningSettings& settings);
+// Empty when every field could be read (the values themselves are the core's to check); a
+// schedule name the core does not know leaves that schedule's type as it was and is refused
+// with the server's field name ("alpha_schedule = 'cosine' is not allowed (...)").
+std::string fromConfig(const LearningConfig& config, LearningSettings& settings);
+// The core names a schedule's field as the config file does ("epsilon/min = ..."); the server's
+// field is "epsilon_min".
+std::string asServerField(std::string message);
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,184 @@
+#include "cartpole_qlearning/ros/conversions.h"
+
+#include "cartpole_qlearning/schedule.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <tuple>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+// Index of a joint by name, or -1.
+int jointIndex(const sensor_msgs::JointState& msg, const std::string& name)
+{
+  const auto it = std::find(msg.name.begin(), msg.name.end(), name);
+  return it == msg.name.end() ? -1 : static_cast<int>(it - msg.name.begin());
+}
+}  // namespace
+
+Reading<CartPoleState> stateFromJointState(const sensor_msgs::JointState& msg, const std::string& cart_joint,
+                                           const std::string& pole_joint)
+{
+  const int cart = jointIndex(msg, cart_joint);
+  const int pole = jointIndex(msg, pole_joint);
+  if (cart < 0 || pole < 0)
+    return {std::nullopt, "dropped joint_states without " + (cart < 0 ? cart_joint : pole_joint)};
+  if (msg.position.size() != msg.name.size() || msg.velocity.size() != msg.name.size())
+    return {std::nullopt, "dropped joint_states with " + std::to_string(msg.name.size()) + " names but " +
+                              std::to_string(msg.position.size()) + " positions and " +
+                              std::to_string(msg.velocity.size()) + " velocities"};
+  const CartPoleState state(msg.position[cart], msg.velocity[cart], msg.position[pole], msg.velocity[pole]);
+  if (!state.allFinite())
+    return {std::nullopt, "dropped joint_states with a non-finite position or velocity"};
+  return {state, ""};
+}
+
+sensor_msgs::JointState jointStateFromState(const CartPoleState& state, double applied_effort, const ros::Time& stamp,
+                                            const std::string& cart_joint, const std::string& pole_joint)
+{
+  sensor_msgs::JointState msg;
+  msg.header.stamp = stamp;
+  msg.name = {cart_joint, pole_joint};
+  msg.position = {state[0], state[2]};
+  msg.velocity = {state[1], state[3]};
+  msg.effort = {applied_effort, 0.0};
+  return msg;
+}
+
+sensor_msgs::JointState commandMessage(double effort, const ros::Time& stamp, const std::string& cart_joint)
+{
+  sensor_msgs::JointState msg;
+  msg.header.stamp = stamp;
+  msg.name = {cart_joint};
+  msg.effort = {effort};
+  return msg;
+}
+
+Reading<double> effortFromCommand(const sensor_msgs::JointState& msg, const std::string& cart_joint)
+{
+  const int index = jointIndex(msg, cart_joint);
+  if (index < 0 || msg.effort.size() != msg.name.size())
+    return {std::nullopt, "dropped a joint_command without an effort for " + cart_joint +
+                              " (names: " + std::to_string(msg.name.size()) +
+                              ", efforts: " + std::to_string(msg.effort.size()) + ")"};
+  return {msg.effort[index], ""};
+}
+
+std::vector<geometry_msgs::TransformStamped> transformsFromState(const CartPoleState& state, double track_y,
+                                                                 const ros::Time& stamp, const std::string& world_frame,
+                                                                 const std::string& cart_frame,
+                                                                 const std::string& pole_frame)
+{
+  geometry_msgs::TransformStamped cart;
+  cart.header.stamp = stamp;
+  cart.header.frame_id = world_frame;
+  cart.child_frame_id = cart_frame;
+  cart.transform.translation.x = state[0];
+  cart.transform.translation.y = track_y;
+  cart.transform.rotation.w = 1.0;
+  geometry_msgs::TransformStamped pole;
+  pole.header.stamp = stamp;
+  pole.header.frame_id = cart_frame;
+  pole.child_frame_id = pole_frame;
+  // theta about +y: positive theta tips the pole's top toward +x.
+  pole.transform.rotation.y = std::sin(state[2] / 2.0);
+  pole.transform.rotation.w = std::cos(state[2] / 2.0);
+  return {cart, pole};
+}
+
+EpisodeStats learnerEpisodeStats(const EpisodeSummary& s, const std::string& robot, const ros::Time& stamp,
+                                 double steps_per_second)
+{
+  EpisodeStats stats;
+  stats.header.stamp = stamp;
+  stats.robot = robot;
+  stats.episode = static_cast<std::uint32_t>(s.episode);
+  stats.steps = s.steps;
+  stats.episode_return = s.episode_return;
+  stats.mean_return_100 = s.mean_return_window;
+  stats.epsilon = s.epsilon;
+  stats.alpha = s.alpha;
+  stats.gamma = s.gamma;
+  stats.terminated = s.terminated;
+  stats.truncated = s.truncated;
+  stats.solved = s.solved;
+  stats.total_steps = s.total_steps;
+  stats.steps_per_second = steps_per_second;
+  return stats;
+}
+
+EpisodeStats robotEpisodeStats(const EpisodeSummary& s, const std::string& robot, const ros::Time& stamp,
+                               double steps_per_second)
+{
+  EpisodeStats stats = learnerEpisodeStats(s, robot, stamp, steps_per_second);
+  stats.episode = static_cast<std::uint32_t>(s.robot_episode);
+  stats.mean_return_100 = s.robot_mean_return_window;
+  stats.total_steps = s.robot_total_steps;
+  return stats;
+}
+
+LearningConfig toConfig(const LearningSettings& s)
+{
+  LearningConfig c = LearningConfig::__getDefault__();
+  c.epsilon_override = s.epsilon_override.value_or(-1.0);
+  c.alpha_override = s.alpha_override.value_or(-1.0);
+  c.gamma = s.gamma;
+  c.epsilon_schedule = toString(s.epsilon.type);
+  c.epsilon_start = s.epsilon.start;
+  c.epsilon_min = s.epsilon.min;
+  c.epsilon_decay_episodes = s.epsilon.decay_episodes;
+  c.epsilon_decay_rate = s.epsilon.decay_rate;
+  c.epsilon_log_divisor = s.epsilon.log_divisor;
+  c.alpha_schedule = toString(s.alpha.type);
+  c.alpha_start = s.alpha.start;
+  c.alpha_min = s.alpha.min;
+  c.alpha_decay_episodes = s.alpha.decay_episodes;
+  c.alpha_decay_rate = s.alpha.decay_rate;
+  c.alpha_log_divisor = s.alpha.log_divisor;
+  return c;
+}
+
+std::string fromConfig(const LearningConfig& c, LearningSettings& s)
+{
+  const auto rate = [](double value) { return value < 0.0 ? std::nullopt : std::optional<double>(value); };
+  s.epsilon_override = rate(c.epsilon_override);
+  s.alpha_override = rate(c.alpha_override);
+  s.gamma = c.gamma;
+  s.epsilon.start = c.epsilon_start;
+  s.epsilon.min = c.epsilon_min;
+  s.epsilon.decay_episodes = c.epsilon_decay_episodes;
+  s.epsilon.decay_rate = c.epsilon_decay_rate;
+  s.epsilon.log_divisor = c.epsilon_log_divisor;
+  s.alpha.start = c.alpha_start;
+  s.alpha.min = c.alpha_min;
+  s.alpha.decay_episodes = c.alpha_decay_episodes;
+  s.alpha.decay_rate = c.alpha_decay_rate;
+  s.alpha.log_divisor = c.alpha_log_divisor;
+  const std::tuple<const char*, const std::string&, ScheduleType&> types[] = {
+      {"epsilon", c.epsilon_schedule, s.epsilon.type}, {"alpha", c.alpha_schedule, s.alpha.type}};
+  for (const auto& [name, text, type] : types)
+  {
+    try
+    {
+      type = scheduleTypeFromString(text);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      return std::string(name) + "_schedule = '" + text + "' is not allowed (" + e.what() + ")";
+    }
+  }
+  return "";
+}
+
+std::string asServerField(std::string message)
+{
+  const std::size_t slash = message.find('/');
+  if (slash < message.find(" = "))
+    message[slash] = '_';
+  return message;
+}
+
+}  // namespace cartpole_qlearning
