@@ -38,6 +38,9 @@ struct Said
   };
   Level level = Level::Info;
   std::string text;
+  // false: said as it is, with no prefix (the progress lines and the trace: the same lines
+  // train_headless prints).
+  bool prefixed = true;
 };
 using Saying = std::vector<Said>;
 
@@ -58,9 +61,9 @@ struct RunClocks
 // the parameter server as ~run/id, ~run/launcher, ~run/folder).
 struct RunIdentity
 {
-  std::string id;        // ~run_id ("": runs are not resumed)
-  int launcher = 0;      // the roslaunch (else the parent) process that started the run
-  std::string folder;    // relative to the table folder
+  std::string id;      // ~run_id ("": runs are not resumed)
+  int launcher = 0;    // the roslaunch (else the parent) process that started the run
+  std::string folder;  // relative to the table folder
 };
 
 // The greedy evaluation's outcome so far.
@@ -79,8 +82,9 @@ struct EpisodeEnd
   // robot), and this robot's since its own previous end.
   double steps_per_second = 0.0;
   double robot_steps_per_second = 0.0;
-  // Training reached its limits (and its table is saved) or the evaluation has its verdict:
-  // serve no more states; end the launch when asked to.
+  // Training reached its limits and its table is saved, or the evaluation has its verdict: end
+  // the launch when asked to. (When the final save failed this stays false while finished()
+  // turns true: no more states are served, and the node stays up for ~save_q_table.)
   bool finished = false;
   // The run's folder was made or renamed now: the node stores it (~run/folder) for a respawn.
   std::optional<std::string> run_folder;
@@ -92,6 +96,18 @@ struct ServiceAnswer
   bool success = false;
   std::string message;
   Saying said;
+};
+
+// A setting the run cannot work with (a ~stats_csv that cannot be written): a ConfigError that
+// keeps the parameter's name (without "~"), its value and why, so that the node names the
+// parameter as it names its others. what(): "~NAME = VALUE is not allowed (WHY)".
+class RunSettingError : public ConfigError
+{
+public:
+  RunSettingError(const std::string& name, const std::string& value, const std::string& why);
+  std::string name;
+  std::string value;
+  std::string why;
 };
 
 class RunApplication

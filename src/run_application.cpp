@@ -1,0 +1,631 @@
+#include "cartpole_qlearning/run_application.h"
+
+#include "cartpole_qlearning/file_access.h"
+#include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/trace.h"
+
+#include <cstdarg>
+#include <cstdio>
+#include <map>
+#include <utility>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+__attribute__((format(printf, 1, 2))) std::string format(const char* pattern, ...)
+{
+  std::va_list args;
+  va_start(args, pattern);
+  std::va_list again;
+  va_copy(again, args);
+  const int size = std::vsnprintf(nullptr, 0, pattern, args);
+  va_end(args);
+  std::string text(size > 0 ? static_cast<std::size_t>(size) : 0, '\0');
+  if (size > 0)
+    std::vsnprintf(text.data(), text.size() + 1, pattern, again);
+  va_end(again);
+  return text;
+}
+
+unsigned long long count(std::uint64_t value)
+{
+  return static_cast<unsigned long long>(value);
+}
+
+void say(Saying& said, Said::Level level, std::string text)
+{
+  said.push_back({level, std::move(text)});
+}
+
+double seconds(std::chrono::steady_clock::duration duration)
+{
+  return std::chrono::duration<double>(duration).count();
+}
+}  // namespace
+
+RunSettingError::RunSettingError(const std::string& name_, const std::string& value_, const std::string& why_)
+  : ConfigError("~" + name_ + " = " + value_ + " is not allowed (" + why_ + ")"), name(name_), value(value_), why(why_)
+{
+}
+
+struct RunApplication::State
+{
+  State(RunSettings settings_, const TrainingConfig& config_, TrainingSession& session_, RunClocks clocks_)
+    : settings(std::move(settings_)), config(config_), session(session_), clocks(std::move(clocks_))
+  {
+    if (settings.trace && settings.learning)
+      state_names = stateNames(config.agent);
+  }
+
+  // Writing the user's choices at each moment of a run.
+  bool writesAlong() const
+  {
+    return settings.checkpoint_every > 0 || settings.save_on_shutdown;
+  }
+  std::string resolve(const std::string& path) const
+  {
+    return resolvePathUnder(settings.q_table_dir, path.empty() ? settings.q_table_path : path);
+  }
+
+  std::string install(QTable table);
+  bool save(const std::string& path, std::string& message);
+  bool checkpoint(const std::string& finished_as, std::string& message);
+  void loadOnStart(Saying& said);
+  void openStatsFile();
+  void openRun(const RunIdentity& previous, Saying& said);
+  // respawn: a respawned controller (else train_headless --resume, which must find a checkpoint).
+  void resumeRun(bool respawn, Saying& said);
+  void startStatsCsv(Saying& said);
+  void writeStatsRow(const std::string& robot, const EpisodeSummary& summary, Saying& said);
+  void startClocks();
+
+  RunSettings settings;
+  TrainingConfig config;
+  TrainingSession& session;
+  RunClocks clocks;
+  std::vector<std::string> state_names;  // as the trace names the rows
+
+  int launcher = 0;
+  RunRecord run;
+  std::string run_folder;  // relative to the table folder ("" when evaluating)
+  bool respawned = false;  // going on with the run of a controller that died
+  bool finished = false;
+  bool final_saved = false;  // training ended and its table is saved (else a shutdown saves it)
+  bool shut_down = false;
+
+  std::unique_ptr<AppendingFile> stats_file;  // opened, its curve not started yet
+  std::unique_ptr<EpisodeCsvWriter> csv;
+  bool csv_pending = false;  // the run's own file, opened at the first episode's end
+  bool folder_made_late = false;
+
+  std::uint64_t balanced = 0;
+
+  std::chrono::steady_clock::time_point started;
+  std::chrono::steady_clock::time_point last_episode_end;
+  std::chrono::steady_clock::time_point last_progress;
+  std::map<std::string, std::chrono::steady_clock::time_point> robot_last_end;
+  std::uint64_t steps_at_last_episode = 0;
+  std::uint64_t steps_at_last_progress = 0;
+};
+
+std::string RunApplication::State::install(QTable table)
+{
+  // Training goes on with the table's own counts: episode numbers, steps, the schedules and
+  // max_episodes all count from them, so the progress lines and the saves agree. (The solved
+  // window starts empty.) Evaluation counts its own episodes from 1.
+  const std::string mismatch =
+      settings.learning ? session.resume(std::move(table), {}) : session.replaceTable(std::move(table));
+  // Steps per second count from here.
+  steps_at_last_episode = steps_at_last_progress = session.lastEpisode().total_steps;
+  return mismatch;
+}
+
+bool RunApplication::State::save(const std::string& path, std::string& message)
+{
+  try
+  {
+    const std::string resolved = resolve(path);
+    saveQTableUnder(session.table(), settings.q_table_dir, path.empty() ? settings.q_table_path : path);
+    message = "saved " + std::to_string(session.table().episodes) + " episodes, " +
+              std::to_string(session.table().steps) + " steps of training to " + resolved;
+    return true;
+  }
+  catch (const std::exception& e)  // QTableFileError, or anything else: never out of a service
+  {
+    message = std::string("nothing written: ") + e.what();
+    return false;
+  }
+}
+
+bool RunApplication::State::checkpoint(const std::string& finished_as, std::string& message)
+{
+  if (!save(run_folder + "/" + kRunTableFile, message))
+    return false;
+  run.episodes = session.table().episodes;
+  run.steps = session.table().steps;
+  run.recent_returns = session.recentReturns();
+  run.finished = finished_as;
+  try
+  {
+    writeFileUnder(settings.q_table_dir, run_folder + "/" + kRunRecordFile, formatRunRecord(run));
+  }
+  catch (const std::exception& e)
+  {
+    message +=
+        ", but not its run record (a restart would go on from the previous checkpoint): " + std::string(e.what());
+    return false;
+  }
+  return true;
+}
+
+void RunApplication::State::loadOnStart(Saying& said)
+{
+  if (settings.load_on_start.empty())
+  {
+    if (!settings.learning)
+      say(said, Said::Level::Warn, "evaluating a table of zeros (set ~load_on_start to a trained table)");
+    return;
+  }
+  std::string path;
+  try
+  {
+    path = resolve(settings.load_on_start);
+    const std::string mismatch = install(loadQTableUnder(settings.q_table_dir, settings.load_on_start));
+    if (!mismatch.empty())
+      throw QTableFileError(path + " does not fit this controller: " + mismatch);
+  }
+  catch (const QTableFileError& e)
+  {
+    throw ConfigError("cannot start from the table '" + settings.load_on_start +
+                      "' (~load_on_start, which the launch files' q_table or load argument sets): " + e.what());
+  }
+  say(said, Said::Level::Info,
+      format("loaded %s (%llu episodes, %llu steps of training)", path.c_str(), count(session.table().episodes),
+             count(session.table().steps)));
+}
+
+void RunApplication::State::openStatsFile()
+{
+  const std::string& name = settings.stats_csv;
+  if (name == "none" || name.empty())
+    return;
+  try
+  {
+    stats_file = std::make_unique<AppendingFile>(
+        name.front() == '/' ? AppendingFile::open(name) : AppendingFile::openUnder(settings.q_table_dir, name));
+  }
+  catch (const FileError& e)
+  {
+    throw RunSettingError("stats_csv", "'" + name + "'", e.what());
+  }
+}
+
+void RunApplication::State::openRun(const RunIdentity& previous, Saying& said)
+{
+  run.run_id = settings.run_id;
+  run.name_space = settings.name_space;
+  run.seed = settings.seed;
+  // A respawn has the run id and the launcher of the process that started the run; a node
+  // started by hand on a reused master has at most the id left there.
+  if (!settings.run_id.empty() && previous.id == settings.run_id && previous.launcher == launcher &&
+      !previous.folder.empty())
+  {
+    run_folder = previous.folder;
+    resumeRun(true, said);
+    return;
+  }
+  const std::time_t now = clocks.calendar();
+  run.started = localTimeText(now);
+  const std::string name = runFolderName(now, settings.name_space, settings.seed);
+  // Made now, so that a folder that cannot be written is said at the start, not at the first
+  // checkpoint; a name taken (another run started in the same second) gets a suffix. A run told
+  // to write nothing along the way (no checkpoints, no save on shutdown) writes nothing yet.
+  run_folder = name;
+  try
+  {
+    for (int n = 2; writesAlong() && !makeDirectoryUnder(settings.q_table_dir, run_folder); ++n)
+      run_folder = name + "_" + std::to_string(n);
+    if (writesAlong())
+      writeFileUnder(settings.q_table_dir, run_folder + "/" + kRunRecordFile, formatRunRecord(run));
+  }
+  catch (const FileError& e)
+  {
+    say(said, Said::Level::Error,
+        format("cannot make this run's folder (%s): checkpoints will fail; ~save_q_table can still save the table "
+               "elsewhere",
+               e.what()));
+  }
+  say(said, Said::Level::Info,
+      format("run %s: checkpoints go to %s", run_folder.c_str(), resolve(run_folder + "/" + kRunTableFile).c_str()));
+}
+
+void RunApplication::State::resumeRun(bool respawn, Saying& said)
+{
+  respawned = true;
+  const char* restarted = respawn ? "restarted; " : "";
+  const std::string table_path = run_folder + "/" + kRunTableFile;
+  RunRecord record;
+  QTable table;
+  try
+  {
+    record = parseRunRecord(readFileUnder(settings.q_table_dir, run_folder + "/" + kRunRecordFile, 1 << 20));
+    table = loadQTableUnder(settings.q_table_dir, table_path);
+  }
+  catch (const FileError& e)
+  {
+    if (!respawn)
+      throw ConfigError("run " + run_folder + " has no checkpoint to go on from: " + e.what());
+    // Killed before its first checkpoint (or the checkpoint is unusable): the run starts over.
+    run.started = localTimeText(clocks.calendar());
+    say(said, Said::Level::Warn,
+        format("restarted; run %s has no checkpoint to go on from (%s): starting it over", run_folder.c_str(),
+               e.what()));
+    return;
+  }
+  // A crash between the table's save and the record's leaves the record one checkpoint behind:
+  // the table wins, and the solved window starts empty.
+  const bool record_matches = record.episodes == table.episodes && record.steps == table.steps;
+  const std::string mismatch =
+      session.resume(std::move(table), record_matches ? record.recent_returns : std::vector<double>());
+  if (!mismatch.empty())
+    throw ConfigError(std::string(respawn ? "restarted, but the checkpoint " : "the checkpoint ") +
+                      resolve(table_path) + " does not fit this controller's configuration: " + mismatch);
+  run = record;
+  const EpisodeSummary& s = session.lastEpisode();
+  steps_at_last_episode = steps_at_last_progress = s.total_steps;
+  say(said, Said::Level::Warn,
+      format("%srun %s goes on from its checkpoint: episode %llu, %llu steps%s", restarted, run_folder.c_str(),
+             count(s.episode), count(s.total_steps),
+             record_matches ? "" : " (its record was one checkpoint behind: the solved window starts empty)"));
+  if (!record.finished.empty())
+  {
+    // Ended (or killed) after its final save: nothing to train. A controller stays up rather
+    // than exit, which under respawn would only start it again.
+    finished = final_saved = true;
+    say(said, Said::Level::Info,
+        format("run %s has finished already (%s); nothing left to do", run_folder.c_str(), record.finished.c_str()));
+  }
+}
+
+void RunApplication::State::startStatsCsv(Saying& said)
+{
+  const std::string& name = settings.stats_csv;
+  if (name == "none" || (name.empty() && !settings.learning))
+    return;
+  if (!stats_file)
+  {
+    // The run's own file: beside its checkpoints, made with its folder. A run told to write
+    // nothing along the way (no checkpoints, no save on shutdown) makes that folder only when
+    // there is something to write: here, at the first episode's end.
+    if (!writesAlong() && !respawned && !csv_pending)
+    {
+      csv_pending = true;
+      return;
+    }
+    try
+    {
+      if (csv_pending)
+      {
+        // Its folder is made now, under a name no other run has taken (as openRun does).
+        const std::string base = run_folder;
+        for (int n = 2; !makeDirectoryUnder(settings.q_table_dir, run_folder); ++n)
+          run_folder = base + "_" + std::to_string(n);
+        folder_made_late = true;
+      }
+      csv_pending = false;
+      stats_file = std::make_unique<AppendingFile>(
+          AppendingFile::openUnder(settings.q_table_dir, run_folder + "/" + kRunEpisodesFile));
+    }
+    catch (const FileError& e)
+    {
+      csv_pending = false;
+      say(said, Said::Level::Error,
+          std::string("no learning curve for this run (~stats_csv none silences this): ") + e.what());
+      return;
+    }
+  }
+  try
+  {
+    // A respawn goes on with its run's curve from the checkpoint it resumed (a run that starts
+    // over keeps the header alone); anything else starts the curve afresh.
+    csv = respawned ? std::make_unique<EpisodeCsvWriter>(std::move(*stats_file), session.episodesEnded())
+                    : std::make_unique<EpisodeCsvWriter>(std::move(*stats_file));
+  }
+  catch (const FileError& e)
+  {
+    stats_file.reset();
+    if (!name.empty())
+      throw RunSettingError("stats_csv", "'" + name + "'", e.what());
+    say(said, Said::Level::Error,
+        std::string("no learning curve for this run (~stats_csv none silences this): ") + e.what());
+    return;
+  }
+  stats_file.reset();
+  say(said, Said::Level::Info,
+      "one row per episode goes to " + csv->path() + " (rosrun cartpole_qlearning plot_learning_curve --follow " +
+          csv->path() + ")");
+}
+
+void RunApplication::State::writeStatsRow(const std::string& robot, const EpisodeSummary& summary, Saying& said)
+{
+  if (csv_pending)
+    startStatsCsv(said);
+  if (!csv)
+    return;
+  try
+  {
+    csv->write(summary, robot, clocks.unix_seconds());
+  }
+  catch (const FileError& e)
+  {
+    say(said, Said::Level::Error, std::string("the learning curve stops here: ") + e.what());
+    csv.reset();
+  }
+}
+
+void RunApplication::State::startClocks()
+{
+  started = last_episode_end = last_progress = clocks.steady();
+}
+
+RunApplication::RunApplication(RunSettings settings, const TrainingConfig& config, TrainingSession& session,
+                               RunClocks clocks)
+  : state_(std::make_unique<State>(std::move(settings), config, session, std::move(clocks)))
+{
+}
+
+RunApplication::~RunApplication() = default;
+
+Saying RunApplication::start(const RunIdentity& previous, int launcher)
+{
+  State& s = *state_;
+  Saying said;
+  s.launcher = launcher;
+  s.loadOnStart(said);
+  s.openStatsFile();
+  if (s.settings.learning)
+    s.openRun(previous, said);
+  s.startStatsCsv(said);
+  s.startClocks();
+  return said;
+}
+
+Saying RunApplication::resume(const std::string& folder)
+{
+  State& s = *state_;
+  if (!s.settings.learning)
+    throw ConfigError("a run is resumed to train it further, not to evaluate it");
+  Saying said;
+  try
+  {
+    s.run_folder = relativePathUnder(s.settings.q_table_dir, folder);
+  }
+  catch (const FileError& e)
+  {
+    throw ConfigError("cannot resume the run '" + folder + "': " + e.what());
+  }
+  s.openStatsFile();
+  s.resumeRun(false, said);
+  s.startStatsCsv(said);
+  s.startClocks();
+  return said;
+}
+
+EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_finished)
+{
+  State& st = *state_;
+  EpisodeEnd end;
+  const EpisodeSummary& s = st.session.lastEpisode();
+  // Before any checkpoint: a row is never missing from a run that a respawn resumes from there.
+  st.writeStatsRow(robot, s, end.said);
+  if (st.folder_made_late)
+  {
+    st.folder_made_late = false;
+    end.run_folder = st.run_folder;
+  }
+  const auto now = st.clocks.steady();
+  const auto robot_end = st.robot_last_end.emplace(robot, st.started).first;
+  const double wall = seconds(now - st.last_episode_end);
+  const double robot_wall = seconds(now - robot_end->second);
+  st.last_episode_end = robot_end->second = now;
+  end.steps_per_second = wall > 0.0 ? static_cast<double>(s.total_steps - st.steps_at_last_episode) / wall : 0.0;
+  end.robot_steps_per_second = robot_wall > 0.0 ? s.steps / robot_wall : 0.0;
+  st.steps_at_last_episode = s.total_steps;
+
+  // When training ends here, the table is saved before the caller says so: whoever acts on the
+  // last episode_stats finds the final file. Into the run's folder; a solved run also replaces
+  // the default table (the one evaluate.launch loads), an unsolved one leaves it as it was.
+  std::string saved;
+  bool saved_ok = true;
+  if (training_finished)
+  {
+    // The default table first: a crash between the two saves then leaves a run not yet marked
+    // finished, which a respawn finishes again.
+    std::string published;
+    const bool published_ok = s.solved && st.save("", published);
+    saved_ok = st.checkpoint(s.solved ? "solved" : "max_episodes", saved);
+    st.final_saved = saved_ok || published_ok;
+    if (s.solved)
+      saved += published_ok ? "; the default table: " + published : "; BUT NOT the default table: " + published;
+    else
+      saved += "; the default table " + st.resolve("") +
+               " is left as it was (this run did not solve: ~save_q_table saves it there if you want it)";
+  }
+
+  if (st.settings.trace && st.settings.learning)
+  {
+    const std::string which = st.session.robots() > 1 ? robot + "'s episode " + std::to_string(s.robot_episode) + " (" +
+                                                            std::to_string(s.episode) + " in all)"
+                                                      : "episode " + std::to_string(s.episode);
+    end.said.push_back(
+        {Said::Level::Info, "Q-table after " + which + ":\n" + qTableText(st.session.table(), st.state_names), false});
+  }
+
+  const TrainingLimits& limits = st.config.limits;
+  if (limits.progress_every > 0 && s.episode % limits.progress_every == 0)
+  {
+    const double interval = seconds(now - st.last_progress);
+    const double rate =
+        interval > 0.0 ? static_cast<double>(s.total_steps - st.steps_at_last_progress) / interval : 0.0;
+    end.said.push_back(
+        {Said::Level::Info, progressLine(s, st.config.task.solved_window, rate, seconds(now - st.started)), false});
+    st.steps_at_last_progress = s.total_steps;
+    st.last_progress = now;
+  }
+
+  if (!st.settings.learning)
+  {
+    // Evaluation: every episode said, and after evaluation_episodes a one-line verdict.
+    st.balanced += s.truncated && !s.terminated;
+    say(end.said, Said::Level::Info,
+        format("evaluation episode %llu: %u steps, return %.1f, %s", count(s.episode), s.steps, s.episode_return,
+               s.terminated ? "fell" : "balanced to the step limit"));
+    if (st.settings.evaluation_episodes == 0 || s.episode < st.settings.evaluation_episodes)
+      return end;
+    say(end.said, Said::Level::Info,
+        format("EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f",
+               count(s.episode), count(st.balanced), st.config.task.max_episode_steps, s.mean_return_window));
+    st.finished = end.finished = true;
+    return end;
+  }
+  if (training_finished)
+  {
+    st.finished = true;
+    if (!saved_ok)
+    {
+      // Keep the trained table alive: the user can still save it elsewhere with ~save_q_table.
+      say(end.said, Said::Level::Error,
+          format("training ended (%s, episode %llu) but the table could not be saved: %s. The node keeps running: "
+                 "call ~save_q_table with another path",
+                 s.solved ? "solved" : "max_episodes", count(s.episode), saved.c_str()));
+      return end;
+    }
+    say(end.said, Said::Level::Info,
+        format("%s after %llu episodes, %llu steps, %.1f s (mean return of the last %u: %.2f); %s",
+               s.solved ? "SOLVED" : "NOT solved, max_episodes reached", count(s.episode), count(s.total_steps),
+               seconds(now - st.started), st.config.task.solved_window, s.mean_return_window, saved.c_str()));
+    end.finished = true;
+    return end;
+  }
+  if (st.settings.checkpoint_every > 0 && s.episode % st.settings.checkpoint_every == 0)
+  {
+    std::string message;
+    if (st.checkpoint("", message))
+      say(end.said, Said::Level::Info, "checkpoint: " + message);
+    else
+      say(end.said, Said::Level::Warn, "checkpoint failed: " + message);
+  }
+  return end;
+}
+
+ServiceAnswer RunApplication::save(const std::string& path)
+{
+  ServiceAnswer answer;
+  answer.success = state_->save(path, answer.message);
+  say(answer.said, answer.success ? Said::Level::Info : Said::Level::Warn, "save_q_table: " + answer.message);
+  return answer;
+}
+
+ServiceAnswer RunApplication::load(const std::string& path)
+{
+  State& s = *state_;
+  ServiceAnswer answer;
+  try
+  {
+    const std::string resolved = s.resolve(path);
+    QTable table = loadQTableUnder(s.settings.q_table_dir, path.empty() ? s.settings.q_table_path : path);
+    const std::uint64_t episodes = table.episodes;
+    const std::uint64_t steps = table.steps;
+    const std::string mismatch = s.install(std::move(table));
+    if (!mismatch.empty())
+      throw QTableFileError(resolved + " does not fit this controller: " + mismatch);
+    answer.success = true;
+    answer.message = "loaded " + resolved + " (" + std::to_string(episodes) + " episodes, " + std::to_string(steps) +
+                     " steps of training)";
+    say(answer.said, Said::Level::Info, "load_q_table: " + answer.message);
+    if (s.settings.learning && s.csv)
+    {
+      // Training goes on from the loaded table's episode count; the curve follows it.
+      try
+      {
+        s.csv->startOver();
+        say(answer.said, Said::Level::Info,
+            format("the learning curve %s starts over from the loaded table's episode %llu", s.csv->path().c_str(),
+                   count(episodes)));
+      }
+      catch (const FileError& e)
+      {
+        say(answer.said, Said::Level::Warn, std::string(e.what()) + "; the learning curve stops here");
+        s.csv.reset();
+      }
+    }
+  }
+  catch (const std::exception& e)  // QTableFileError, or anything else: never out of a service
+  {
+    answer.success = false;
+    answer.message = std::string("refused, the table in use is unchanged: ") + e.what();
+    answer.said.clear();
+    say(answer.said, Said::Level::Warn, "load_q_table: " + answer.message);
+  }
+  return answer;
+}
+
+Saying RunApplication::shutdown()
+{
+  State& s = *state_;
+  Saying said;
+  if (s.shut_down || !s.settings.learning || !s.settings.save_on_shutdown || s.final_saved)
+    return said;
+  s.shut_down = true;
+  std::string message;
+  const bool ok = s.checkpoint("", message);
+  say(said, ok ? Said::Level::Info : Said::Level::Error,
+      "on shutdown: " + message + " (the default table is left as it was)");
+  return said;
+}
+
+RunIdentity RunApplication::identity() const
+{
+  if (!state_->settings.learning || state_->settings.run_id.empty())
+    return {};
+  return {state_->settings.run_id, state_->launcher, state_->run_folder};
+}
+
+bool RunApplication::respawned() const
+{
+  return state_->respawned;
+}
+
+bool RunApplication::finished() const
+{
+  return state_->finished;
+}
+
+EvaluationVerdict RunApplication::verdict() const
+{
+  EvaluationVerdict verdict;
+  if (state_->settings.learning)
+    return verdict;
+  verdict.episodes = state_->session.episodesEnded();
+  verdict.balanced = state_->balanced;
+  verdict.mean_return = verdict.episodes > 0 ? state_->session.lastEpisode().mean_return_window : 0.0;
+  return verdict;
+}
+
+std::string RunApplication::resolve(const std::string& path) const
+{
+  return state_->resolve(path);
+}
+
+const std::string& RunApplication::tableDirectory() const
+{
+  return state_->settings.q_table_dir;
+}
+
+const std::string& RunApplication::runFolder() const
+{
+  return state_->run_folder;
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,732 @@
+// The application around the learner: a run's folder and record, checkpoints and their cadence,
+// the resume of a respawned controller, the learning curve's file, which save replaces the
+// default table, the save on shutdown, the evaluation verdict, progress lines and rates, and
+// the services' paths. Clocks are injected; tables go to a temporary folder.
+#include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/run_application.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+using namespace cartpole_qlearning;
+namespace fs = std::filesystem;
+
+namespace
+{
+constexpr std::time_t kStartTime = 1790000000;  // the injected calendar: every run starts then
+constexpr int kLauncher = 4242;
+
+class RunApplicationTest : public ::testing::Test
+{
+protected:
+  void SetUp() override
+  {
+    dir_ = fs::temp_directory_path() / ("run_application_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    settings_.q_table_dir = dir_.string();
+    settings_.run_id = "run_host_1_2";
+    // Episodes of 5 steps; solved when the last 2 episodes balanced (return 5 each).
+    config_.task.max_episode_steps = 5;
+    config_.task.solved_mean_return = 5.0;
+    config_.task.solved_window = 2;
+    config_.limits.progress_every = 0;
+    clocks_.steady = [this] { return now_; };
+    clocks_.unix_seconds = [] { return 1000.25; };
+    clocks_.calendar = [] { return kStartTime; };
+  }
+  void TearDown() override
+  {
+    fs::remove_all(dir_);
+  }
+
+  // A session and its application, as a controller (or a respawn of it) makes them.
+  struct Run
+  {
+    std::unique_ptr<TrainingSession> session;
+    std::unique_ptr<RunApplication> app;
+    Saying started;
+  };
+  Run startRun(const RunIdentity& previous = {}, int launcher = kLauncher)
+  {
+    Run run;
+    run.session =
+        std::make_unique<TrainingSession>(config_.task, config_.agent, settings_.seed, settings_.learning, robots_);
+    run.app = std::make_unique<RunApplication>(settings_, config_, *run.session, clocks_);
+    run.started = run.app->start(previous, launcher);
+    return run;
+  }
+
+  // An episode that balances to the step limit (return 5), or falls at once (return 1).
+  static void balance(TrainingSession& session, std::size_t robot = 0)
+  {
+    session.beginEpisode(CartPoleState::Zero(), robot);
+    while (!session.observe(CartPoleState::Zero(), robot).episode_over)
+    {
+    }
+  }
+  static void fall(TrainingSession& session, std::size_t robot = 0)
+  {
+    session.beginEpisode(CartPoleState::Zero(), robot);
+    session.observe(CartPoleState(0.0, 0.0, 1.0, 0.0), robot);
+  }
+  EpisodeEnd episode(Run& run, bool balanced = false, bool training_finished = false, const std::string& robot = "")
+  {
+    balanced ? balance(*run.session) : fall(*run.session);
+    now_ += std::chrono::seconds(1);
+    return run.app->endEpisode(robot, training_finished);
+  }
+
+  std::string text(const fs::path& file) const
+  {
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream out;
+    out << in.rdbuf();
+    return out.str();
+  }
+  std::vector<std::string> lines(const fs::path& file) const
+  {
+    std::vector<std::string> found;
+    std::istringstream in(text(file));
+    for (std::string line; std::getline(in, line);)
+      found.push_back(line);
+    return found;
+  }
+  // Every file below the table folder, as "relative/path".
+  std::vector<std::string> files() const
+  {
+    std::vector<std::string> found;
+    for (const auto& entry : fs::recursive_directory_iterator(dir_))
+    {
+      if (!entry.is_directory())
+        found.push_back(fs::relative(entry.path(), dir_).string());
+    }
+    std::sort(found.begin(), found.end());
+    return found;
+  }
+  static std::string folderName()
+  {
+    return runFolderName(kStartTime, "/cartpole", 0);
+  }
+  // The one line said with this text in it, else "" (and a failure when several are).
+  static Said said(const Saying& saying, const std::string& part)
+  {
+    Said found{Said::Level::Info, "", true};
+    int times = 0;
+    for (const Said& s : saying)
+    {
+      if (s.text.find(part) != std::string::npos)
+      {
+        found = s;
+        ++times;
+      }
+    }
+    EXPECT_LE(times, 1) << "'" << part << "' said " << times << " times";
+    return found;
+  }
+  static bool says(const Saying& saying, const std::string& part)
+  {
+    return !said(saying, part).text.empty();
+  }
+  static std::string all(const Saying& saying)
+  {
+    std::string text;
+    for (const Said& s : saying)
+      text += s.text + "\n";
+    return text;
+  }
+
+  fs::path dir_;
+  RunSettings settings_;
+  TrainingConfig config_;
+  RunClocks clocks_;
+  std::chrono::steady_clock::time_point now_{std::chrono::seconds(100)};
+  std::size_t robots_ = 1;
+};
+
+TEST_F(RunApplicationTest, AFreshRunMakesItsFolderRecordAndCurve)
+{
+  Run run = startRun();
+  const std::string folder = folderName();
+  EXPECT_EQ(folder, run.app->runFolder());
+  EXPECT_FALSE(run.app->respawned());
+  EXPECT_FALSE(run.app->finished());
+  EXPECT_EQ((std::vector<std::string>{folder + "/episodes.csv", folder + "/run.yaml"}), files());
+  const RunRecord record = parseRunRecord(text(dir_ / folder / "run.yaml"));
+  EXPECT_EQ("run_host_1_2", record.run_id);
+  EXPECT_EQ("/cartpole", record.name_space);
+  EXPECT_EQ(localTimeText(kStartTime), record.started);
+  EXPECT_EQ("", record.finished);
+  const Said where = said(run.started, "checkpoints go to");
+  EXPECT_EQ("run " + folder + ": checkpoints go to " + (dir_ / folder / "q_table.yaml").string(), where.text);
+  EXPECT_EQ(Said::Level::Info, where.level);
+  EXPECT_TRUE(where.prefixed);
+  EXPECT_TRUE(says(run.started, "one row per episode goes to " + (dir_ / folder / "episodes.csv").string()));
+  // What a respawn needs to find it.
+  const RunIdentity identity = run.app->identity();
+  EXPECT_EQ("run_host_1_2", identity.id);
+  EXPECT_EQ(kLauncher, identity.launcher);
+  EXPECT_EQ(folder, identity.folder);
+}
+
+TEST_F(RunApplicationTest, ARunFolderNameTakenGetsASuffix)
+{
+  Run first = startRun();
+  Run second = startRun();
+  Run third = startRun();
+  EXPECT_EQ(folderName(), first.app->runFolder());
+  EXPECT_EQ(folderName() + "_2", second.app->runFolder());
+  EXPECT_EQ(folderName() + "_3", third.app->runFolder());
+  EXPECT_TRUE(fs::is_regular_file(dir_ / (folderName() + "_3") / "run.yaml"));
+}
+
+TEST_F(RunApplicationTest, AFolderThatCannotBeMadeIsSaidAtTheStart)
+{
+  // A file where the runs' folder goes.
+  std::ofstream(dir_ / "runs") << "not a folder";
+  Run run = startRun();
+  const Said error = said(run.started, "cannot make this run's folder");
+  EXPECT_EQ(Said::Level::Error, error.level);
+  EXPECT_NE(std::string::npos, error.text.find("checkpoints will fail; ~save_q_table can still save the table"));
+}
+
+TEST_F(RunApplicationTest, NothingIsWrittenWithoutCheckpointsAndShutdownSaveUntilTheFirstEpisode)
+{
+  settings_.checkpoint_every = 0;
+  settings_.save_on_shutdown = false;
+  Run run = startRun();
+  EXPECT_TRUE(files().empty());
+  EXPECT_FALSE(says(run.started, "one row per episode"));
+  const EpisodeEnd end = episode(run);
+  const std::string folder = folderName();
+  EXPECT_EQ((std::vector<std::string>{folder + "/episodes.csv"}), files());
+  EXPECT_EQ(2u, lines(dir_ / folder / "episodes.csv").size());
+  EXPECT_TRUE(says(end.said, "one row per episode goes to"));
+  ASSERT_TRUE(end.run_folder.has_value());  // the node stores it for a respawn
+  EXPECT_EQ(folder, *end.run_folder);
+  EXPECT_FALSE(episode(run).run_folder.has_value());
+  EXPECT_TRUE(run.app->shutdown().empty());
+  EXPECT_EQ((std::vector<std::string>{folder + "/episodes.csv"}), files());
+}
+
+TEST_F(RunApplicationTest, AFolderMadeAtTheFirstEpisodeTakesAFreeName)
+{
+  settings_.checkpoint_every = 0;
+  settings_.save_on_shutdown = false;
+  Run first = startRun();
+  Run second = startRun();
+  episode(first);
+  const EpisodeEnd end = episode(second);
+  ASSERT_TRUE(end.run_folder.has_value());
+  EXPECT_EQ(folderName() + "_2", *end.run_folder);
+  EXPECT_EQ(folderName() + "_2", second.app->identity().folder);
+}
+
+TEST_F(RunApplicationTest, CheckpointsComeAtTheirCadence)
+{
+  settings_.checkpoint_every = 2;
+  Run run = startRun();
+  const fs::path table = dir_ / folderName() / "q_table.yaml";
+  EXPECT_FALSE(says(episode(run).said, "checkpoint"));
+  EXPECT_FALSE(fs::exists(table));
+  const EpisodeEnd second = episode(run, true);
+  const Said checkpoint = said(second.said, "checkpoint: ");
+  EXPECT_EQ("checkpoint: saved 2 episodes, 6 steps of training to " + table.string(), checkpoint.text);
+  EXPECT_EQ(2u, loadQTableFile(table.string()).episodes);
+  const RunRecord record = parseRunRecord(text(dir_ / folderName() / "run.yaml"));
+  EXPECT_EQ(2u, record.episodes);
+  EXPECT_EQ(6u, record.steps);
+  EXPECT_EQ((std::vector<double>{1.0, 5.0}), record.recent_returns);
+  EXPECT_EQ("", record.finished);
+  EXPECT_FALSE(says(episode(run).said, "checkpoint"));
+  EXPECT_TRUE(says(episode(run).said, "checkpoint: saved 4 episodes"));
+}
+
+TEST_F(RunApplicationTest, AFailedCheckpointIsAWarningAndTrainingGoesOn)
+{
+  settings_.checkpoint_every = 1;
+  Run run = startRun();
+  fs::create_directories(dir_ / folderName() / "q_table.yaml");  // a folder where the table goes
+  const EpisodeEnd end = episode(run);
+  const Said failed = said(end.said, "checkpoint failed: nothing written: ");
+  EXPECT_EQ(Said::Level::Warn, failed.level);
+  EXPECT_FALSE(end.finished);
+  EXPECT_FALSE(run.app->finished());
+}
+
+TEST_F(RunApplicationTest, ARespawnGoesOnFromTheCheckpoint)
+{
+  settings_.checkpoint_every = 2;
+  Run first = startRun();
+  episode(first, true);
+  episode(first, true);
+  episode(first);  // after the checkpoint: played again by the respawn
+  const RunIdentity identity = first.app->identity();
+  EXPECT_EQ(4u, lines(dir_ / folderName() / "episodes.csv").size());
+
+  Run respawn = startRun(identity, kLauncher);
+  EXPECT_TRUE(respawn.app->respawned());
+  EXPECT_FALSE(respawn.app->finished());
+  EXPECT_EQ(folderName(), respawn.app->runFolder());
+  const Said resumed = said(respawn.started, "goes on from its checkpoint");
+  EXPECT_EQ(Said::Level::Warn, resumed.level);
+  EXPECT_EQ("restarted; run " + folderName() + " goes on from its checkpoint: episode 2, 10 steps", resumed.text);
+  EXPECT_EQ(2u, respawn.session->episodesEnded());
+  EXPECT_EQ(10u, respawn.session->lastEpisode().total_steps);
+  EXPECT_EQ((std::vector<double>{5.0, 5.0}), respawn.session->recentReturns());
+  // The curve keeps the rows the checkpoint covers; the next episode is number 3 again.
+  EXPECT_EQ(3u, lines(dir_ / folderName() / "episodes.csv").size());
+  episode(respawn);
+  const std::vector<std::string> rows = lines(dir_ / folderName() / "episodes.csv");
+  ASSERT_EQ(4u, rows.size());
+  EXPECT_EQ(0u, rows[3].rfind("3,", 0)) << rows[3];
+}
+
+TEST_F(RunApplicationTest, OnlyTheSameIdAndLauncherResume)
+{
+  settings_.checkpoint_every = 1;
+  Run first = startRun();
+  episode(first);
+  const RunIdentity identity = first.app->identity();
+  // Another roslaunch with the same id (a reused master): a run of its own.
+  Run other_launch = startRun(identity, kLauncher + 1);
+  EXPECT_FALSE(other_launch.app->respawned());
+  EXPECT_EQ(folderName() + "_2", other_launch.app->runFolder());
+  EXPECT_EQ(0u, other_launch.session->episodesEnded());
+  RunIdentity other_id = identity;
+  other_id.id = "run_host_9_9";
+  EXPECT_FALSE(startRun(other_id, kLauncher).app->respawned());
+  // Without a run id runs are never resumed, and there is nothing to store.
+  settings_.run_id = "";
+  Run anonymous = startRun(identity, kLauncher);
+  EXPECT_FALSE(anonymous.app->respawned());
+  EXPECT_EQ("", anonymous.app->identity().id);
+}
+
+TEST_F(RunApplicationTest, ARecordOneCheckpointBehindLetsTheTableWinWithAnEmptyWindow)
+{
+  settings_.checkpoint_every = 1;
+  Run first = startRun();
+  episode(first, true);
+  const std::string behind = text(dir_ / folderName() / "run.yaml");
+  episode(first, true);
+  // A crash between the table's save and the record's.
+  std::ofstream(dir_ / folderName() / "run.yaml") << behind;
+  Run respawn = startRun(first.app->identity());
+  const Said resumed = said(respawn.started, "goes on from its checkpoint");
+  EXPECT_EQ("restarted; run " + folderName() +
+                " goes on from its checkpoint: episode 2, 10 steps (its record was one checkpoint behind: the solved "
+                "window starts empty)",
+            resumed.text);
+  EXPECT_EQ(2u, respawn.session->episodesEnded());
+  EXPECT_TRUE(respawn.session->recentReturns().empty());
+}
+
+TEST_F(RunApplicationTest, ARespawnWithoutACheckpointStartsTheRunOver)
+{
+  Run first = startRun();
+  episode(first);
+  episode(first);
+  Run respawn = startRun(first.app->identity());
+  EXPECT_TRUE(respawn.app->respawned());
+  const Said over = said(respawn.started, "has no checkpoint to go on from");
+  EXPECT_EQ(Said::Level::Warn, over.level);
+  EXPECT_EQ(0u, over.text.rfind("restarted; run " + folderName() + " has no checkpoint to go on from (", 0))
+      << over.text;
+  EXPECT_NE(std::string::npos, over.text.find("): starting it over"));
+  EXPECT_EQ(0u, respawn.session->episodesEnded());
+  EXPECT_EQ(folderName(), respawn.app->runFolder());
+  EXPECT_EQ(1u, lines(dir_ / folderName() / "episodes.csv").size());  // the header alone
+}
+
+TEST_F(RunApplicationTest, ARespawnOfAFinishedRunHasNothingToDo)
+{
+  config_.limits.max_episodes = 2;
+  Run first = startRun();
+  episode(first);
+  const EpisodeEnd last = episode(first, false, true);
+  EXPECT_TRUE(last.finished);
+  Run respawn = startRun(first.app->identity());
+  EXPECT_TRUE(respawn.app->finished());
+  const Said done = said(respawn.started, "has finished already");
+  EXPECT_EQ("run " + folderName() + " has finished already (max_episodes); nothing left to do", done.text);
+  // Its table is saved: no save on shutdown.
+  const std::string table = text(dir_ / folderName() / "q_table.yaml");
+  EXPECT_TRUE(respawn.app->shutdown().empty());
+  EXPECT_EQ(table, text(dir_ / folderName() / "q_table.yaml"));
+}
+
+TEST_F(RunApplicationTest, ACheckpointThatDoesNotFitStopsTheRespawn)
+{
+  settings_.checkpoint_every = 1;
+  Run first = startRun();
+  episode(first);
+  config_.agent.actions = {-10.0, 0.0, 10.0};
+  try
+  {
+    startRun(first.app->identity());
+    FAIL() << "resumed from a table of another shape";
+  }
+  catch (const ConfigError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("restarted, but the checkpoint " +
+                                                            (dir_ / folderName() / "q_table.yaml").string() +
+                                                            " does not fit this controller's configuration: "))
+        << e.what();
+  }
+}
+
+TEST_F(RunApplicationTest, TheCurveHasAHeaderAndOneRowPerEpisodeWithTheRobotAndTheWallClock)
+{
+  robots_ = 2;
+  Run run = startRun();
+  fall(*run.session, 1);
+  run.app->endEpisode("robot_1", false);
+  const std::vector<std::string> rows = lines(dir_ / folderName() / "episodes.csv");
+  ASSERT_EQ(2u, rows.size());
+  EXPECT_EQ(kEpisodeCsvHeader, rows[0]);
+  EXPECT_EQ(episodeCsvRow(run.session->lastEpisode(), "robot_1", 1000.25), rows[1]);
+}
+
+TEST_F(RunApplicationTest, AStatsCsvOfTheUsersOwnIsOpenedAtTheStartOrRefused)
+{
+  settings_.stats_csv = "curves/mine.csv";
+  Run run = startRun();
+  episode(run);
+  EXPECT_EQ(2u, lines(dir_ / "curves" / "mine.csv").size());
+  EXPECT_FALSE(fs::exists(dir_ / folderName() / "episodes.csv"));
+
+  std::ofstream(dir_ / "notes.txt") << "my notes\n";
+  settings_.stats_csv = "notes.txt";
+  try
+  {
+    startRun();
+    FAIL() << "a file that is not a curve was taken";
+  }
+  catch (const RunSettingError& e)
+  {
+    EXPECT_EQ("stats_csv", e.name);
+    EXPECT_EQ("'notes.txt'", e.value);
+    EXPECT_EQ(0u, std::string(e.what()).rfind("~stats_csv = 'notes.txt' is not allowed (", 0)) << e.what();
+  }
+  EXPECT_EQ("my notes\n", text(dir_ / "notes.txt"));
+  fs::create_directories(dir_ / "a_folder");
+  settings_.stats_csv = (dir_ / "a_folder").string();
+  EXPECT_THROW(startRun(), RunSettingError);
+  // "none": no curve at all.
+  settings_.stats_csv = "none";
+  Run quiet = startRun();
+  episode(quiet);
+  EXPECT_FALSE(fs::exists(dir_ / quiet.app->runFolder() / "episodes.csv"));
+}
+
+TEST_F(RunApplicationTest, ALoadedTableStartsTheCurveOver)
+{
+  settings_.checkpoint_every = 1;
+  Run run = startRun();
+  episode(run);
+  episode(run);
+  saveQTableFile(run.session->table(), (dir_ / "two.yaml").string());
+  episode(run);
+  const ServiceAnswer answer = run.app->load("two.yaml");
+  EXPECT_TRUE(answer.success) << answer.message;
+  EXPECT_EQ("loaded " + (dir_ / "two.yaml").string() + " (2 episodes, 2 steps of training)", answer.message);
+  EXPECT_TRUE(says(answer.said, "load_q_table: loaded "));
+  const Said over = said(answer.said, "starts over");
+  EXPECT_EQ("the learning curve " + (dir_ / folderName() / "episodes.csv").string() +
+                " starts over from the loaded table's episode 2",
+            over.text);
+  EXPECT_EQ(1u, lines(dir_ / folderName() / "episodes.csv").size());
+  EXPECT_EQ(2u, run.session->episodesEnded());
+  episode(run);
+  const std::vector<std::string> rows = lines(dir_ / folderName() / "episodes.csv");
+  ASSERT_EQ(2u, rows.size());
+  EXPECT_EQ(0u, rows[1].rfind("3,", 0)) << rows[1];
+}
+
+TEST_F(RunApplicationTest, ASolvedRunReplacesTheDefaultTable)
+{
+  Run run = startRun();
+  episode(run, true);
+  const EpisodeEnd end = episode(run, true, true);
+  ASSERT_TRUE(run.session->lastEpisode().solved);
+  EXPECT_TRUE(end.finished);
+  EXPECT_TRUE(run.app->finished());
+  const fs::path default_table = dir_ / "q_table.yaml";
+  const fs::path run_table = dir_ / folderName() / "q_table.yaml";
+  EXPECT_EQ(text(default_table), text(run_table));
+  EXPECT_EQ(2u, loadQTableFile(default_table.string()).episodes);
+  EXPECT_EQ("solved", parseRunRecord(text(dir_ / folderName() / "run.yaml")).finished);
+  const Said solved = said(end.said, "SOLVED");
+  EXPECT_EQ(
+      "SOLVED after 2 episodes, 10 steps, 2.0 s (mean return of the last 2: 5.00); saved 2 episodes, 10 steps "
+      "of training to " +
+          run_table.string() + "; the default table: saved 2 episodes, 10 steps of training to " +
+          default_table.string(),
+      solved.text);
+  // Saved: nothing on shutdown.
+  EXPECT_TRUE(run.app->shutdown().empty());
+}
+
+TEST_F(RunApplicationTest, AnUnsolvedRunLeavesTheDefaultTable)
+{
+  config_.limits.max_episodes = 2;
+  std::ofstream(dir_ / "q_table.yaml") << "the user's table\n";
+  Run run = startRun();
+  episode(run);
+  const EpisodeEnd end = episode(run, false, true);
+  EXPECT_TRUE(end.finished);
+  EXPECT_EQ("the user's table\n", text(dir_ / "q_table.yaml"));
+  EXPECT_EQ("max_episodes", parseRunRecord(text(dir_ / folderName() / "run.yaml")).finished);
+  const Said result = said(end.said, "NOT solved");
+  EXPECT_EQ(0u, result.text.rfind("NOT solved, max_episodes reached after 2 episodes, 2 steps, 2.0 s (mean return of "
+                                  "the last 2: 1.00); saved 2 episodes",
+                                  0))
+      << result.text;
+  EXPECT_NE(std::string::npos,
+            result.text.find("; the default table " + (dir_ / "q_table.yaml").string() +
+                             " is left as it was (this run did not solve: ~save_q_table saves it there if you want "
+                             "it)"));
+}
+
+TEST_F(RunApplicationTest, AFailedFinalSaveKeepsTheNodeUpWithTheErrorSaid)
+{
+  config_.limits.max_episodes = 1;
+  Run run = startRun();
+  fs::create_directories(dir_ / folderName() / "q_table.yaml");
+  const EpisodeEnd end = episode(run, false, true);
+  EXPECT_FALSE(end.finished);        // the launch is not ended
+  EXPECT_TRUE(run.app->finished());  // no more states served
+  const Said error = said(end.said, "could not be saved");
+  EXPECT_EQ(Said::Level::Error, error.level);
+  EXPECT_EQ(0u, error.text.rfind("training ended (max_episodes, episode 1) but the table could not be saved: nothing "
+                                 "written: ",
+                                 0))
+      << error.text;
+  EXPECT_NE(std::string::npos, error.text.find(". The node keeps running: call ~save_q_table with another path"));
+  // The user saves it elsewhere.
+  const ServiceAnswer saved = run.app->save("elsewhere.yaml");
+  EXPECT_TRUE(saved.success) << saved.message;
+  EXPECT_EQ(1u, loadQTableFile((dir_ / "elsewhere.yaml").string()).episodes);
+}
+
+TEST_F(RunApplicationTest, TheShutdownSaveIsIntoTheRunsFolderWhenTrainingAndNotSaved)
+{
+  Run run = startRun();
+  episode(run);
+  const Saying said = run.app->shutdown();
+  ASSERT_EQ(1u, said.size());
+  const fs::path table = dir_ / folderName() / "q_table.yaml";
+  EXPECT_EQ("on shutdown: saved 1 episodes, 1 steps of training to " + table.string() +
+                " (the default table is left as it was)",
+            said[0].text);
+  EXPECT_EQ(1u, loadQTableFile(table.string()).episodes);
+  EXPECT_EQ(1u, parseRunRecord(text(dir_ / folderName() / "run.yaml")).episodes);
+  EXPECT_FALSE(fs::exists(dir_ / "q_table.yaml"));
+  EXPECT_TRUE(run.app->shutdown().empty());  // once
+
+  settings_.save_on_shutdown = false;
+  Run unsaved = startRun();
+  episode(unsaved);
+  EXPECT_TRUE(unsaved.app->shutdown().empty());
+  EXPECT_FALSE(fs::exists(dir_ / unsaved.app->runFolder() / "q_table.yaml"));
+}
+
+TEST_F(RunApplicationTest, EvaluationGivesItsVerdictAfterItsEpisodesAndWritesNothing)
+{
+  settings_.learning = false;
+  settings_.evaluation_episodes = 3;
+  Run run = startRun();
+  EXPECT_EQ(Said::Level::Warn,
+            said(run.started, "evaluating a table of zeros (set ~load_on_start to a trained table)").level);
+  EXPECT_EQ("", run.app->runFolder());
+  EXPECT_EQ("", run.app->identity().id);
+  const EpisodeEnd first = episode(run, true);
+  EXPECT_EQ("evaluation episode 1: 5 steps, return 5.0, balanced to the step limit", first.said.at(0).text);
+  EXPECT_FALSE(first.finished);
+  const EpisodeEnd second = episode(run);
+  EXPECT_EQ("evaluation episode 2: 1 steps, return 1.0, fell", second.said.at(0).text);
+  EXPECT_FALSE(run.app->finished());
+  const EpisodeEnd third = episode(run, true);
+  EXPECT_TRUE(third.finished);
+  EXPECT_TRUE(run.app->finished());
+  // The mean over the task's solved window (2 here): episodes 2 and 3.
+  EXPECT_EQ("EVALUATED 3 episodes: 2 balanced to the step limit (5 steps), mean return 3.0", third.said.at(1).text);
+  const EvaluationVerdict verdict = run.app->verdict();
+  EXPECT_EQ(3u, verdict.episodes);
+  EXPECT_EQ(2u, verdict.balanced);
+  EXPECT_DOUBLE_EQ(3.0, verdict.mean_return);
+  EXPECT_TRUE(run.app->shutdown().empty());
+  EXPECT_TRUE(files().empty());
+}
+
+TEST_F(RunApplicationTest, EvaluationWithoutEpisodeCountNeverEnds)
+{
+  settings_.learning = false;
+  settings_.evaluation_episodes = 0;
+  Run run = startRun();
+  for (int i = 0; i < 5; ++i)
+    EXPECT_FALSE(episode(run, true).finished);
+  EXPECT_FALSE(run.app->finished());
+}
+
+TEST_F(RunApplicationTest, ProgressLinesComeAtTheirCadenceWithTheInjectedClocksRate)
+{
+  config_.limits.progress_every = 2;
+  Run run = startRun();
+  const EpisodeEnd first = episode(run, true);  // 1 s later: 5 steps
+  for (const Said& s : first.said)
+    EXPECT_EQ(std::string::npos, s.text.find("steps/s")) << s.text;
+  EXPECT_DOUBLE_EQ(5.0, first.steps_per_second);
+  now_ += std::chrono::seconds(1);
+  const EpisodeEnd second = episode(run, true);  // 2 s later: 5 more steps
+  EXPECT_DOUBLE_EQ(2.5, second.steps_per_second);
+  const Said progress = said(second.said, "steps/s");
+  EXPECT_FALSE(progress.prefixed);  // as train_headless prints it
+  EXPECT_EQ(progressLine(run.session->lastEpisode(), 2, 10.0 / 3.0, 3.0), progress.text);
+  episode(run, true);
+  const EpisodeEnd fourth = episode(run, true);
+  EXPECT_EQ(progressLine(run.session->lastEpisode(), 2, 5.0, 5.0), said(fourth.said, "steps/s").text);
+}
+
+TEST_F(RunApplicationTest, EachRobotHasItsOwnRate)
+{
+  robots_ = 2;
+  Run run = startRun();
+  now_ += std::chrono::seconds(1);
+  balance(*run.session, 0);
+  const EpisodeEnd robot_0 = run.app->endEpisode("robot_0", false);  // 1 s after the start
+  EXPECT_DOUBLE_EQ(5.0, robot_0.steps_per_second);
+  EXPECT_DOUBLE_EQ(5.0, robot_0.robot_steps_per_second);
+  now_ += std::chrono::seconds(1);
+  fall(*run.session, 1);
+  const EpisodeEnd robot_1 = run.app->endEpisode("robot_1", false);  // 2 s after the start
+  EXPECT_DOUBLE_EQ(1.0, robot_1.steps_per_second);
+  EXPECT_DOUBLE_EQ(0.5, robot_1.robot_steps_per_second);
+}
+
+TEST_F(RunApplicationTest, TheTraceShowsTheTableAtEachEpisodesEnd)
+{
+  settings_.trace = true;
+  Run run = startRun();
+  const EpisodeEnd end = episode(run);
+  const Said table = said(end.said, "Q-table after episode 1:\n");
+  EXPECT_FALSE(table.prefixed);
+  EXPECT_EQ("Q-table after episode 1:\n" + qTableText(run.session->table(), stateNames(config_.agent)), table.text);
+}
+
+TEST_F(RunApplicationTest, ServicesTakePathsUnderTheTableFolderOnly)
+{
+  Run run = startRun();
+  episode(run);
+  for (const std::string path : {"../outside.yaml", "/tmp/outside.yaml", "a/../../outside.yaml"})
+  {
+    const ServiceAnswer save = run.app->save(path);
+    EXPECT_FALSE(save.success) << path;
+    EXPECT_EQ(0u, save.message.rfind("nothing written: ", 0)) << save.message;
+    EXPECT_EQ(Said::Level::Warn, said(save.said, "save_q_table: nothing written").level);
+    const ServiceAnswer load = run.app->load(path);
+    EXPECT_FALSE(load.success) << path;
+    EXPECT_EQ(0u, load.message.rfind("refused, the table in use is unchanged: ", 0)) << load.message;
+    EXPECT_EQ(Said::Level::Warn, said(load.said, "load_q_table: refused").level);
+  }
+  EXPECT_FALSE(fs::exists(dir_.parent_path() / "outside.yaml"));
+  // A link out of the folder is refused too.
+  fs::create_directory_symlink(fs::temp_directory_path(), dir_ / "link");
+  EXPECT_FALSE(run.app->save("link/outside.yaml").success);
+  EXPECT_THROW(run.app->resolve("../x.yaml"), QTableFileError);
+  // Empty: the default table.
+  const ServiceAnswer saved = run.app->save("");
+  EXPECT_TRUE(saved.success) << saved.message;
+  EXPECT_EQ("saved 1 episodes, 1 steps of training to " + (dir_ / "q_table.yaml").string(), saved.message);
+  EXPECT_EQ(Said::Level::Info, said(saved.said, "save_q_table: saved").level);
+  EXPECT_TRUE(run.app->load("").success);
+}
+
+TEST_F(RunApplicationTest, ABadLoadLeavesTheTableUntouched)
+{
+  Run run = startRun();
+  episode(run, true);
+  episode(run);
+  const std::vector<double> values = run.session->table().values();
+  std::ofstream(dir_ / "cut.yaml") << formatQTable(run.session->table()).substr(0, 200);
+  const ServiceAnswer cut = run.app->load("cut.yaml");
+  EXPECT_FALSE(cut.success);
+  EXPECT_EQ(values, run.session->table().values());
+  EXPECT_EQ(2u, run.session->episodesEnded());
+  // A table of another shape.
+  AgentParams other = config_.agent;
+  other.actions = {-10.0, 0.0, 10.0};
+  TrainingSession wider(config_.task, other, 0);
+  saveQTableFile(wider.table(), (dir_ / "wider.yaml").string());
+  const ServiceAnswer mismatch = run.app->load("wider.yaml");
+  EXPECT_FALSE(mismatch.success);
+  EXPECT_NE(std::string::npos, mismatch.message.find("does not fit this controller: ")) << mismatch.message;
+  EXPECT_EQ(values, run.session->table().values());
+  EXPECT_FALSE(run.app->load("missing.yaml").success);
+  EXPECT_EQ(values, run.session->table().values());
+}
+
+TEST_F(RunApplicationTest, LoadOnStartTakesATableOrStopsTheStart)
+{
+  {
+    Run trained = startRun();
+    episode(trained, true);
+    episode(trained, true);
+    saveQTableFile(trained.session->table(), (dir_ / "trained.yaml").string());
+  }
+  settings_.load_on_start = "trained.yaml";
+  Run run = startRun();
+  EXPECT_EQ("loaded " + (dir_ / "trained.yaml").string() + " (2 episodes, 10 steps of training)",
+            said(run.started, "loaded").text);
+  EXPECT_EQ(2u, run.session->episodesEnded());  // training goes on from its counts
+  // Evaluation counts its own episodes.
+  settings_.learning = false;
+  Run evaluation = startRun();
+  EXPECT_EQ(0u, evaluation.session->episodesEnded());
+  EXPECT_FALSE(says(evaluation.started, "table of zeros"));
+
+  settings_.load_on_start = "missing.yaml";
+  try
+  {
+    startRun();
+    FAIL() << "started without its table";
+  }
+  catch (const ConfigError& e)
+  {
+    EXPECT_EQ(0u, std::string(e.what()).rfind("cannot start from the table 'missing.yaml' (~load_on_start, which "
+                                              "the launch files' q_table or load argument sets): ",
+                                              0))
+        << e.what();
+  }
+}
+
+TEST_F(RunApplicationTest, ResumeGoesOnFromARunFolderOrRefuses)
+{
+  settings_.checkpoint_every = 2;
+  Run first = startRun();
+  episode(first, true);
+  episode(first, true);
+  settings_.run_id = "";
+  TrainingSession session(config_.task, config_.agent, settings_.seed);
+  RunApplication app(settings_, config_, session, clocks_);
+  const Saying said = app.resume(folderName());
+  EXPECT_EQ("run " + folderName() + " goes on from its checkpoint: episode 2, 10 steps", said.at(0).text);
+  EXPECT_EQ(2u, session.episodesEnded());
+  EXPECT_EQ(folderName(), app.runFolder());
+
+  TrainingSession other(config_.task, config_.agent, settings_.seed);
+  RunApplication empty(settings_, config_, other, clocks_);
+  fs::create_directories(dir_ / "runs" / "empty");
+  EXPECT_THROW(empty.resume("runs/empty"), ConfigError);
+  EXPECT_THROW(empty.resume("../elsewhere"), ConfigError);
+}
+
+}  // namespace
