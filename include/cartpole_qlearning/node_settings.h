@@ -28,23 +28,23 @@ struct RunSettings
   // "" the run's folder/episodes.csv (training; none when evaluating), "none" no file, else a
   // path (relative: under q_table_dir; absolute: the user's own).
   std::string stats_csv;
-  std::string run_id;                       // the launch's own id: a respawn finds its run by it
-  std::uint64_t evaluation_episodes = 10;   // evaluate: the verdict after this many episodes (0: never)
-  std::uint64_t checkpoint_every = 100;     // training: a checkpoint every this many episodes (0: none)
-  bool save_on_shutdown = true;             // training: save into the run's folder when stopped early
-  bool trace = false;                       // log every update and the table at each episode end
+  std::string run_id;                      // the launch's own id: a respawn finds its run by it
+  std::uint64_t evaluation_episodes = 10;  // evaluate: the verdict after this many episodes (0: never)
+  std::uint64_t checkpoint_every = 100;    // training: a checkpoint every this many episodes (0: none)
+  bool save_on_shutdown = true;            // training: save into the run's folder when stopped early
+  bool trace = false;                      // log every update and the table at each episode end
 };
 
 struct ControllerSettings
 {
   TrainingConfig training;  // the shared sections, with ~stop_when_solved and ~max_episodes applied
   RunSettings run;
-  bool shutdown_when_finished = true;                 // end the launch (or the node) when done
-  double sim_timeout = 2.0;                           // [s] wall: a robot silent this long is said to be
-  std::string reset_service = "cartpole_sim/reset";   // "": a robot that cannot be reset on command
-  std::vector<std::string> robots{""};                // namespaces relative to the learner's
-  bool sync = true;                                   // several robots: served in lockstep rounds
-  ControllerProtocolParams protocol;                  // reset_service, start_region, limits
+  bool shutdown_when_finished = true;                // end the launch (or the node) when done
+  double sim_timeout = 2.0;                          // [s] wall: a robot silent this long is said to be gone
+  std::string reset_service = "cartpole_sim/reset";  // "": a robot that cannot be reset on command
+  std::vector<std::string> robots{""};               // namespaces relative to the learner's
+  bool sync = true;                                  // several robots: served in lockstep rounds
+  ControllerProtocolParams protocol;                 // reset_service, start_region, limits
 };
 
 // What only ROS knows, handed in by the node.
@@ -64,5 +64,36 @@ struct ControllerContext
 // unknown private key.
 ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& priv,
                                           const ControllerContext& context);
+
+enum class SimMode
+{
+  Realtime,  // steps on a wall timer, holding the last command
+  Lockstep   // steps when the command answering the pending state arrives
+};
+
+struct SimSettings
+{
+  CartPoleParams physics;           // the shared physics section
+  double start_state_bound = 0.05;  // physics/start_state_bound
+  SimMode mode = SimMode::Realtime;
+  std::uint64_t seed = 0;
+  double command_timeout = 0.5;   // [s] realtime: an older command counts as zero
+  double lockstep_timeout = 0.5;  // [s] lockstep: republish the state when unanswered this long
+  double effort_limit = 10.0;     // [N] <= physics.force_mag, which is its default
+  bool publish_clock = false;     // lockstep only: drive /clock (one lockstep instance per master)
+  bool publish_tf = true;
+  double tf_rate = 30.0;  // [Hz] lockstep: TF at most this often (wall clock)
+  double track_y = 0.0;   // [m] where the track lies along world y (several robots side by side)
+  std::string world_frame = "world";
+  std::string cart_frame = "cart";
+  std::string pole_frame = "pole";
+  double position_noise_std = 0.0;  // [m, rad] on published positions
+  double velocity_noise_std = 0.0;  // [m/s, rad/s] on published velocities
+  double effort_noise_std = 0.0;    // [N] on the applied force
+};
+
+// Reads the physics section from `shared` and the sim's private parameters from `priv`; throws
+// ConfigError as readControllerSettings does.
+SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource& priv);
 
 }  // namespace cartpole_qlearning

@@ -15,6 +15,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace
 {
@@ -283,6 +284,8 @@ int run(int argc, char** argv)
   std::uint64_t last_steps = 0;
   auto last_time = start;
   std::string returns;
+  // The robots' names in the CSV, as train.launch robots:=N gives them.
+  const std::vector<std::string> robot_names = robotNamespaces(robots);
   const TrainingResult result = trainer.run([&](const EpisodeSummary& s) {
     if (print_returns)
     {
@@ -300,8 +303,7 @@ int run(int argc, char** argv)
     }
     if (stats_csv)
     {
-      // The robots' names as train.launch robots:=N gives them.
-      const std::string robot = robots > 1 ? "robot_" + std::to_string(s.robot) : "";
+      const std::string& robot = robot_names[s.robot];
       const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
       try
       {

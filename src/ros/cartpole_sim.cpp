@@ -34,16 +34,16 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
 {
   const std::lock_guard<std::mutex> lock(mutex_);
   readParameters();
-  simulation_ = std::make_unique<CartPoleSimulation>(physics_, start_state_bound_, seed_);
-  noise_ = std::make_unique<RandomStream>(seed_, kNoiseStream);
+  simulation_ = std::make_unique<CartPoleSimulation>(settings_.physics, settings_.start_state_bound, settings_.seed);
+  noise_ = std::make_unique<RandomStream>(settings_.seed, kNoiseStream);
 
-  if (mode_ == Mode::Lockstep)
+  if (settings_.mode == SimMode::Lockstep)
     joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>(
         "joint_states", 10,
         [this](const ros::SingleSubscriberPublisher& subscriber) { onSubscriberConnect(subscriber); });
   else
     joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
-  if (publish_clock_)
+  if (settings_.publish_clock)
     clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   ros::NodeHandle command_nh(nh_);
   if (command_queue != nullptr)
@@ -57,65 +57,31 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
 
   // The first state: a random start, which takes one tick of sim time like every reset.
   simulation_->resetRandom();
-  if (mode_ == Mode::Lockstep)
+  if (settings_.mode == SimMode::Lockstep)
   {
-    lockstep_ = std::make_unique<SimProtocol>(tickOf(physics_.tau), wallDuration(lockstep_timeout_));
+    lockstep_ = std::make_unique<SimProtocol>(tickOf(settings_.physics.tau), wallDuration(settings_.lockstep_timeout));
     // A state that reaches no controller (one that subscribes late or restarts) is sent again
     // after lockstep_timeout; the timer looks twice per timeout.
-    timer_ = nh_.createSteadyTimer(ros::WallDuration(lockstep_timeout_ / 2), &CartPoleSimNode::onLockstepTimer, this);
+    timer_ = nh_.createSteadyTimer(ros::WallDuration(settings_.lockstep_timeout / 2), &CartPoleSimNode::onLockstepTimer,
+                                   this);
     publishState(toRosTime(lockstep_->start(WallClock::now())));
   }
   else
   {
-    hold_ = std::make_unique<CommandHold>(wallDuration(command_timeout_));
-    timer_ = nh_.createSteadyTimer(ros::WallDuration(physics_.tau), &CartPoleSimNode::onRealtimeTick, this);
+    hold_ = std::make_unique<CommandHold>(wallDuration(settings_.command_timeout));
+    timer_ = nh_.createSteadyTimer(ros::WallDuration(settings_.physics.tau), &CartPoleSimNode::onRealtimeTick, this);
     publishState(ros::Time::now());
   }
   ROS_INFO("cartpole_sim: %s mode, tau %g s, integrator %s, seed %llu, start state [%g, %g, %g, %g]%s",
-           mode_ == Mode::Lockstep ? "lockstep" : "realtime", physics_.tau, toString(physics_.integrator).c_str(),
-           static_cast<unsigned long long>(seed_), simulation_->state()[0], simulation_->state()[1],
-           simulation_->state()[2], simulation_->state()[3], publish_clock_ ? ", publishing /clock" : "");
+           settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau,
+           toString(settings_.physics.integrator).c_str(), static_cast<unsigned long long>(settings_.seed),
+           simulation_->state()[0], simulation_->state()[1], simulation_->state()[2], simulation_->state()[3],
+           settings_.publish_clock ? ", publishing /clock" : "");
 }
 
 void CartPoleSimNode::readParameters()
 {
-  readPhysics(RosParameterSource(nh_), physics_, start_state_bound_);
-
-  // Private parameters: the same reader and checks as the shared sections; a key it does not
-  // know (a typo such as lockstep_timout) stops the node instead of being ignored.
-  const RosParameterSource source(pnh_);
-  SectionReader priv(source, "");
-  std::string mode = "realtime";
-  priv.readChoice("mode", mode, {"realtime", "lockstep"});
-  mode_ = mode == "lockstep" ? Mode::Lockstep : Mode::Realtime;
-  priv.read("seed", seed_, 0);
-  priv.readAtLeast("command_timeout", command_timeout_, 0.0, true);
-  priv.readAtLeast("lockstep_timeout", lockstep_timeout_, 0.0, true);
-  priv.readAtLeast("tf_rate", tf_rate_, 0.0, true);
-  effort_limit_ = physics_.force_mag;
-  priv.readAtLeast("effort_limit", effort_limit_, 0.0, true);
-  if (effort_limit_ > physics_.force_mag)
-    priv.fail("effort_limit", SectionReader::numberText(effort_limit_),
-              "must be <= physics/force_mag = " + SectionReader::numberText(physics_.force_mag));
-  priv.readAtLeast("position_noise_std", position_noise_std_, 0.0, false);
-  priv.readAtLeast("velocity_noise_std", velocity_noise_std_, 0.0, false);
-  priv.readAtLeast("effort_noise_std", effort_noise_std_, 0.0, false);
-  priv.read("publish_clock", publish_clock_);
-  priv.read("publish_tf", publish_tf_);
-  priv.read("track_y", track_y_);
-  if (!std::isfinite(track_y_))
-    priv.fail("track_y", SectionReader::numberText(track_y_), "must be finite");
-  for (const auto& [name, frame] : {std::pair<const char*, std::string*>{"world_frame", &world_frame_},
-                                    {"cart_frame", &cart_frame_},
-                                    {"pole_frame", &pole_frame_}})
-  {
-    priv.read(name, *frame);
-    if (frame->empty())
-      priv.fail(name, "''", "frame names must not be empty");
-  }
-  priv.refuseUnknown();
-  if (publish_clock_ && mode_ != Mode::Lockstep)
-    priv.fail("publish_clock", "true", "only in lockstep mode: in realtime the wall clock is the clock");
+  settings_ = readSimSettings(RosParameterSource(nh_), RosParameterSource(pnh_));
 }
 
 bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
@@ -126,9 +92,9 @@ bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
       ROS_WARN("cartpole_sim: refused a non-finite effort (%f)", requested);
     return false;
   }
-  effort = std::clamp(requested, -effort_limit_, effort_limit_);
+  effort = std::clamp(requested, -settings_.effort_limit, settings_.effort_limit);
   if (effort != requested && clamp_warning_.ready())
-    ROS_WARN("cartpole_sim: effort %g N clamped to the limit of %g N", requested, effort_limit_);
+    ROS_WARN("cartpole_sim: effort %g N clamped to the limit of %g N", requested, settings_.effort_limit);
   return true;
 }
 
@@ -148,7 +114,7 @@ void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
   if (!acceptEffort(msg->effort[index], effort))
     return;
   const WallClock::time_point now = WallClock::now();
-  if (mode_ == Mode::Realtime)
+  if (settings_.mode == SimMode::Realtime)
   {
     if (!hold_->set(effort, msg->header.stamp.toNSec(), now))
       ROS_DEBUG("cartpole_sim: dropped a joint_command older than the one held");
@@ -164,7 +130,7 @@ void CartPoleSimNode::onEffort(const std_msgs::Float64ConstPtr& msg)
   if (!acceptEffort(msg->data, effort))
     return;
   const WallClock::time_point now = WallClock::now();
-  if (mode_ == Mode::Realtime)
+  if (settings_.mode == SimMode::Realtime)
   {
     hold_->set(effort, 0, now);
     return;
@@ -202,8 +168,9 @@ void CartPoleSimNode::apply(SimProtocol::Verdict verdict, double effort, const r
 void CartPoleSimNode::advance(double effort, const ros::Time& stamp)
 {
   double force = effort;
-  if (effort_noise_std_ > 0.0)
-    force = std::clamp(effort + effort_noise_std_ * noise_->normal(), -effort_limit_, effort_limit_);
+  if (settings_.effort_noise_std > 0.0)
+    force = std::clamp(effort + settings_.effort_noise_std * noise_->normal(), -settings_.effort_limit,
+                       settings_.effort_limit);
   simulation_->step(force);
   publishState(stamp);
 }
@@ -219,7 +186,7 @@ void CartPoleSimNode::onLockstepTimer(const ros::SteadyTimerEvent&)
   const std::lock_guard<std::mutex> lock(mutex_);
   if (!lockstep_->repeatDue(WallClock::now()))
     return;
-  ROS_DEBUG("cartpole_sim: no command for %.3f s, publishing the state again", lockstep_timeout_);
+  ROS_DEBUG("cartpole_sim: no command for %.3f s, publishing the state again", settings_.lockstep_timeout);
   republishState();
 }
 
@@ -260,7 +227,8 @@ bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response
   }
   // In lockstep a reset takes one tick of sim time, so the new start state never shares a stamp
   // with the state before it, and an answer to that state still in flight is dropped.
-  publishState(mode_ == Mode::Lockstep ? toRosTime(lockstep_->onReset(WallClock::now())) : ros::Time::now());
+  publishState(settings_.mode == SimMode::Lockstep ? toRosTime(lockstep_->onReset(WallClock::now()))
+                                                   : ros::Time::now());
   const CartPoleState& s = simulation_->state();
   std::ostringstream out;
   out.precision(17);
@@ -272,7 +240,7 @@ bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response
 
 void CartPoleSimNode::republishState()
 {
-  if (publish_clock_)
+  if (settings_.publish_clock)
   {
     rosgraph_msgs::Clock clock;
     clock.clock = joint_state_->header.stamp;
@@ -290,36 +258,36 @@ void CartPoleSimNode::publishState(const ros::Time& stamp)
   msg->position = {s[0], s[2]};
   msg->velocity = {s[1], s[3]};
   msg->effort = {simulation_->appliedForce(), 0.0};  // the pole joint is not actuated
-  if (position_noise_std_ > 0.0)
+  if (settings_.position_noise_std > 0.0)
   {
-    msg->position[0] += position_noise_std_ * noise_->normal();
-    msg->position[1] += position_noise_std_ * noise_->normal();
+    msg->position[0] += settings_.position_noise_std * noise_->normal();
+    msg->position[1] += settings_.position_noise_std * noise_->normal();
   }
-  if (velocity_noise_std_ > 0.0)
+  if (settings_.velocity_noise_std > 0.0)
   {
-    msg->velocity[0] += velocity_noise_std_ * noise_->normal();
-    msg->velocity[1] += velocity_noise_std_ * noise_->normal();
+    msg->velocity[0] += settings_.velocity_noise_std * noise_->normal();
+    msg->velocity[1] += settings_.velocity_noise_std * noise_->normal();
   }
   joint_state_ = msg;
   republishState();
 
-  if (!publish_tf_)
+  if (!settings_.publish_tf)
     return;
   const WallClock::time_point wall_now = WallClock::now();
-  if (mode_ == Mode::Lockstep && wall_now - last_tf_ < wallDuration(1.0 / tf_rate_))
+  if (settings_.mode == SimMode::Lockstep && wall_now - last_tf_ < wallDuration(1.0 / settings_.tf_rate))
     return;
   last_tf_ = wall_now;
   geometry_msgs::TransformStamped cart;
   cart.header.stamp = stamp;
-  cart.header.frame_id = world_frame_;
-  cart.child_frame_id = cart_frame_;
+  cart.header.frame_id = settings_.world_frame;
+  cart.child_frame_id = settings_.cart_frame;
   cart.transform.translation.x = s[0];
-  cart.transform.translation.y = track_y_;
+  cart.transform.translation.y = settings_.track_y;
   cart.transform.rotation.w = 1.0;
   geometry_msgs::TransformStamped pole;
   pole.header.stamp = stamp;
-  pole.header.frame_id = cart_frame_;
-  pole.child_frame_id = pole_frame_;
+  pole.header.frame_id = settings_.cart_frame;
+  pole.child_frame_id = settings_.pole_frame;
   // theta about +y: positive theta tips the pole's top toward +x.
   pole.transform.rotation.y = std::sin(s[2] / 2.0);
   pole.transform.rotation.w = std::cos(s[2] / 2.0);

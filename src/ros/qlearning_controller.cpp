@@ -6,7 +6,6 @@
 #include "cartpole_qlearning/ros/parameter_source.h"
 
 #include <ros/names.h>
-#include <xmlrpcpp/XmlRpcValue.h>
 
 #include <algorithm>
 #include <array>
@@ -27,45 +26,6 @@ namespace
 // [s] A reset call is given up after max(this, 2 x ~sim_timeout) (README: the ~reset_service row).
 constexpr double kMinResetGiveUp = 5.0;
 constexpr double kMaxResetGiveUp = 3600.0;
-
-// ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
-// the learner's own namespace (N = 1), or robot_0 ... robot_<N-1> (train.launch robots:=N).
-void readRobots(const ros::NodeHandle& pnh, SectionReader& priv, std::vector<std::string>& names)
-{
-  priv.know("robots");
-  XmlRpc::XmlRpcValue value;
-  if (!pnh.getParam("robots", value))
-    return;
-  const auto refuse = [&](const std::string& why) { refuseParameter(pnh, "robots", "'" + value.toXml() + "'", why); };
-  const char* allowed = "a whole number in [1, 1000] or a list of namespaces relative to the controller's";
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeInt)
-  {
-    const int count = static_cast<int>(value);
-    if (count < 1 || count > 1000)
-      refuse(allowed);
-    names.clear();
-    if (count == 1)
-      names.push_back("");
-    for (int i = 0; count > 1 && i < count; ++i)
-      names.push_back("robot_" + std::to_string(i));
-    return;
-  }
-  if (value.getType() != XmlRpc::XmlRpcValue::TypeArray || value.size() < 1 || value.size() > 1000)
-    refuse(allowed);
-  names.clear();
-  for (int i = 0; i < value.size(); ++i)
-  {
-    if (value[i].getType() != XmlRpc::XmlRpcValue::TypeString)
-      refuse(allowed);
-    const std::string name = static_cast<std::string>(value[i]);
-    std::string error;
-    if (!name.empty() && !ros::names::validate(name, error))
-      refuse("'" + name + "' is not a valid ROS name: " + error);
-    if (std::find(names.begin(), names.end(), name) != names.end())
-      refuse("'" + name + "' is listed twice");
-    names.push_back(name);
-  }
-}
 
 double secondsSince(std::chrono::steady_clock::time_point then)
 {
@@ -149,45 +109,46 @@ std::string asServerField(std::string message)
 QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
                                                  std::function<void()> shutdown, bool shutdown_by_default,
                                                  ros::CallbackQueue* state_queue)
-  : nh_(nh), pnh_(pnh), shutdown_(std::move(shutdown)), shutdown_when_finished_(shutdown_by_default)
+  : nh_(nh), pnh_(pnh), shutdown_(std::move(shutdown))
 {
   std::unique_lock<std::mutex> lock(mutex_);
-  readParameters();
-  session_ = std::make_unique<TrainingSession>(config_.task, config_.agent, seed_, learning_, robot_names_.size());
-  if (trace_ && learning_)
+  readParameters(shutdown_by_default);
+  session_ = std::make_unique<TrainingSession>(settings_.training.task, settings_.training.agent, settings_.run.seed,
+                                               settings_.run.learning, settings_.robots.size());
+  if (settings_.run.trace && settings_.run.learning)
   {
-    state_names_ = stateNames(config_.agent);
+    state_names_ = stateNames(settings_.training.agent);
     session_->setTrace([this](std::size_t robot, const TraceStep& step) {
-      const std::string& name = robot_names_[robot];
-      ROS_INFO("%s%s", robot_names_.size() > 1 ? (name + ": ").c_str() : "",
-               traceLine(step, state_names_, config_.agent.actions).c_str());
+      const std::string& name = settings_.robots[robot];
+      ROS_INFO("%s%s", settings_.robots.size() > 1 ? (name + ": ").c_str() : "",
+               traceLine(step, state_names_, settings_.training.agent.actions).c_str());
     });
   }
-  if (!load_on_start_.empty())
+  if (!settings_.run.load_on_start.empty())
   {
     std::string path;
     try
     {
-      path = resolve(load_on_start_);
-      const std::string mismatch = install(loadQTableUnder(q_table_dir_, load_on_start_));
+      path = resolve(settings_.run.load_on_start);
+      const std::string mismatch = install(loadQTableUnder(settings_.run.q_table_dir, settings_.run.load_on_start));
       if (!mismatch.empty())
         throw QTableFileError(path + " does not fit this controller: " + mismatch);
     }
     catch (const QTableFileError& e)
     {
-      throw ConfigError("cannot start from the table '" + load_on_start_ +
+      throw ConfigError("cannot start from the table '" + settings_.run.load_on_start +
                         "' (~load_on_start, which the launch files' q_table or load argument sets): " + e.what());
     }
     ROS_INFO("qlearning_controller: loaded %s (%llu episodes, %llu steps of training)", path.c_str(),
              static_cast<unsigned long long>(session_->table().episodes),
              static_cast<unsigned long long>(session_->table().steps));
   }
-  else if (!learning_)
+  else if (!settings_.run.learning)
   {
     ROS_WARN("qlearning_controller: evaluating a table of zeros (set ~load_on_start to a trained table)");
   }
   openStatsFile();
-  if (learning_)
+  if (settings_.run.learning)
     openRun();
   startStatsCsv();
 
@@ -196,18 +157,19 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
   load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
   setUpRobots(state_queue);
-  if (protocol_params_.reset_service)
+  if (settings_.protocol.reset_service)
   {
     // Long enough for a sim that is merely slow (loaded, or far away) to answer, since giving a
     // call up leaves a thread and a connection behind; ~sim_timeout is how long the user lets a
     // sim be silent before calling it gone.
     // (At most an hour: a huge ~sim_timeout must not overflow the clock's arithmetic.)
-    const auto give_up_after = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(std::min(kMaxResetGiveUp, std::max(kMinResetGiveUp, 2.0 * sim_timeout_))));
+    const auto give_up_after =
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(
+            std::min(kMaxResetGiveUp, std::max(kMinResetGiveUp, 2.0 * settings_.sim_timeout))));
     for (Robot& robot : robots_)
-      robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(reset_service_), give_up_after);
+      robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(settings_.reset_service), give_up_after);
   }
-  watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, sim_timeout_ / 2.0)),
+  watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, settings_.sim_timeout / 2.0)),
                                     &QLearningControllerNode::onWatchdog, this);
   std::string served;
   for (const Robot& robot : robots_)
@@ -218,11 +180,12 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
           ? std::to_string(features.tilings) + " tilings, " + std::to_string(session_->table().stateCount()) + " tiles"
           : std::to_string(session_->table().stateCount()) + " states";
   ROS_INFO("qlearning_controller: %s, seed %llu, %s x %zu actions, tables under %s; serving %s%s; %s",
-           learning_ ? "training" : "evaluating (greedy, no learning)", static_cast<unsigned long long>(seed_),
-           rows.c_str(), session_->table().actionCount(), q_table_dir_.c_str(), served.c_str(),
-           robots_.size() > 1 ? (sync_ ? " in lockstep rounds" : ", each as its states come") : "",
-           protocol_params_.reset_service ? ("resets by ~" + reset_service_).c_str()
-                                          : "no reset service: episodes start when the state is in ~start_region");
+           settings_.run.learning ? "training" : "evaluating (greedy, no learning)",
+           static_cast<unsigned long long>(settings_.run.seed), rows.c_str(), session_->table().actionCount(),
+           settings_.run.q_table_dir.c_str(), served.c_str(),
+           robots_.size() > 1 ? (settings_.sync ? " in lockstep rounds" : ", each as its states come") : "",
+           settings_.protocol.reset_service ? ("resets by ~" + settings_.reset_service).c_str()
+                                            : "no reset service: episodes start when the state is in ~start_region");
   lock.unlock();
   startLiveTuning();
 }
@@ -230,15 +193,15 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
 void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
 {
   rounds_ = std::make_unique<RobotRounds>(
-      robot_names_.size(), sync_,
-      std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(sim_timeout_)));
-  robots_.resize(robot_names_.size());
+      settings_.robots.size(), settings_.sync,
+      std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(settings_.sim_timeout)));
+  robots_.resize(settings_.robots.size());
   const auto now = std::chrono::steady_clock::now();
   for (std::size_t r = 0; r < robots_.size(); ++r)
   {
     Robot& robot = robots_[r];
-    robot.name = robot_names_[r];
-    ControllerProtocolParams params = protocol_params_;
+    robot.name = settings_.robots[r];
+    ControllerProtocolParams params = settings_.protocol;
     params.robot = r;
     robot.protocol = std::make_unique<ControllerProtocol>(*session_, params);
     robot.nh = robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name);
@@ -272,7 +235,7 @@ QLearningControllerNode::~QLearningControllerNode()
   for (Robot& robot : robots_)
     robot.state_sub.shutdown();
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (learning_ && save_on_shutdown_ && !final_saved_)
+  if (settings_.run.learning && settings_.run.save_on_shutdown && !final_saved_)
   {
     std::string message;
     checkpoint("", message);
@@ -281,106 +244,26 @@ QLearningControllerNode::~QLearningControllerNode()
   }
 }
 
-void QLearningControllerNode::readParameters()
+void QLearningControllerNode::readParameters(bool shutdown_by_default)
 {
-  const RosParameterSource shared(nh_);
-  config_ = readTrainingConfig(shared);
-
-  // Private parameters: the same reader and checks as the shared sections; a key it does not
-  // know (a typo) stops the node instead of being ignored.
-  const RosParameterSource source(pnh_);
-  SectionReader priv(source, "");
-  // The launch files' stop_when_solved and max_episodes arrive as private parameters; they
-  // override the shared training/ keys for this controller only.
-  priv.read("stop_when_solved", config_.limits.stop_when_solved);
-  priv.read("max_episodes", config_.limits.max_episodes, 1);
-
-  std::string mode = "train";
-  priv.readChoice("mode", mode, {"train", "evaluate"});
-  learning_ = mode == "train";
-  priv.read("seed", seed_, 0);
-
-  q_table_dir_ = defaultTableDirectory(nh_.getNamespace());
-  priv.read("q_table_dir", q_table_dir_);
-  if (q_table_dir_.empty())
-    priv.fail("q_table_dir", "''", "must name a directory");
-  // Paths given as "~/..." (roslaunch passes them on unexpanded) name the user's home.
+  ControllerContext context;
+  context.name_space = nh_.getNamespace();
   const char* home = std::getenv("HOME");
-  const auto expand_home = [&](const std::string& name, std::string& path) {
-    try
-    {
-      path = expandHome(path, home ? home : "");
-    }
-    catch (const FileError& e)
-    {
-      priv.fail(name, "'" + path + "'", e.what());
-    }
+  context.home = home ? home : "";
+  context.shutdown_by_default = shutdown_by_default;
+  context.name_error = [](const std::string& name) {
+    std::string error;
+    return ros::names::validate(name, error) ? std::string() : error;
   };
-  expand_home("q_table_dir", q_table_dir_);
-  priv.read("q_table_path", q_table_path_);
-  expand_home("q_table_path", q_table_path_);
-  try
-  {
-    resolve(q_table_path_);
-  }
-  catch (const QTableFileError& e)
-  {
-    priv.fail("q_table_path", "'" + q_table_path_ + "'", e.what());
-  }
-  priv.read("load_on_start", load_on_start_);
-  expand_home("load_on_start", load_on_start_);
-  priv.read("stats_csv", stats_csv_);
-  expand_home("stats_csv", stats_csv_);
-  if (stats_csv_ != "none" && !stats_csv_.empty() && stats_csv_.front() != '/')
-  {
-    try
-    {
-      relativePathUnder(q_table_dir_, stats_csv_);
-    }
-    catch (const FileError& e)
-    {
-      priv.fail("stats_csv", "'" + stats_csv_ + "'", e.what());
-    }
-  }
-  priv.read("run_id", run_id_);
-  // Set by the controller itself (openRun), for a respawn of it to find.
-  priv.know("run/id");
-  priv.know("run/launcher");
-  priv.know("run/folder");
-  priv.read("evaluation_episodes", evaluation_episodes_, 0);
-  priv.read("checkpoint_every", checkpoint_every_, 0);
-  priv.read("save_on_shutdown", save_on_shutdown_);
-  priv.read("shutdown_when_finished", shutdown_when_finished_);
-  priv.readAtLeast("sim_timeout", sim_timeout_, 0.0, true);
-  priv.read("reset_service", reset_service_);
-  protocol_params_.reset_service = !reset_service_.empty();
-  protocol_params_.start_region = CartPoleState::Constant(config_.start_state_bound);
-  std::array<double, kStateDimensions> region{};
-  for (std::size_t i = 0; i < kStateDimensions; ++i)
-    region[i] = protocol_params_.start_region[i];
-  priv.readDimensions("start_region", region, false);
-  for (std::size_t i = 0; i < kStateDimensions; ++i)
-  {
-    if (!(std::isfinite(region[i]) && region[i] > 0.0))
-      priv.fail("start_region", SectionReader::listText({region.begin(), region.end()}),
-                "must be 4 finite values > 0: |x|, |x_dot|, |theta|, |theta_dot| bounds");
-    protocol_params_.start_region[i] = region[i];
-  }
-  readRobots(pnh_, priv, robot_names_);
-  priv.read("sync", sync_);
-  priv.read("trace", trace_);
-  if (trace_ && config_.agent.features == FeatureKind::Tiles)
-    priv.fail("trace", "true", "the trace shows one table row per state: learning/features bins only");
   // Live tuning's values, which the controller's own dynamic_reconfigure server keeps there.
   for (const auto& param : LearningConfig::__getParamDescriptions__())
-    priv.know(param->name);
-  priv.refuseUnknown();
-  protocol_params_.limits = config_.limits;
+    context.other_keys.push_back(param->name);
+  settings_ = readControllerSettings(RosParameterSource(nh_), RosParameterSource(pnh_), context);
 }
 
 std::string QLearningControllerNode::resolve(const std::string& path) const
 {
-  return resolvePathUnder(q_table_dir_, path.empty() ? q_table_path_ : path);
+  return resolvePathUnder(settings_.run.q_table_dir, path.empty() ? settings_.run.q_table_path : path);
 }
 
 bool QLearningControllerNode::extractState(const sensor_msgs::JointState& msg, CartPoleState& state) const
@@ -564,7 +447,7 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
     robot.stats_pub.publish(stats);
   }
 
-  if (trace_ && learning_)
+  if (settings_.run.trace && settings_.run.learning)
   {
     const std::string which = robots_.size() > 1 ? robot.name + "'s episode " + std::to_string(s.robot_episode) + " (" +
                                                        std::to_string(s.episode) + " in all)"
@@ -572,29 +455,29 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
     ROS_INFO("Q-table after %s:\n%s", which.c_str(), qTableText(session_->table(), state_names_).c_str());
   }
 
-  const TrainingLimits& limits = config_.limits;
+  const TrainingLimits& limits = settings_.training.limits;
   if (limits.progress_every > 0 && s.episode % limits.progress_every == 0)
   {
     const double interval = secondsSince(last_progress_);
     const double rate = interval > 0.0 ? (s.total_steps - steps_at_last_progress_) / interval : 0.0;
-    ROS_INFO("%s", progressLine(s, config_.task.solved_window, rate, secondsSince(started_)).c_str());
+    ROS_INFO("%s", progressLine(s, settings_.training.task.solved_window, rate, secondsSince(started_)).c_str());
     steps_at_last_progress_ = s.total_steps;
     last_progress_ = std::chrono::steady_clock::now();
   }
 
-  if (!learning_)
+  if (!settings_.run.learning)
   {
     // Evaluation: every episode said, and after ~evaluation_episodes a one-line verdict.
     evaluated_balanced_ += s.truncated && !s.terminated;
     ROS_INFO("qlearning_controller: evaluation episode %llu: %u steps, return %.1f, %s",
              static_cast<unsigned long long>(s.episode), s.steps, s.episode_return,
              s.terminated ? "fell" : "balanced to the step limit");
-    if (evaluation_episodes_ == 0 || s.episode < evaluation_episodes_)
+    if (settings_.run.evaluation_episodes == 0 || s.episode < settings_.run.evaluation_episodes)
       return;
     ROS_INFO(
         "qlearning_controller: EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f",
         static_cast<unsigned long long>(s.episode), static_cast<unsigned long long>(evaluated_balanced_),
-        config_.task.max_episode_steps, s.mean_return_window);
+        settings_.training.task.max_episode_steps, s.mean_return_window);
     finished_training_ = true;
     endWhenFinished();
     return;
@@ -613,12 +496,12 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
     }
     ROS_INFO("qlearning_controller: %s after %llu episodes, %llu steps, %.1f s (mean return of the last %u: %.2f); %s",
              s.solved ? "SOLVED" : "NOT solved, max_episodes reached", static_cast<unsigned long long>(s.episode),
-             static_cast<unsigned long long>(s.total_steps), secondsSince(started_), config_.task.solved_window,
-             s.mean_return_window, saved.c_str());
+             static_cast<unsigned long long>(s.total_steps), secondsSince(started_),
+             settings_.training.task.solved_window, s.mean_return_window, saved.c_str());
     endWhenFinished();
     return;
   }
-  if (checkpoint_every_ > 0 && s.episode % checkpoint_every_ == 0)
+  if (settings_.run.checkpoint_every > 0 && s.episode % settings_.run.checkpoint_every == 0)
   {
     std::string message;
     if (checkpoint("", message))
@@ -634,7 +517,7 @@ std::string QLearningControllerNode::install(QTable table)
   // max_episodes all count from them, so the progress lines and the saves agree. (The solved
   // window starts empty.) Evaluation counts its own episodes from 1.
   const std::string mismatch =
-      learning_ ? session_->resume(std::move(table), {}) : session_->replaceTable(std::move(table));
+      settings_.run.learning ? session_->resume(std::move(table), {}) : session_->replaceTable(std::move(table));
   // Steps per second count from here.
   steps_at_last_episode_ = steps_at_last_progress_ = session_->lastEpisode().total_steps;
   return mismatch;
@@ -642,7 +525,7 @@ std::string QLearningControllerNode::install(QTable table)
 
 void QLearningControllerNode::endWhenFinished()
 {
-  if (!shutdown_when_finished_)
+  if (!settings_.shutdown_when_finished)
     return;
   if (endParentLaunch())
   {
@@ -655,16 +538,16 @@ void QLearningControllerNode::endWhenFinished()
 
 void QLearningControllerNode::openRun()
 {
-  run_.run_id = run_id_;
+  run_.run_id = settings_.run.run_id;
   run_.name_space = nh_.getNamespace();
-  run_.seed = seed_;
+  run_.seed = settings_.run.seed;
   // A respawn has the run id and the roslaunch (else the parent) of the process that started the
   // run; a node started by hand on a reused master has at most the id left there.
   const pid_t roslaunch = launchingRoslaunch();
   const int launcher = static_cast<int>(roslaunch > 0 ? roslaunch : ::getppid());
   std::string stored_id;
   int stored_launcher = 0;
-  if (!run_id_.empty() && pnh_.getParam("run/id", stored_id) && stored_id == run_id_ &&
+  if (!settings_.run.run_id.empty() && pnh_.getParam("run/id", stored_id) && stored_id == settings_.run.run_id &&
       pnh_.getParam("run/launcher", stored_launcher) && stored_launcher == launcher &&
       pnh_.getParam("run/folder", run_folder_) && !run_folder_.empty())
   {
@@ -674,17 +557,19 @@ void QLearningControllerNode::openRun()
   }
   const std::time_t now = std::time(nullptr);
   run_.started = localTimeText(now);
-  const std::string name = runFolderName(now, nh_.getNamespace(), seed_);
+  const std::string name = runFolderName(now, nh_.getNamespace(), settings_.run.seed);
   // Made now, so that a folder that cannot be written is said at the start, not at the first
   // checkpoint; a name taken (another run started in the same second) gets a suffix. A node told
   // to write nothing along the way (no checkpoints, no save on shutdown) writes nothing yet.
   run_folder_ = name;
   try
   {
-    for (int n = 2; (checkpoint_every_ > 0 || save_on_shutdown_) && !makeDirectoryUnder(q_table_dir_, run_folder_); ++n)
+    for (int n = 2; (settings_.run.checkpoint_every > 0 || settings_.run.save_on_shutdown) &&
+                    !makeDirectoryUnder(settings_.run.q_table_dir, run_folder_);
+         ++n)
       run_folder_ = name + "_" + std::to_string(n);
-    if (checkpoint_every_ > 0 || save_on_shutdown_)
-      writeFileUnder(q_table_dir_, run_folder_ + "/" + kRunRecordFile, formatRunRecord(run_));
+    if (settings_.run.checkpoint_every > 0 || settings_.run.save_on_shutdown)
+      writeFileUnder(settings_.run.q_table_dir, run_folder_ + "/" + kRunRecordFile, formatRunRecord(run_));
   }
   catch (const FileError& e)
   {
@@ -693,9 +578,9 @@ void QLearningControllerNode::openRun()
         "still save the table elsewhere",
         e.what());
   }
-  if (!run_id_.empty())
+  if (!settings_.run.run_id.empty())
   {
-    pnh_.setParam("run/id", run_id_);
+    pnh_.setParam("run/id", settings_.run.run_id);
     pnh_.setParam("run/launcher", launcher);
     pnh_.setParam("run/folder", run_folder_);
   }
@@ -705,30 +590,31 @@ void QLearningControllerNode::openRun()
 
 void QLearningControllerNode::openStatsFile()
 {
-  if (stats_csv_ == "none" || stats_csv_.empty())
+  if (settings_.run.stats_csv == "none" || settings_.run.stats_csv.empty())
     return;
   try
   {
-    stats_file_ =
-        std::make_unique<AppendingFile>(stats_csv_.front() == '/' ? AppendingFile::open(stats_csv_)
-                                                                  : AppendingFile::openUnder(q_table_dir_, stats_csv_));
+    stats_file_ = std::make_unique<AppendingFile>(
+        settings_.run.stats_csv.front() == '/'
+            ? AppendingFile::open(settings_.run.stats_csv)
+            : AppendingFile::openUnder(settings_.run.q_table_dir, settings_.run.stats_csv));
   }
   catch (const FileError& e)
   {
-    refuseParameter(pnh_, "stats_csv", "'" + stats_csv_ + "'", e.what());
+    refuseParameter(pnh_, "stats_csv", "'" + settings_.run.stats_csv + "'", e.what());
   }
 }
 
 void QLearningControllerNode::startStatsCsv()
 {
-  if (stats_csv_ == "none" || (stats_csv_.empty() && !learning_))
+  if (settings_.run.stats_csv == "none" || (settings_.run.stats_csv.empty() && !settings_.run.learning))
     return;
   if (!stats_file_)
   {
     // The run's own file: beside its checkpoints, made with its folder. A node told to write
     // nothing along the way (no checkpoints, no save on shutdown) makes that folder only when
     // there is something to write: here, at the first episode's end.
-    if (!(checkpoint_every_ > 0 || save_on_shutdown_) && !resumed_run_ && !stats_csv_pending_)
+    if (!(settings_.run.checkpoint_every > 0 || settings_.run.save_on_shutdown) && !resumed_run_ && !stats_csv_pending_)
     {
       stats_csv_pending_ = true;
       return;
@@ -739,14 +625,14 @@ void QLearningControllerNode::startStatsCsv()
       {
         // Its folder is made now, under a name no other run has taken (as openRun does).
         const std::string name = run_folder_;
-        for (int n = 2; !makeDirectoryUnder(q_table_dir_, run_folder_); ++n)
+        for (int n = 2; !makeDirectoryUnder(settings_.run.q_table_dir, run_folder_); ++n)
           run_folder_ = name + "_" + std::to_string(n);
-        if (!run_id_.empty())
+        if (!settings_.run.run_id.empty())
           pnh_.setParam("run/folder", run_folder_);
       }
       stats_csv_pending_ = false;
-      stats_file_ =
-          std::make_unique<AppendingFile>(AppendingFile::openUnder(q_table_dir_, run_folder_ + "/" + kRunEpisodesFile));
+      stats_file_ = std::make_unique<AppendingFile>(
+          AppendingFile::openUnder(settings_.run.q_table_dir, run_folder_ + "/" + kRunEpisodesFile));
     }
     catch (const FileError& e)
     {
@@ -766,8 +652,8 @@ void QLearningControllerNode::startStatsCsv()
   catch (const FileError& e)
   {
     stats_file_.reset();
-    if (!stats_csv_.empty())
-      refuseParameter(pnh_, "stats_csv", "'" + stats_csv_ + "'", e.what());
+    if (!settings_.run.stats_csv.empty())
+      refuseParameter(pnh_, "stats_csv", "'" + settings_.run.stats_csv + "'", e.what());
     ROS_ERROR("qlearning_controller: no learning curve for this run (~stats_csv none silences this): %s", e.what());
     return;
   }
@@ -803,8 +689,8 @@ void QLearningControllerNode::resumeRun()
   QTable table;
   try
   {
-    record = parseRunRecord(readFileUnder(q_table_dir_, run_folder_ + "/" + kRunRecordFile, 1 << 20));
-    table = loadQTableUnder(q_table_dir_, table_path);
+    record = parseRunRecord(readFileUnder(settings_.run.q_table_dir, run_folder_ + "/" + kRunRecordFile, 1 << 20));
+    table = loadQTableUnder(settings_.run.q_table_dir, table_path);
   }
   catch (const FileError& e)
   {
@@ -836,7 +722,7 @@ void QLearningControllerNode::resumeRun()
     finished_training_ = final_saved_ = true;
     ROS_INFO("qlearning_controller: run %s has finished already (%s); nothing left to do", run_folder_.c_str(),
              record.finished.c_str());
-    if (shutdown_when_finished_ && endParentLaunch())
+    if (settings_.shutdown_when_finished && endParentLaunch())
       ROS_INFO("qlearning_controller: ending the launch");
   }
 }
@@ -851,7 +737,7 @@ bool QLearningControllerNode::checkpoint(const std::string& finished, std::strin
   run_.finished = finished;
   try
   {
-    writeFileUnder(q_table_dir_, run_folder_ + "/" + kRunRecordFile, formatRunRecord(run_));
+    writeFileUnder(settings_.run.q_table_dir, run_folder_ + "/" + kRunRecordFile, formatRunRecord(run_));
   }
   catch (const std::exception& e)
   {
@@ -867,7 +753,7 @@ bool QLearningControllerNode::save(const std::string& path, std::string& message
   try
   {
     const std::string resolved = resolve(path);
-    saveQTableUnder(session_->table(), q_table_dir_, path.empty() ? q_table_path_ : path);
+    saveQTableUnder(session_->table(), settings_.run.q_table_dir, path.empty() ? settings_.run.q_table_path : path);
     message = "saved " + std::to_string(session_->table().episodes) + " episodes, " +
               std::to_string(session_->table().steps) + " steps of training to " + resolved;
     return true;
@@ -896,7 +782,8 @@ bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::R
   try
   {
     const std::string path = resolve(request.path);
-    QTable table = loadQTableUnder(q_table_dir_, request.path.empty() ? q_table_path_ : request.path);
+    QTable table =
+        loadQTableUnder(settings_.run.q_table_dir, request.path.empty() ? settings_.run.q_table_path : request.path);
     const std::uint64_t episodes = table.episodes;
     const std::uint64_t steps = table.steps;
     const std::string mismatch = install(std::move(table));
@@ -906,7 +793,7 @@ bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::R
     response.message = "loaded " + path + " (" + std::to_string(episodes) + " episodes, " + std::to_string(steps) +
                        " steps of training)";
     ROS_INFO("qlearning_controller: load_q_table: %s", response.message.c_str());
-    if (learning_ && stats_csv_writer_)
+    if (settings_.run.learning && stats_csv_writer_)
     {
       // Training goes on from the loaded table's episode count; the curve follows it.
       try
@@ -938,11 +825,11 @@ void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
     return;
   for (Robot& robot : robots_)
   {
-    if (robot.silent_reported || secondsSince(robot.last_state_at) < sim_timeout_)
+    if (robot.silent_reported || secondsSince(robot.last_state_at) < settings_.sim_timeout)
       continue;
     robot.silent_reported = true;
     ROS_WARN("qlearning_controller: no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting for it",
-             describe(robot).c_str(), sim_timeout_);
+             describe(robot).c_str(), settings_.sim_timeout);
   }
   const std::vector<std::size_t> dropped = rounds_->dropOuts(WallClock::now());
   for (const std::size_t r : dropped)
@@ -1008,9 +895,10 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
   const std::string changes = learningChangesText(in_use, wanted);
   if (changes.empty())
     return;
-  const char* applies = learning_ ? "gamma from the next update, epsilon and alpha from the next episode"
-                                  : "evaluating, so none of it applies: actions stay greedy (epsilon 0), nothing "
-                                    "is learnt (alpha 0, gamma unused)";
+  const char* applies = settings_.run.learning
+                            ? "gamma from the next update, epsilon and alpha from the next episode"
+                            : "evaluating, so none of it applies: actions stay greedy (epsilon 0), nothing "
+                              "is learnt (alpha 0, gamma unused)";
   if (first && respawned_)
     ROS_WARN("qlearning_controller: restarted; the live tuning of this run before the restart applies again: %s (%s)",
              changes.c_str(), applies);

@@ -7,6 +7,7 @@
 #include "cartpole_qlearning/Reset.h"
 #include "cartpole_qlearning/cartpole_simulation.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
+#include "cartpole_qlearning/node_settings.h"
 #include "cartpole_qlearning/random.h"
 #include "cartpole_qlearning/wall_throttle.h"
 
@@ -32,12 +33,6 @@ public:
   CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, ros::CallbackQueue* command_queue = nullptr);
 
 private:
-  enum class Mode
-  {
-    Realtime,  // steps on a wall timer, holding the last command
-    Lockstep   // steps when the command answering the pending state arrives
-  };
-
   void readParameters();
   void onJointCommand(const sensor_msgs::JointStateConstPtr& msg);
   void onEffort(const std_msgs::Float64ConstPtr& msg);
@@ -67,23 +62,7 @@ private:
   std::mutex mutex_;
 
   // Parameters
-  Mode mode_ = Mode::Realtime;
-  CartPoleParams physics_;
-  double start_state_bound_ = 0.05;
-  std::uint64_t seed_ = 0;
-  double command_timeout_ = 0.5;   // [s] realtime: an older command counts as zero
-  double lockstep_timeout_ = 0.5;  // [s] lockstep: republish the state when unanswered this long
-  double effort_limit_ = 10.0;     // [N]
-  bool publish_clock_ = false;     // lockstep: drive /clock (one lockstep instance per master)
-  bool publish_tf_ = true;
-  double tf_rate_ = 30.0;  // [Hz] lockstep: TF at most this often (wall clock)
-  double track_y_ = 0.0;   // [m] where the track lies along world y (several robots side by side)
-  std::string world_frame_ = "world";
-  std::string cart_frame_ = "cart";
-  std::string pole_frame_ = "pole";
-  double position_noise_std_ = 0.0;  // [m, rad] on published positions
-  double velocity_noise_std_ = 0.0;  // [m/s, rad/s] on published velocities
-  double effort_noise_std_ = 0.0;    // [N] on the applied force
+  SimSettings settings_;
 
   std::unique_ptr<CartPoleSimulation> simulation_;
   std::unique_ptr<RandomStream> noise_;

@@ -16,6 +16,7 @@
 #include "cartpole_qlearning/ros/reset_caller.h"
 #include "cartpole_qlearning/episode_csv.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
+#include "cartpole_qlearning/node_settings.h"
 #include "cartpole_qlearning/robot_rounds.h"
 #include "cartpole_qlearning/training_run.h"
 #include "cartpole_qlearning/training_session.h"
@@ -75,7 +76,7 @@ private:
     bool silent_reported = false;
   };
 
-  void readParameters();
+  void readParameters(bool shutdown_by_default);
   // Serves the learning settings in use on ~set_parameters (dynamic_reconfigure). Called with
   // mutex_ free: the server calls onReconfigure at once, which takes it.
   void startLiveTuning();
@@ -131,35 +132,16 @@ private:
   // services and timer on the manager's): each holds this while it runs.
   std::mutex mutex_;
   std::function<void()> shutdown_;
-  bool shutdown_when_finished_;
 
   // Parameters
-  TrainingConfig config_;
-  bool learning_ = true;  // ~mode: train (true) or evaluate
-  std::uint64_t seed_ = 0;
-  std::string q_table_dir_;
-  std::string q_table_path_ = "q_table.yaml";
-  std::string load_on_start_;
-  std::string run_id_;        // ~run_id: the launch's own id (train.launch: $(anon run))
-  std::string run_folder_;    // this run's folder, relative to q_table_dir_ ("" when evaluating)
+  ControllerSettings settings_;
+  std::string run_folder_;    // this run's folder, relative to settings_.run.q_table_dir ("" when evaluating)
   bool resumed_run_ = false;  // this process is a respawn going on with its run
-  // ~stats_csv: "" the run's folder/episodes.csv (training; none when evaluating), "none" no
-  // file, else a path (relative: under q_table_dir_).
-  std::string stats_csv_;
   std::unique_ptr<AppendingFile> stats_file_;  // opened, its curve not started yet
   std::unique_ptr<EpisodeCsvWriter> stats_csv_writer_;
   bool stats_csv_pending_ = false;  // the default file, opened at the first episode's end
   RunRecord run_;
-  std::uint64_t evaluation_episodes_ = 10;  // evaluate: the verdict after this many episodes (0: never)
   std::uint64_t evaluated_balanced_ = 0;
-  std::uint64_t checkpoint_every_ = 100;
-  bool save_on_shutdown_ = true;
-  double sim_timeout_ = 2.0;                          // [s] wall
-  std::string reset_service_ = "cartpole_sim/reset";  // "": a robot that cannot be reset on command
-  std::vector<std::string> robot_names_{""};
-  bool sync_ = true;
-  ControllerProtocolParams protocol_params_;
-  bool trace_ = false;                    // ~trace: log every update and the table at each episode end
   std::vector<std::string> state_names_;  // as the trace names the rows (trace.h)
 
   bool respawned_ = false;  // this process goes on with the run of a controller that died (openRun)

@@ -1,0 +1,260 @@
+#include "cartpole_qlearning/node_settings.h"
+
+#include "cartpole_qlearning/file_access.h"
+#include "cartpole_qlearning/headless_trainer.h"
+#include "cartpole_qlearning/q_table_file.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+constexpr std::int64_t kMaxRobots = 1000;
+
+// A value of any form as messages show it (for a key whose forms are all wrong).
+std::string anyValueText(const ParameterSource& source, const std::string& key)
+{
+  const auto quoted = [](const std::string& text) { return "'" + text + "'"; };
+  try
+  {
+    std::string text;
+    if (source.get(key, text))
+      return quoted(text);
+  }
+  catch (const ConfigError&)
+  {
+  }
+  try
+  {
+    double number = 0.0;
+    if (source.get(key, number))
+      return SectionReader::numberText(number);
+  }
+  catch (const ConfigError&)
+  {
+  }
+  try
+  {
+    bool flag = false;
+    if (source.get(key, flag))
+      return flag ? "true" : "false";
+  }
+  catch (const ConfigError&)
+  {
+  }
+  try
+  {
+    std::vector<double> numbers;
+    if (source.get(key, numbers))
+      return SectionReader::listText(numbers);
+  }
+  catch (const ConfigError&)
+  {
+  }
+  const std::vector<std::string> keys = source.keysUnder(key);
+  return keys.size() == 1 && keys.front() == key ? "a list of mixed values" : "a map";
+}
+
+std::string listText(const std::vector<std::string>& names)
+{
+  std::string text;
+  for (const std::string& name : names)
+    text += (text.empty() ? "" : ", ") + name;
+  return "[" + text + "]";
+}
+
+// ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
+// the learner's own namespace (N = 1), or robot_0 ... robot_<N-1> (train.launch robots:=N).
+void readRobots(const ParameterSource& source, SectionReader& priv, const ControllerContext& context,
+                std::vector<std::string>& robots)
+{
+  priv.know("robots");
+  const std::string allowed =
+      "a whole number in [1, " + std::to_string(kMaxRobots) + "] or a list of namespaces relative to the controller's";
+  std::int64_t count = 0;
+  bool whole_number = false;
+  try
+  {
+    if (!source.get("robots", count))
+      return;
+    whole_number = true;
+  }
+  catch (const ConfigError&)  // not a whole number: a list, or nothing allowed
+  {
+  }
+  if (whole_number)
+  {
+    if (count < 1 || count > kMaxRobots)
+      priv.fail("robots", std::to_string(count), allowed);
+    robots = robotNamespaces(static_cast<std::size_t>(count));
+    return;
+  }
+  std::vector<std::string> names;
+  try
+  {
+    source.get("robots", names);
+  }
+  catch (const ConfigError&)
+  {
+    priv.fail("robots", anyValueText(source, "robots"), allowed);
+  }
+  if (names.empty() || names.size() > static_cast<std::size_t>(kMaxRobots))
+    priv.fail("robots", listText(names), allowed);
+  for (auto it = names.begin(); it != names.end(); ++it)
+  {
+    const std::string error = it->empty() || !context.name_error ? "" : context.name_error(*it);
+    if (!error.empty())
+      priv.fail("robots", listText(names), "'" + *it + "' is not a valid ROS name: " + error);
+    if (std::find(names.begin(), it, *it) != it)
+      priv.fail("robots", listText(names), "'" + *it + "' is listed twice");
+  }
+  robots = std::move(names);
+}
+}  // namespace
+
+ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& source,
+                                          const ControllerContext& context)
+{
+  ControllerSettings settings;
+  settings.training = readTrainingConfig(shared);
+  RunSettings& run = settings.run;
+  run.name_space = context.name_space;
+  settings.shutdown_when_finished = context.shutdown_by_default;
+
+  // The same reader and checks as the shared sections; a key it does not know (a typo) stops
+  // the node instead of being ignored.
+  SectionReader priv(source, "");
+  // The launch files' stop_when_solved and max_episodes arrive as private parameters; they
+  // override the shared training/ keys for this controller only.
+  priv.read("stop_when_solved", settings.training.limits.stop_when_solved);
+  priv.read("max_episodes", settings.training.limits.max_episodes, 1);
+
+  std::string mode = "train";
+  priv.readChoice("mode", mode, {"train", "evaluate"});
+  run.learning = mode == "train";
+  priv.read("seed", run.seed, 0);
+
+  run.q_table_dir = defaultTableDirectory(context.name_space);
+  priv.read("q_table_dir", run.q_table_dir);
+  if (run.q_table_dir.empty())
+    priv.fail("q_table_dir", "''", "must name a directory");
+  // Paths given as "~/..." (roslaunch passes them on unexpanded) name the user's home.
+  const auto expand_home = [&](const std::string& name, std::string& path) {
+    try
+    {
+      path = expandHome(path, context.home);
+    }
+    catch (const FileError& e)
+    {
+      priv.fail(name, "'" + path + "'", e.what());
+    }
+  };
+  expand_home("q_table_dir", run.q_table_dir);
+  priv.read("q_table_path", run.q_table_path);
+  expand_home("q_table_path", run.q_table_path);
+  try
+  {
+    relativePathUnder(run.q_table_dir, run.q_table_path);
+  }
+  catch (const FileError& e)
+  {
+    priv.fail("q_table_path", "'" + run.q_table_path + "'", e.what());
+  }
+  priv.read("load_on_start", run.load_on_start);
+  expand_home("load_on_start", run.load_on_start);
+  priv.read("stats_csv", run.stats_csv);
+  expand_home("stats_csv", run.stats_csv);
+  if (run.stats_csv != "none" && !run.stats_csv.empty() && run.stats_csv.front() != '/')
+  {
+    try
+    {
+      relativePathUnder(run.q_table_dir, run.stats_csv);
+    }
+    catch (const FileError& e)
+    {
+      priv.fail("stats_csv", "'" + run.stats_csv + "'", e.what());
+    }
+  }
+  priv.read("run_id", run.run_id);
+  // Set by the controller itself, for a respawn of it to find its run.
+  priv.know("run/id");
+  priv.know("run/launcher");
+  priv.know("run/folder");
+  priv.read("evaluation_episodes", run.evaluation_episodes, 0);
+  priv.read("checkpoint_every", run.checkpoint_every, 0);
+  priv.read("save_on_shutdown", run.save_on_shutdown);
+  priv.read("shutdown_when_finished", settings.shutdown_when_finished);
+  priv.readAtLeast("sim_timeout", settings.sim_timeout, 0.0, true);
+  priv.read("reset_service", settings.reset_service);
+
+  ControllerProtocolParams& protocol = settings.protocol;
+  protocol.reset_service = !settings.reset_service.empty();
+  std::array<double, kStateDimensions> region{};
+  region.fill(settings.training.start_state_bound);
+  priv.readDimensions("start_region", region, false);
+  for (std::size_t i = 0; i < kStateDimensions; ++i)
+  {
+    if (!(std::isfinite(region[i]) && region[i] > 0.0))
+      priv.fail("start_region", SectionReader::listText({region.begin(), region.end()}),
+                "must be 4 finite values > 0: |x|, |x_dot|, |theta|, |theta_dot| bounds");
+    protocol.start_region[i] = region[i];
+  }
+  readRobots(source, priv, context, settings.robots);
+  priv.read("sync", settings.sync);
+  priv.read("trace", run.trace);
+  if (run.trace && settings.training.agent.features == FeatureKind::Tiles)
+    priv.fail("trace", "true", "the trace shows one table row per state: learning/features bins only");
+  for (const std::string& key : context.other_keys)
+    priv.know(key);
+  priv.refuseUnknown();
+  protocol.limits = settings.training.limits;
+  return settings;
+}
+
+SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource& source)
+{
+  SimSettings settings;
+  readPhysics(shared, settings.physics, settings.start_state_bound);
+
+  // The same reader and checks as the shared sections; a key it does not know (a typo such as
+  // lockstep_timout) stops the node instead of being ignored.
+  SectionReader priv(source, "");
+  std::string mode = "realtime";
+  priv.readChoice("mode", mode, {"realtime", "lockstep"});
+  settings.mode = mode == "lockstep" ? SimMode::Lockstep : SimMode::Realtime;
+  priv.read("seed", settings.seed, 0);
+  priv.readAtLeast("command_timeout", settings.command_timeout, 0.0, true);
+  priv.readAtLeast("lockstep_timeout", settings.lockstep_timeout, 0.0, true);
+  priv.readAtLeast("tf_rate", settings.tf_rate, 0.0, true);
+  settings.effort_limit = settings.physics.force_mag;
+  priv.readAtLeast("effort_limit", settings.effort_limit, 0.0, true);
+  if (settings.effort_limit > settings.physics.force_mag)
+    priv.fail("effort_limit", SectionReader::numberText(settings.effort_limit),
+              "must be <= physics/force_mag = " + SectionReader::numberText(settings.physics.force_mag));
+  priv.readAtLeast("position_noise_std", settings.position_noise_std, 0.0, false);
+  priv.readAtLeast("velocity_noise_std", settings.velocity_noise_std, 0.0, false);
+  priv.readAtLeast("effort_noise_std", settings.effort_noise_std, 0.0, false);
+  priv.read("publish_clock", settings.publish_clock);
+  priv.read("publish_tf", settings.publish_tf);
+  priv.read("track_y", settings.track_y);
+  if (!std::isfinite(settings.track_y))
+    priv.fail("track_y", SectionReader::numberText(settings.track_y), "must be finite");
+  for (const auto& [name, frame] : {std::pair<const char*, std::string*>{"world_frame", &settings.world_frame},
+                                    {"cart_frame", &settings.cart_frame},
+                                    {"pole_frame", &settings.pole_frame}})
+  {
+    priv.read(name, *frame);
+    if (frame->empty())
+      priv.fail(name, "''", "frame names must not be empty");
+  }
+  priv.refuseUnknown();
+  if (settings.publish_clock && settings.mode != SimMode::Lockstep)
+    priv.fail("publish_clock", "true", "only in lockstep mode: in realtime the wall clock is the clock");
+  return settings;
+}
+
+}  // namespace cartpole_qlearning
