@@ -41,50 +41,53 @@ void usage(std::ostream& out)
          "                      [--stats-csv FILE] [--quiet] [--returns] [--trace]\n"
          "       train_headless --evaluate TABLE [--episodes N] [--config FILE] [--seed N] [--robots N] [--ns NS]\n"
          "       train_headless --replay FILE [--config FILE] [--seed N] [--save PATH]\n"
-         "Trains as train.launch's controller does, with the core alone (no ROS master), and writes what it\n"
-         "writes. Paths: a relative path is under the table folder $ROS_HOME/cartpole_qlearning/NS (~/.ros/...),\n"
-         "where the launch files and the controller's services look; an absolute path is your own.\n"
+         "Trains as train.launch's controller does, with the core alone (no ROS master), writes what it writes and\n"
+         "prints what it logs. Training ends with \"solved=true|false episodes=N steps=M wall_s=T\" (N and M count\n"
+         "a loaded or resumed table's own), an evaluation with \"evaluated=N balanced=M mean_return=R\".\n"
+         "Paths (--save, --load, --resume, --evaluate, --stats-csv): a relative path is under the table folder\n"
+         "$ROS_HOME/cartpole_qlearning/NS (~/.ros/cartpole_qlearning/cartpole by default), where the launch files\n"
+         "and the controller's services look; an absolute path is your own (links followed as the shell would).\n"
+         "A training run has its own folder there, runs/<date>_<time>_<ns>_seed<N>, as the controller's has: its\n"
+         "table at every checkpoint, at the end and on Ctrl-C (q_table.yaml), its record (run.yaml) and its curve\n"
+         "(episodes.csv). A solved run also replaces the default table; an unsolved one leaves it as it was.\n"
          "  --config FILE        physics, task, learning and training parameters (YAML); default: the package's\n"
          "                       config/cartpole.yaml\n"
-         "  --seed N             seed of the start states and of exploration (default 0; --resume: the run's)\n"
-         "  --robots N           N simulated robots feed one learner, served in lockstep rounds in robot order (as\n"
-         "                       train.launch robots:=N, whose namespaces robot_0 ... the messages use); robot r\n"
-         "                       starts from seed S + r (default 1)\n"
-         "  --ns NS              the namespace whose table folder paths are under (default cartpole)\n"
-         "  --max-episodes N     override training/max_episodes (counted from a loaded table's episodes)\n"
-         "  --save PATH          the table a solved run replaces (the controller's ~q_table_path; default\n"
-         "                       q_table.yaml, which evaluate.launch loads); an unsolved run leaves it as it was\n"
-         "                       and says where its own table is\n"
-         "  Each training run has its own folder, runs/<time>_<ns>_seed<N> under the table folder, as the\n"
-         "  controller's: its table (at the end, at every checkpoint and on Ctrl-C), its record (run.yaml) and\n"
-         "  its curve (episodes.csv).\n"
+         "  --seed N             seed of the start states and of exploration (default 0; with --resume the run's)\n"
+         "  --robots N           N simulated robots feed one learner, served in lockstep rounds in robot order, as\n"
+         "                       train.launch robots:=N (named by its namespaces robot_0 ...); robot r starts from\n"
+         "                       seed N + r (default 1)\n"
+         "  --ns NS              the namespace whose table folder the paths are under (default cartpole)\n"
+         "  --max-episodes N     override training/max_episodes (a loaded or resumed table's episodes count)\n"
+         "  --save PATH          the default table (the controller's ~q_table_path; default q_table.yaml, which\n"
+         "                       evaluate.launch loads), replaced only by a solved run\n"
          "  --checkpoint-every N a checkpoint into the run's folder every N episodes (default 100; 0: none)\n"
-         "  --no-run-folder      no run folder (no checkpoints, record or curve; nothing saved on Ctrl-C), and no\n"
-         "                       table but --save's: for scripts that run it many times\n"
-         "  --load TABLE         train further from a table: its episode and step counts go on, and with them\n"
-         "                       the schedules (epsilon, alpha) and --max-episodes\n"
-         "  --resume FOLDER      go on from a run folder's last checkpoint (e.g. "
-         "runs/2026-12-01_20-05-00_cartpole_seed0,\n"
-         "                       as the start of a run says): its counters, schedules, solved window and curve;\n"
-         "                       give the run's --config (and --robots)\n"
-         "  --evaluate TABLE     run TABLE greedily, learning nothing and writing nothing, then print\n"
-         "                       \"evaluated=N balanced=M mean_return=R\" (balanced: reached the step limit)\n"
+         "  --no-run-folder      write no run folder (no checkpoints, record or curve, nothing on Ctrl-C) and no\n"
+         "                       table but --save's (when solved): for scripts that run it many times\n"
+         "  --load TABLE         train further from a table: its episode and step counts go on, and with them the\n"
+         "                       schedules (epsilon, alpha) and --max-episodes\n"
+         "  --resume FOLDER      go on from the last checkpoint of a run folder under the table folder (runs/...,\n"
+         "                       as a run's first line says): its counters, schedules, solved window and curve;\n"
+         "                       give the run's --config and --robots. A finished run has nothing left to do:\n"
+         "                       --load its q_table.yaml to train it further\n"
+         "  --evaluate TABLE     run TABLE greedily, learning nothing and writing nothing; then M is how many of\n"
+         "                       the N episodes balanced to the step limit, R the mean return of the last\n"
+         "                       task/solved_window episodes (100: all of them by default)\n"
          "  --episodes N         with --evaluate: how many episodes (default 100)\n"
          "  --stats-csv FILE     one CSV row per episode, as each ends (the learning curve, for rosrun\n"
-         "                       cartpole_qlearning plot_learning_curve FILE); default: the run's episodes.csv;\n"
-         "                       'none': no file. An earlier curve there is replaced, any other file refused\n"
-         "  --quiet              only warnings, errors and the result line\n"
-         "  --returns            before the result line, one line \"returns=R1 R2 ...\": every episode's return,\n"
+         "                       cartpole_qlearning plot_learning_curve FILE) instead of the run's episodes.csv;\n"
+         "                       none: no curve. An earlier curve there is replaced, any other file refused\n"
+         "  --quiet              nothing but warnings, errors and the result line\n"
+         "  --returns            before the result line, one line \"returns=R1 R2 ...\": every episode's return\n"
          "                       in order\n"
-         "  --trace              print every update as the tutorial works it (state, action, reward, next\n"
-         "                       state, old Q, target, new Q) and the Q-table at each episode's end\n"
+         "  --trace              print every update as the tutorial works it (state, action, reward, next state,\n"
+         "                       old Q, target, new Q) and the Q-table at each episode's end\n"
          "  --replay FILE        train on nothing else than the transitions listed in FILE ([state, action,\n"
          "                       reward, next state], states named as the config's learning/state_names), traced\n"
          "                       as --trace does; --save writes its table; e.g. --config\n"
          "                       config/tutorial_4_states.yaml --replay config/tutorial_10_steps.yaml\n"
-         "Ctrl-C (SIGINT or SIGTERM) saves the table into the run's folder, as the controller does when it is\n"
-         "stopped, and exits with 128 + the signal's number. Exit 1: a table could not be saved; 2: a bad\n"
-         "argument, config or table (the message names it).\n";
+         "Ctrl-C (SIGINT) or SIGTERM saves the table into the run's folder, as the controller does when stopped,\n"
+         "and exits with 128 + the signal's number. Exit 1: a table could not be saved; 2: a bad argument, config,\n"
+         "table or folder (the message names it).\n";
 }
 
 bool parseCount(const std::string& text, std::uint64_t& value)
@@ -316,6 +319,18 @@ int run(int argc, char** argv)
     return 2;
   }
   const std::string table_dir = defaultTableDirectory(name_space);
+  // A relative --save must stay in the table folder, as over a service: said before training.
+  if (!save_path.empty() && save_path.front() != '/')
+  {
+    try
+    {
+      relativePathUnder(table_dir, save_path);
+    }
+    catch (const FileError& e)
+    {
+      return refuse("--save", save_path, e.what());
+    }
+  }
 
   // Only the trace and the replay name states (one name per table row: built for them alone).
   const std::vector<std::string> names =
@@ -366,14 +381,14 @@ int run(int argc, char** argv)
   }
 
   // --resume: the run's own seed unless another is given (its record says which).
-  if (!resume_folder.empty() && !seed_given)
+  RunRecord resumed;
+  if (!resume_folder.empty())
   {
     try
     {
-      seed = parseRunRecord(resume_folder.front() == '/'
-                                ? readFile(resume_folder + "/" + kRunRecordFile, 1 << 20)
-                                : readFileUnder(table_dir, resume_folder + "/" + kRunRecordFile, 1 << 20))
-                 .seed;
+      resumed = parseRunRecord(readFileUnder(table_dir, resume_folder + "/" + kRunRecordFile, 1 << 20));
+      if (!seed_given)
+        seed = resumed.seed;
     }
     catch (const FileError&)
     {
@@ -417,7 +432,7 @@ int run(int argc, char** argv)
   }
   catch (const RunSettingError& e)
   {
-    std::cerr << "train_headless: --stats-csv " << e.value << " is not allowed (" << e.why << ")\n";
+    std::cerr << "train_headless: --stats-csv " << stats_csv_path << " is not allowed (" << e.why << ")\n";
     return 2;
   }
   catch (const ConfigError& e)
@@ -431,7 +446,13 @@ int run(int argc, char** argv)
     return 2;
   }
   if (application->finished())
+  {
+    // A resumed run that had finished: nothing to train; its counts, as a result line.
+    const EpisodeSummary& last = trainer.session().lastEpisode();
+    std::printf("solved=%s episodes=%llu steps=%llu wall_s=0.000000\n", resumed.finished == "solved" ? "true" : "false",
+                static_cast<unsigned long long>(last.episode), static_cast<unsigned long long>(last.total_steps));
     return 0;
+  }
 
   struct sigaction action = {};
   action.sa_handler = onSignal;
@@ -471,6 +492,28 @@ int run(int argc, char** argv)
   }
   else
   {
+    // A solved run's default table that could not be written is said in the final line above;
+    // it is an error all the same.
+    const EpisodeSummary& end = trainer.session().lastEpisode();
+    if (!stopped && end.solved && !settings.q_table_path.empty())
+    {
+      bool written = false;
+      try
+      {
+        const QTable saved = loadQTableFile(application->resolve(""));
+        written =
+            saved.episodes == trainer.session().table().episodes && saved.steps == trainer.session().table().steps;
+      }
+      catch (const FileError&)
+      {
+      }
+      if (!written)
+      {
+        std::fflush(stdout);
+        std::fprintf(stderr, "train_headless: the table was not saved to %s\n", application->resolve("").c_str());
+        error = true;
+      }
+    }
     // The session's counts: a loaded or resumed table's episodes included, as the node counts them.
     // Microseconds: a run to solved takes a few milliseconds.
     const EpisodeSummary& last = trainer.session().lastEpisode();
