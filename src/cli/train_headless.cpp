@@ -526,6 +526,9 @@ int run(int argc, char** argv)
 
 int main(int argc, char** argv)
 {
+  // Line by line, as the node logs: a log file followed with tail -f (or cut short by kill -9)
+  // holds whole lines up to the last one said.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   // What the checks above did not foresee still ends with a message and exit 2, not an abort.
   try
   {
