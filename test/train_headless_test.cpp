@@ -289,6 +289,14 @@ TEST_F(TrainHeadlessTest, LoadTrainsFurtherFromTheTablesCounters)
   EXPECT_EQ(static_cast<double>(table.steps) + sum, std::stod(result[1].str()));
   EXPECT_EQ((std::vector<unsigned long>{31, 32, 33, 34, 35, 36, 37, 38, 39, 40}), curveEpisodes(curve));
 
+  // A table at or past --max-episodes has nothing to train.
+  const CommandRun past = trainHeadless(config() + " --load " + folder + "/q_table.yaml --max-episodes 30");
+  EXPECT_EQ(2, past.status) << past.output;
+  EXPECT_NE(std::string::npos, past.output.find("--load " + folder +
+                                                "/q_table.yaml: its table has 30 episodes of training already, and "
+                                                "training ends at episode 30"))
+      << past.output;
+
   // The schedules go on from episode 30: the same epsilon and alpha as a run that never stopped.
   const std::string straight = file("straight.csv");
   ASSERT_EQ(

@@ -396,6 +396,30 @@ int run(int argc, char** argv)
     }
   }
 
+  // Training goes on from a table's episode count, and max_episodes counts it: a table at or past
+  // it has nothing to train (else one episode would run). A resumed run that has finished says
+  // so below; a table that cannot be read is said by RunApplication.
+  if (!resume_folder.empty() || !load_path.empty())
+  {
+    std::uint64_t episodes = 0;
+    try
+    {
+      episodes = !resume_folder.empty()     ? (resumed.finished.empty() ? resumed.episodes : 0)
+                 : load_path.front() == '/' ? loadQTableFile(load_path).episodes
+                                            : loadQTableUnder(table_dir, load_path).episodes;
+    }
+    catch (const FileError&)
+    {
+    }
+    if (episodes >= config.limits.max_episodes)
+    {
+      std::cerr << "train_headless: " << (resume_folder.empty() ? "--load " + load_path : "--resume " + resume_folder)
+                << ": its table has " << episodes << " episodes of training already, and training ends at episode "
+                << config.limits.max_episodes << " (--max-episodes, else training/max_episodes): nothing to train\n";
+      return 2;
+    }
+  }
+
   // The settings the controller reads from its private parameters, from the command line.
   RunSettings settings;
   settings.learning = !evaluating;
