@@ -701,9 +701,27 @@ TEST_F(RunApplicationTest, ServicesTakePathsUnderTheTableFolderOnly)
     EXPECT_EQ(Said::Level::Warn, said(load.said, "load_q_table: refused").level);
   }
   EXPECT_FALSE(fs::exists(dir_.parent_path() / "outside.yaml"));
-  // A link out of the folder is refused too.
-  fs::create_directory_symlink(fs::temp_directory_path(), dir_ / "link");
-  EXPECT_FALSE(run.app->save("link/outside.yaml").success);
+  // Links out of the folder, to a folder or to a file, are refused both ways: nothing written or
+  // read there.
+  const fs::path outside = dir_.string() + "_outside";
+  fs::create_directories(outside);
+  saveQTableFile(run.session->table(), (outside / "secret.yaml").string());
+  const std::string secret = text(outside / "secret.yaml");
+  fs::create_directory_symlink(outside, dir_ / "link");
+  fs::create_symlink(outside / "secret.yaml", dir_ / "file_link.yaml");
+  for (const std::string path : {"link/new.yaml", "nope/../link/new.yaml", "link/secret.yaml", "file_link.yaml"})
+  {
+    const ServiceAnswer save = run.app->save(path);
+    EXPECT_FALSE(save.success) << path << ": " << save.message;
+    const ServiceAnswer load = run.app->load(path);
+    EXPECT_FALSE(load.success) << path << ": " << load.message;
+    EXPECT_NE(std::string::npos, load.message.find("unchanged")) << load.message;
+  }
+  EXPECT_EQ(1u, run.session->episodesEnded());
+  EXPECT_EQ(std::vector<fs::path>{outside / "secret.yaml"},
+            std::vector<fs::path>(fs::directory_iterator(outside), fs::directory_iterator()));
+  EXPECT_EQ(secret, text(outside / "secret.yaml"));
+  fs::remove_all(outside);
   EXPECT_THROW(run.app->resolve("../x.yaml"), QTableFileError);
   // Empty: the default table.
   const ServiceAnswer saved = run.app->save("");

@@ -1,8 +1,9 @@
 // train.launch as a user runs it (roslaunch, a ROS_HOME of the test's own, this test's master):
-// a solved run ends the launch cleanly (exit 0, no "REQUIRED process has died"); a shorter,
-// unsolved run afterwards leaves the solved default table byte for byte and keeps its own
-// folder; another namespace has its own tables; kill -9 of the sim or of the controller does not
-// end training: the node respawns and the controller goes on from its run's last checkpoint.
+// a solved run ends the launch cleanly (exit 0, no "REQUIRED process has died") with the default
+// table written in its namespace's folder under ROS_HOME; kill -9 of the sim, of the controller
+// or of the nodelet manager does not end training: the node respawns and the controller goes on
+// from its run's last checkpoint. What the run decides (which save replaces the default table,
+// run folders, the record, the curve of a resumed run) is RunApplicationTest's (core_tests).
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/q_table_file.h"
 #include "cartpole_qlearning/training_run.h"
@@ -124,29 +125,11 @@ void expectGoesOnFromItsCheckpoint(const Launch& run, Episodes& episodes, const 
       EXPECT_GT(episodes.seen[i], checkpoint) << "the episode counter went back to " << episodes.seen[i];
   }
   EXPECT_EQ(1u, runFolders(ns).size());
-
-  // The run's learning curve goes on in the same file: one header, every episode once, in order
-  // (the rows after the checkpoint, which the run played again, were replaced). The last line
-  // may be in the middle of being written.
-  const std::string csv = fileText((folder / "episodes.csv").string());
-  std::istringstream lines(csv.substr(0, csv.rfind('\n') + 1));
-  std::string line;
-  ASSERT_TRUE(std::getline(lines, line)) << "no episodes.csv in " << folder;
-  EXPECT_EQ(0u, line.find("episode,robot,steps,")) << line;
-  std::uint64_t rows = 0;
-  while (std::getline(lines, line))
-  {
-    ++rows;
-    ASSERT_EQ(std::to_string(rows) + ",", line.substr(0, line.find(',') + 1))
-        << "row " << rows << " of " << folder / "episodes.csv"
-        << " after the restart";
-  }
-  EXPECT_GT(rows, checkpoint);
 }
 
-TEST(TrainLaunch, ASolvedRunEndsCleanlyAndLaterUnsolvedRunsLeaveItsTable)
+TEST(TrainLaunch, ASolvedRunEndsCleanlyWithItsTableInItsNamespacesFolder)
 {
-  // 1. Train to solved: the launch ends by itself, exit 0, and nothing looks like a crash.
+  // Train to solved: the launch ends by itself, exit 0, and nothing looks like a crash.
   {
     Launch run("solved", "ns:=first");
     const int status = run.waitFor(150.0);
@@ -159,33 +142,7 @@ TEST(TrainLaunch, ASolvedRunEndsCleanlyAndLaterUnsolvedRunsLeaveItsTable)
   }
   const std::string default_table = tables("first") + "/q_table.yaml";
   ASSERT_TRUE(fs::exists(default_table)) << "the solved run did not write the default table";
-  const std::string solved = fileText(default_table);
   ASSERT_EQ(1u, runFolders("first").size());
-  const fs::path solved_run = runFolders("first").front();
-  EXPECT_EQ(solved, fileText((solved_run / cartpole_qlearning::kRunTableFile).string()));
-  EXPECT_EQ("solved", cartpole_qlearning::parseRunRecord(fileText((solved_run / "run.yaml").string())).finished);
-
-  // 2. A short run that cannot solve: its table goes to a folder of its own, the solved default
-  //    table stays byte for byte, and the console says so.
-  {
-    Launch run("short", "ns:=first max_episodes:=5");
-    ASSERT_EQ(0, run.waitFor(90.0)) << run.output();
-    EXPECT_NE(std::string::npos, run.output().find("left as it was")) << run.output();
-  }
-  EXPECT_EQ(solved, fileText(default_table)) << "an unsolved run replaced the solved default table";
-  const std::vector<fs::path> folders = runFolders("first");
-  ASSERT_EQ(2u, folders.size());
-  const fs::path short_run = folders[0] == solved_run ? folders[1] : folders[0];
-  EXPECT_EQ(5u, cartpole_qlearning::loadQTableFile((short_run / "q_table.yaml").string()).episodes);
-
-  // 3. Another namespace: tables of its own, nothing of "first" touched.
-  {
-    Launch run("other", "ns:=second max_episodes:=3");
-    ASSERT_EQ(0, run.waitFor(90.0)) << run.output();
-  }
-  EXPECT_EQ(1u, runFolders("second").size());
-  EXPECT_EQ(2u, runFolders("first").size());
-  EXPECT_EQ(solved, fileText(default_table));
 }
 
 TEST(TrainLaunch, ABadParameterEndsTheLaunchInsteadOfRespawningIntoTheSameError)

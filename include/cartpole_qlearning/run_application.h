@@ -125,11 +125,13 @@ public:
   // when `previous` names this very run (same id and launcher: a respawn), goes on from its
   // checkpoint. launcher: this process's roslaunch (else parent) pid, 0 when not applicable
   // (train_headless). Throws ConfigError naming the parameter for what must stop the node: a
-  // ~load_on_start table that cannot be used, a ~stats_csv that cannot be written, a checkpoint
-  // that does not fit the configuration.
+  // ~load_on_start table that cannot be used, a ~stats_csv that cannot be written (a
+  // RunSettingError), a checkpoint that does not fit the configuration.
   Saying start(const RunIdentity& previous = {}, int launcher = 0);
   // train_headless --resume FOLDER: goes on from that run folder's checkpoint (relative: under
-  // the table folder). Throws ConfigError when it holds no usable checkpoint.
+  // the table folder), instead of start(): ~load_on_start plays no part, the curve keeps the rows
+  // the checkpoint covers. Throws ConfigError when it holds no usable checkpoint, when the folder
+  // escapes the table folder, or when evaluating.
   Saying resume(const std::string& folder);
 
   // An episode has just ended on robot `robot` (its namespace, "" for the learner's own): the

@@ -6,7 +6,9 @@
 
 #include <condition_variable>
 #include <mutex>
+#include <optional>
 #include <utility>
+#include <vector>
 
 namespace cartpole_qlearning
 {
@@ -14,27 +16,29 @@ namespace cartpole_qlearning
 // after the ResetCaller is gone, so it is all the thread may touch.
 struct ResetCaller::Shared
 {
+  // A call back, for run() to feed to ResetCalls.
+  struct Returned
+  {
+    std::uint64_t generation = 0;
+    bool called = true;  // false: the thread was given up before it took its call
+    bool answered = false;
+    std::string message;
+  };
+
   std::mutex mutex;
   std::condition_variable changed;
-  bool pending = false;   // a reset is wanted
-  bool stopping = false;  // the ResetCaller is going away
-  // The one calling thread whose answers count; a thread given up sees another number and ends.
+  bool stopping = false;   // the ResetCaller is going away
+  bool requested = false;  // request() since run() last looked
+  std::vector<Returned> returned;
+  // The calling thread whose calls count; a thread of another generation was given up and ends.
   std::uint64_t generation = 0;
-  // Given-up threads still blocked in their call. While one is, the next call is not given up
-  // too: a sim stuck in its callback would otherwise cost a thread and a socket every give-up.
-  int blocked = 0;
-  // A call handed to the current thread, and its answer.
-  bool asked = false;
-  bool persistent = true;
-  bool done = false;
-  bool answered = false;
-  std::string message;
+  // A call handed to the current thread: on the persistent connection or a fresh one.
+  std::optional<bool> handed;
 };
 
 ResetCaller::ResetCaller(std::string service, std::chrono::steady_clock::duration give_up_after)
-  : service_(std::move(service)), give_up_after_(give_up_after), shared_(std::make_shared<Shared>())
+  : service_(std::move(service)), calls_(service_, give_up_after), shared_(std::make_shared<Shared>())
 {
-  caller_ = std::thread(&ResetCaller::callLoop, shared_, shared_->generation, service_);
   thread_ = std::thread(&ResetCaller::run, this);
 }
 
@@ -52,7 +56,7 @@ void ResetCaller::request()
 {
   {
     std::lock_guard<std::mutex> lock(shared_->mutex);
-    shared_->pending = true;
+    shared_->requested = true;
   }
   shared_->changed.notify_all();
 }
@@ -67,18 +71,19 @@ void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t 
     bool persistent = true;
     {
       std::unique_lock<std::mutex> lock(shared->mutex);
-      shared->changed.wait(lock, [&] { return shared->stopping || shared->generation != generation || shared->asked; });
+      shared->changed.wait(lock,
+                           [&] { return shared->stopping || shared->generation != generation || shared->handed; });
       if (shared->generation != generation)
       {
-        // Given up before it even took its call (a starved thread): counted as blocked all the same.
-        --shared->blocked;
+        // Given up before it even took its call (a starved thread): it frees its slot all the same.
+        shared->returned.push_back({generation, false, false, ""});
         shared->changed.notify_all();
         return;
       }
       if (shared->stopping)
         return;
-      shared->asked = false;
-      persistent = shared->persistent;
+      persistent = *shared->handed;
+      shared->handed.reset();
     }
     Reset reset;  // empty state: a random start
     bool answered = false;
@@ -92,9 +97,8 @@ void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t 
     }
     else
     {
-      // While the sim is away or restarting, each try makes a connection of its own: roscpp's
-      // persistent links can hang across a server's restart (ros/ros_comm#149, #152). The
-      // persistent link is made again once the sim answers.
+      // A connection of its own (see ResetCalls): the persistent link is made again once the sim
+      // answers.
       persistent_client = ros::ServiceClient();
       answered =
           ros::ServiceClient(service, false, ros::M_string(), ros::service_traits::md5sum<Reset>()).call(reset) &&
@@ -102,93 +106,62 @@ void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t 
     }
     {
       std::lock_guard<std::mutex> lock(shared->mutex);
-      if (shared->generation != generation)
-      {
-        --shared->blocked;  // given up while the call hung: nobody waits for this answer any more
-        shared->changed.notify_all();
+      shared->returned.push_back({generation, true, answered, reset.response.message});
+      shared->changed.notify_all();
+      if (shared->generation != generation || shared->stopping)
         return;
-      }
-      if (shared->stopping)
-        return;
-      shared->done = true;
-      shared->answered = answered;
-      shared->message = reset.response.message;
     }
-    shared->changed.notify_all();
   }
 }
 
 void ResetCaller::run()
 {
-  // A failing robot is called again no sooner than this later, not in a tight loop.
-  const auto retry_after = std::chrono::milliseconds(200);
-  auto retry_at = std::chrono::steady_clock::time_point::min();
-  bool failing = false;
   std::unique_lock<std::mutex> lock(shared_->mutex);
+  const auto woken = [this] { return shared_->stopping || shared_->requested || !shared_->returned.empty(); };
   for (;;)
   {
-    while (!shared_->stopping && !(shared_->pending && std::chrono::steady_clock::now() >= retry_at))
-    {
-      if (shared_->pending)
-        shared_->changed.wait_until(lock, retry_at);
-      else
-        shared_->changed.wait(lock);
-    }
+    if (wake_at_ == ResetCalls::Clock::time_point::max())
+      shared_->changed.wait(lock, woken);
+    else
+      shared_->changed.wait_until(lock, wake_at_, woken);
+    const auto now = ResetCalls::Clock::now();
+    for (const Shared::Returned& back : std::exchange(shared_->returned, {}))
+      carryOut(back.called ? calls_.onReturn(back.generation, back.answered, back.message, now)
+                           : calls_.onThreadEnded(back.generation, now));
     if (shared_->stopping)
       break;
-    // Taken before the call: a request made while the call is under way (a short episode can
-    // end before the answer comes) is then served by the next call, not lost.
-    shared_->pending = false;
-    shared_->asked = true;
-    shared_->persistent = !failing;
-    shared_->done = false;
-    shared_->changed.notify_all();
-    const auto give_up_at = std::chrono::steady_clock::now() + give_up_after_;
-    // A call given up earlier and still blocked: this one is waited for as long as it takes (a
-    // third connection would hang behind the same stuck sim).
-    if (!shared_->changed.wait_until(lock, give_up_at, [&] { return shared_->done || shared_->stopping; }) &&
-        shared_->blocked > 0)
-      shared_->changed.wait(lock, [&] { return shared_->done || shared_->stopping; });
-    if (!shared_->done && !shared_->stopping)
-    {
-      ++shared_->generation;
-      ++shared_->blocked;
-      caller_.detach();
-      ROS_WARN(
-          "qlearning_controller: reset call to %s has not returned after %.1f s; giving it up and retrying on a "
-          "new connection",
-          service_.c_str(), std::chrono::duration<double>(give_up_after_).count());
-      failing = true;
-      shared_->pending = true;
-      retry_at = std::chrono::steady_clock::now();
-      caller_ = std::thread(&ResetCaller::callLoop, shared_, shared_->generation, service_);
-      continue;
-    }
-    if (!shared_->done)
-    {
-      // Stopping while a call is under way: it is given up, as a hung one, without a wait.
-      ++shared_->generation;
-      ++shared_->blocked;
-      caller_.detach();
-      return;
-    }
-    if (shared_->answered)
-    {
-      if (failing)
-        ROS_INFO("qlearning_controller: %s answers again; going on", service_.c_str());
-      failing = false;
-      continue;
-    }
-    if (!failing)
-      ROS_WARN("qlearning_controller: reset call to %s failed%s; retrying until it answers", service_.c_str(),
-               shared_->message.empty() ? "" : (": " + shared_->message).c_str());
-    failing = true;
-    shared_->pending = true;
-    retry_at = std::chrono::steady_clock::now() + retry_after;
+    if (std::exchange(shared_->requested, false))
+      carryOut(calls_.request(now));
+    carryOut(calls_.onTime(now));
   }
-  // No call under way: the calling thread sees stopping and ends at once.
+  carryOut(calls_.stop());
+  // No call under way any more: a thread still current sees stopping and ends at once.
   lock.unlock();
-  caller_.join();
+  if (caller_.joinable())
+    caller_.join();
+}
+
+void ResetCaller::carryOut(const ResetCalls::Orders& orders)
+{
+  if (orders.give_up && caller_.joinable())
+    caller_.detach();  // blocked in its call, or about to see that it was given up
+  shared_->generation = calls_.generation();
+  for (const ResetCalls::Say& say : orders.say)
+  {
+    if (say.level == ResetCalls::Say::Level::Warn)
+      ROS_WARN("qlearning_controller: %s", say.text.c_str());
+    else
+      ROS_INFO("qlearning_controller: %s", say.text.c_str());
+  }
+  if (orders.call)
+  {
+    if (!caller_.joinable())
+      caller_ = std::thread(&ResetCaller::callLoop, shared_, orders.call->generation, service_);
+    shared_->handed = orders.call->persistent;
+  }
+  if (orders.give_up || orders.call)
+    shared_->changed.notify_all();
+  wake_at_ = orders.wake_at;
 }
 
 }  // namespace cartpole_qlearning

@@ -19,10 +19,10 @@ bool startNode(const std::string& name, const std::function<void()>& start, std:
   }
   catch (const std::exception& e)
   {
-    const std::string logger = std::string(ROSCONSOLE_DEFAULT_NAME) + "." + name;
-    ROS_FATAL_STREAM_NAMED(logger, name << ": " << e.what());
+    // ros.cartpole_qlearning.<name>: the logger the node logs on afterwards.
+    ROS_FATAL_STREAM_NAMED(name, name << ": " << e.what());
     if (endParentLaunch())
-      ROS_FATAL_STREAM_NAMED(logger, name << ": ending the launch: this cannot work until the above is fixed");
+      ROS_FATAL_STREAM_NAMED(name, name << ": ending the launch: this cannot work until the above is fixed");
     if (reason != nullptr)
       *reason = e.what();
     return false;

@@ -6,6 +6,9 @@
 // up), and publishes episode_stats. Several robots are served in lockstep rounds (RobotRounds)
 // unless ~sync is false. It saves and loads its Q-table through services, and serves its learning
 // settings (epsilon, alpha, gamma and their schedules) for live tuning with dynamic_reconfigure.
+// What a run writes and decides (its folder, checkpoints, resume, the curve, which save replaces
+// the default table, the evaluation verdict) is the core's RunApplication: the node carries it out
+// and logs what it says on its named logger (ros.cartpole_qlearning.qlearning_controller).
 #pragma once
 
 #include "cartpole_qlearning/EpisodeStats.h"
@@ -14,11 +17,10 @@
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/ros/reset_caller.h"
-#include "cartpole_qlearning/episode_csv.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
 #include "cartpole_qlearning/node_settings.h"
 #include "cartpole_qlearning/robot_rounds.h"
-#include "cartpole_qlearning/training_run.h"
+#include "cartpole_qlearning/run_application.h"
 #include "cartpole_qlearning/training_session.h"
 #include "cartpole_qlearning/wall_throttle.h"
 
@@ -48,11 +50,12 @@ public:
   // shutdown_by_default), the controller ends the roslaunch that started it, as Ctrl-C would
   // (launch_control.h); when no roslaunch started it, it calls shutdown: the executable ends
   // there; a nodelet ends its manager only when asked. state_queue: where the joint_states callbacks queue (nullptr:
-  // nh's queue); a nodelet passes the queue its lockstep thread serves. Throws ConfigError naming a bad parameter,
-  // QTableFileError for a bad ~load_on_start file.
+  // nh's queue); a nodelet passes the queue its lockstep thread serves. Throws ConfigError naming a bad parameter
+  // (a ~load_on_start table or ~stats_csv that cannot be used included).
   QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::function<void()> shutdown,
                           bool shutdown_by_default, ros::CallbackQueue* state_queue = nullptr);
-  // Saves the table when ~save_on_shutdown (training), after giving up any reset call under way.
+  // Saves the table when ~save_on_shutdown (training, RunApplication::shutdown), after giving up
+  // any reset call under way.
   ~QLearningControllerNode();
 
   QLearningControllerNode(const QLearningControllerNode&) = delete;
@@ -72,7 +75,6 @@ private:
     ros::Time held_stamp;                   // a new state waiting for its round
     CartPoleState held_state;
     std::chrono::steady_clock::time_point last_state_at;
-    std::chrono::steady_clock::time_point last_episode_end;
     bool silent_reported = false;
   };
 
@@ -83,20 +85,9 @@ private:
   // A change from a dynamic_reconfigure client: applied when the core accepts it, else refused
   // with the values in use put back into config (what the server then keeps and reports).
   void onReconfigure(LearningConfig& config, std::uint32_t level);
-  // Training: starts this run's folder, or continues it when this process is a respawn of the
-  // controller that started it (the same ~run_id).
-  void openRun();
-  void resumeRun();
-  // ~stats_csv: the file a user named is opened before the run starts (a bad one stops the node
-  // naming the parameter); the curve itself starts once the run is known (fresh, or going on
-  // from the checkpoint a respawn resumed).
-  void openStatsFile();
-  void startStatsCsv();
-  void writeStatsRow(const Robot& robot, const EpisodeSummary& summary);
-  // Saves the table and the run record into the run's folder; returns the message to log.
-  bool checkpoint(const std::string& finished, std::string& message);
-  // Puts a loaded table in place (checked; on a mismatch returns what differs, nothing changed).
-  std::string install(QTable table);
+  // Starts the run (fresh, or going on with the run of a controller this process respawns) and
+  // stores what a respawn of it needs to find it (~run/id, ~run/launcher, ~run/folder).
+  void startRun();
   // Training or evaluation is over: ends the launch (or the node) when ~shutdown_when_finished.
   void endWhenFinished();
   void setUpRobots(ros::CallbackQueue* state_queue);
@@ -112,19 +103,22 @@ private:
   // Serves every complete round of held states, in robot order.
   void serveRounds();
   void command(Robot& robot, double effort, const ros::Time& stamp);
-  // Statistics, progress, checkpoints and, when training reached its limits, the final save.
+  // Carries out the application's episode end (statistics, progress, checkpoints, the final
+  // save) and publishes episode_stats.
   void endEpisode(Robot& robot, const ros::Time& stamp, bool training_finished);
   // Logs what the protocol did with a state that was not simply answered.
   void report(const Robot& robot, const Reaction& reaction, const ros::Time& stamp);
-  // Saves to a user path (empty: the default); returns the message for the log or service.
-  bool save(const std::string& path, std::string& message);
-  std::string resolve(const std::string& path) const;
   std::string describe(const Robot& robot) const;
 
   // Reset calls run on threads of their own (ResetCaller, one per robot): a blocking service
   // call from this node's callback would never return if the sim's service ran on the same
   // single thread (nodelets), and a robot whose call hangs must not hold up the others.
   void requestReset(std::size_t robot);
+
+  // The node's log: every line on its named logger, "qlearning_controller: " before those said
+  // with a prefix.
+  void say(const Saying& said) const;
+  void say(Said::Level level, const char* format, ...) const __attribute__((format(printf, 3, 4)));
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
@@ -135,29 +129,14 @@ private:
 
   // Parameters
   ControllerSettings settings_;
-  std::string run_folder_;    // this run's folder, relative to settings_.run.q_table_dir ("" when evaluating)
-  bool resumed_run_ = false;  // this process is a respawn going on with its run
-  std::unique_ptr<AppendingFile> stats_file_;  // opened, its curve not started yet
-  std::unique_ptr<EpisodeCsvWriter> stats_csv_writer_;
-  bool stats_csv_pending_ = false;  // the default file, opened at the first episode's end
-  RunRecord run_;
-  std::uint64_t evaluated_balanced_ = 0;
   std::vector<std::string> state_names_;  // as the trace names the rows (trace.h)
 
-  bool respawned_ = false;  // this process goes on with the run of a controller that died (openRun)
-
   std::unique_ptr<TrainingSession> session_;
+  // The run around the session: what it writes and decides (finished(): serve no more states).
+  std::unique_ptr<RunApplication> app_;
   std::vector<Robot> robots_;
   std::unique_ptr<RobotRounds> rounds_;
-  bool finished_training_ = false;
-  bool final_saved_ = false;  // training ended and its table is saved (else Ctrl-C saves it)
 
-  // Wall-clock bookkeeping for steps/s.
-  std::chrono::steady_clock::time_point started_;
-  std::chrono::steady_clock::time_point last_episode_end_;
-  std::uint64_t steps_at_last_episode_ = 0;
-  std::uint64_t steps_at_last_progress_ = 0;
-  std::chrono::steady_clock::time_point last_progress_;
   mutable WallThrottle bad_state_warning_{1.0};
   WallThrottle dropped_state_warning_{1.0};
   // A replayed older stamp, sent twice, looks like a restarted sim: said at most once a second.

@@ -1,6 +1,8 @@
 // A robot's reset service, called on threads of its own (see ResetCaller).
 #pragma once
 
+#include "cartpole_qlearning/reset_calls.h"
+
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -13,14 +15,14 @@ namespace cartpole_qlearning
 // asked, on threads of its own, so that a robot whose call hangs holds up no other robot.
 // roscpp's ServiceClient::call has no timeout: a sim stuck in its callback, a host gone with its
 // TCP connection half-open, or a persistent link that hangs across a server's restart
-// (ros/ros_comm#149, #152) can block a call for many minutes. A call still under way after
-// give_up_after is given up: its thread is left blocked (detached; it shares only state held by
-// shared_ptr, so it may outlive this object and the node) and a fresh thread retries on a new
-// connection.
+// (ros/ros_comm#149, #152) can block a call for many minutes. When to call, retry and give a call
+// up is ResetCalls' (reset_calls.h); this class makes the calls, logs what it says and wakes it at
+// its times. A call given up leaves its thread blocked (detached; it shares only state held by
+// shared_ptr, so it may outlive this object and the node) and a new thread takes the next calls.
 class ResetCaller
 {
 public:
-  // service: the service's resolved name.
+  // service: the service's resolved name; give_up_after: resetGiveUpAfter(~sim_timeout).
   ResetCaller(std::string service, std::chrono::steady_clock::duration give_up_after);
   // Never waits for a call under way: gives it up as a hung one.
   ~ResetCaller();
@@ -33,16 +35,18 @@ public:
 
 private:
   struct Shared;
-  // Hands each wanted reset to the current calling thread and waits for its answer, at most
-  // give_up_after; retries a failing robot.
+  // Feeds calls_ what happened (requests, calls back) and the time, and carries out its orders.
   void run();
-  // A calling thread: makes the calls it is handed while it is the current one (generation).
+  // Under shared_->mutex, on run()'s thread.
+  void carryOut(const ResetCalls::Orders& orders);
+  // A calling thread: makes the calls handed to its generation while it is the current one.
   static void callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t generation, const std::string& service);
 
   const std::string service_;
-  const std::chrono::steady_clock::duration give_up_after_;
+  ResetCalls calls_;  // run()'s only (a given-up thread must not touch this object)
   std::shared_ptr<Shared> shared_;
-  std::thread caller_;  // the current calling thread; used by run() only, until it ends
+  std::thread caller_;  // the current calling thread, if any; run()'s only
+  ResetCalls::Clock::time_point wake_at_ = ResetCalls::Clock::time_point::max();
   std::thread thread_;  // run()
 };
 
