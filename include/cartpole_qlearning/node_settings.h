@@ -59,7 +59,8 @@ struct ControllerContext
   std::string name_space = "/cartpole";  // the learner's namespace (the default table folder's name)
   std::string home;                      // $HOME, for "~/" in paths ("": none)
   bool shutdown_by_default = true;       // ~shutdown_when_finished's default (a nodelet: false)
-  // "" for a valid relative ROS name, else why it is not one (ros::names::validate).
+  // "" for a valid relative ROS name, else why it is not one (ros::names::validate; unset: any
+  // name passes).
   std::function<std::string(const std::string&)> name_error;
   // Private keys read by other means (dynamic_reconfigure's fields, ~run/...): not unknown.
   std::vector<std::string> other_keys;
