@@ -358,7 +358,7 @@ done
 
 # --- The core alone: the step counts every loop must reproduce ----------------------------------
 for n in $ROBOTS_LIST; do
-  "$TRAIN_HEADLESS" --robots "$n" --seed 0 --quiet >"$WORK/headless_$n.log" 2>&1 ||
+  "$TRAIN_HEADLESS" --robots "$n" --seed 0 --quiet --no-run-folder >"$WORK/headless_$n.log" 2>&1 ||
     die "train_headless --robots $n failed (log: $WORK/headless_$n.log)"
   echo "kind=headless robots=$n $(tail -n 1 "$WORK/headless_$n.log")" >>"$RESULTS"
 done

@@ -162,7 +162,8 @@ def train_headless_runs(trainer, config, seeds, max_episodes, jobs, returns=Fals
     episodes_args = ["--max-episodes", str(max_episodes)] if max_episodes else []
     returns_args = ["--returns"] if returns else []
     return run_seeds(seeds, jobs,
-                     lambda seed: trainer + ["--quiet", "--seed", str(seed)] + config_args + episodes_args + returns_args,
+                     lambda seed: trainer + ["--quiet", "--no-run-folder", "--seed", str(seed)] + config_args
+                     + episodes_args + returns_args,
                      parse_train_headless, config or "train_headless")
 
 

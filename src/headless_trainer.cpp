@@ -4,8 +4,8 @@
 
 namespace cartpole_qlearning
 {
-HeadlessTrainer::HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed, std::size_t robots)
-  : config_(config), session_(config.task, config.agent, seed, true, robots)
+HeadlessTrainer::HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed, std::size_t robots, bool learning)
+  : config_(config), session_(config.task, config.agent, seed, learning, robots)
 {
   for (std::size_t r = 0; r < robots; ++r)
     simulations_.emplace_back(config.physics, config.start_state_bound, robotSeed(seed, r));
@@ -26,14 +26,30 @@ const EpisodeSummary& HeadlessTrainer::runEpisode()
 
 TrainingResult HeadlessTrainer::run(const std::function<void(const EpisodeSummary&)>& on_episode)
 {
+  return runUntil([&](const EpisodeSummary& summary) {
+    if (on_episode)
+      on_episode(summary);
+    return config_.limits.reached(summary.episode, summary.solved);
+  });
+}
+
+TrainingResult HeadlessTrainer::runUntil(const std::function<bool(const EpisodeSummary&)>& finished,
+                                         const std::atomic<bool>* stop)
+{
   const auto start = std::chrono::steady_clock::now();
   TrainingResult result;
   // As each sim starts: a random start state. The episodes begin in the first round.
   std::vector<double> efforts(simulations_.size(), 0.0);
   for (CartPoleSimulation& simulation : simulations_)
     simulation.resetRandom();
+  const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   for (;;)
   {
+    if (stop != nullptr && stop->load(std::memory_order_relaxed))
+    {
+      result.wall_s = elapsed();
+      return result;
+    }
     for (std::size_t r = 0; r < simulations_.size(); ++r)
     {
       CartPoleSimulation& simulation = simulations_[r];
@@ -50,11 +66,9 @@ TrainingResult HeadlessTrainer::run(const std::function<void(const EpisodeSummar
       }
       const EpisodeSummary& summary = session_.lastEpisode();
       result.record(summary);
-      if (on_episode)
-        on_episode(summary);
-      if (config_.limits.reached(summary.episode, summary.solved))
+      if (finished(summary))
       {
-        result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        result.wall_s = elapsed();
         return result;
       }
       simulation.resetRandom();  // the sim's reset; the next episode begins in the next round

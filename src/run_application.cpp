@@ -61,10 +61,17 @@ struct RunApplication::State
   // Writing the user's choices at each moment of a run.
   bool writesAlong() const
   {
-    return settings.checkpoint_every > 0 || settings.save_on_shutdown;
+    return settings.run_folder && (settings.checkpoint_every > 0 || settings.save_on_shutdown);
+  }
+  // A table path of the settings that is the user's own (see RunSettings::own_absolute_paths).
+  bool own(const std::string& path) const
+  {
+    return settings.own_absolute_paths && !path.empty() && path.front() == '/';
   }
   std::string resolve(const std::string& path) const
   {
+    if (path.empty() && own(settings.q_table_path))
+      return settings.q_table_path;
     return resolvePathUnder(settings.q_table_dir, path.empty() ? settings.q_table_path : path);
   }
 
@@ -126,7 +133,10 @@ bool RunApplication::State::save(const std::string& path, std::string& message)
   try
   {
     const std::string resolved = resolve(path);
-    saveQTableUnder(session.table(), settings.q_table_dir, path.empty() ? settings.q_table_path : path);
+    if (path.empty() && own(settings.q_table_path))
+      saveQTableFile(session.table(), settings.q_table_path);
+    else
+      saveQTableUnder(session.table(), settings.q_table_dir, path.empty() ? settings.q_table_path : path);
     message = "saved " + std::to_string(session.table().episodes) + " episodes, " +
               std::to_string(session.table().steps) + " steps of training to " + resolved;
     return true;
@@ -170,8 +180,10 @@ void RunApplication::State::loadOnStart(Saying& said)
   std::string path;
   try
   {
-    path = resolve(settings.load_on_start);
-    const std::string mismatch = install(loadQTableUnder(settings.q_table_dir, settings.load_on_start));
+    const bool users_own = own(settings.load_on_start);
+    path = users_own ? settings.load_on_start : resolve(settings.load_on_start);
+    const std::string mismatch = install(users_own ? loadQTableFile(settings.load_on_start)
+                                                   : loadQTableUnder(settings.q_table_dir, settings.load_on_start));
     if (!mismatch.empty())
       throw QTableFileError(path + " does not fit this controller: " + mismatch);
   }
@@ -206,6 +218,8 @@ void RunApplication::State::openRun(const RunIdentity& previous, Saying& said)
   run.run_id = settings.run_id;
   run.name_space = settings.name_space;
   run.seed = settings.seed;
+  if (!settings.run_folder)
+    return;
   // A respawn has the run id and the launcher of the process that started the run; a node
   // started by hand on a reused master has at most the id left there.
   if (!settings.run_id.empty() && previous.id == settings.run_id && previous.launcher == launcher &&
@@ -291,7 +305,7 @@ void RunApplication::State::resumeRun(bool respawn, Saying& said)
 void RunApplication::State::startStatsCsv(Saying& said)
 {
   const std::string& name = settings.stats_csv;
-  if (name == "none" || (name.empty() && !settings.learning))
+  if (name == "none" || (name.empty() && (!settings.learning || !settings.run_folder)))
     return;
   if (!stats_file)
   {
@@ -443,12 +457,20 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
     // The default table first: a crash between the two saves then leaves a run not yet marked
     // finished, which a respawn finishes again.
     std::string published;
-    const bool published_ok = s.solved && st.save("", published);
-    saved_ok = st.checkpoint(s.solved ? "solved" : "max_episodes", saved);
-    st.final_saved = saved_ok || published_ok;
-    if (s.solved)
-      saved += published_ok ? "; the default table: " + published : "; BUT NOT the default table: " + published;
+    const bool publishes = s.solved && !st.settings.q_table_path.empty();
+    const bool published_ok = publishes && st.save("", published);
+    if (st.settings.run_folder)
+      saved_ok = st.checkpoint(s.solved ? "solved" : "max_episodes", saved);
     else
+    {
+      // The default table is the only save, if there is one.
+      saved = "no run folder";
+      saved_ok = !publishes || published_ok;
+    }
+    st.final_saved = saved_ok || published_ok;
+    if (publishes)
+      saved += published_ok ? "; the default table: " + published : "; BUT NOT the default table: " + published;
+    else if (!st.settings.q_table_path.empty())
       saved += "; the default table " + st.resolve("") +
                " is left as it was (this run did not solve: ~save_q_table saves it there if you want it)";
   }
@@ -534,7 +556,9 @@ ServiceAnswer RunApplication::load(const std::string& path)
   try
   {
     const std::string resolved = s.resolve(path);
-    QTable table = loadQTableUnder(s.settings.q_table_dir, path.empty() ? s.settings.q_table_path : path);
+    QTable table = path.empty() && s.own(s.settings.q_table_path)
+                       ? loadQTableFile(s.settings.q_table_path)
+                       : loadQTableUnder(s.settings.q_table_dir, path.empty() ? s.settings.q_table_path : path);
     const std::uint64_t episodes = table.episodes;
     const std::uint64_t steps = table.steps;
     const std::string mismatch = s.install(std::move(table));

@@ -91,7 +91,7 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
   EXPECT_EQ(solved.total_steps, table.steps);
   const std::string headless = qTableDir() + "/headless.yaml";
   const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " + CARTPOLE_CONFIG_DIR "/" +
-                              configFile() + " --save " + headless;
+                              configFile() + " --no-run-folder --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
   EXPECT_EQ(fileText(headless), fileText(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
   // The table is of the features the config asks for, as the test names them.

@@ -26,7 +26,7 @@ TEST(Nodelets, TrainingOnOneWorkerThreadSolvesWithTheHeadlessTable)
   // episode_stats: what is awaited is the final table, which must be train_headless's.
   const std::string headless = dir + "/headless.yaml";
   const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " +
-                              CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
+                              CARTPOLE_CONFIG_DIR "/cartpole.yaml --no-run-folder --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
   const std::string expected = fileText(headless);
   const std::string trained = dir + "/q_table.yaml";

@@ -361,7 +361,7 @@ class TrainHeadlessCurveTest(PictureTest):
         self.assertTrue(train_headless, "train_headless not built")
         csv = self.path("episodes.csv")
         result = subprocess.run(
-            [train_headless[0], "--seed", "0", "--quiet", "--stats-csv", csv],
+            [train_headless[0], "--seed", "0", "--quiet", "--no-run-folder", "--stats-csv", csv],
             stdout=subprocess.PIPE,
             universal_newlines=True,
             timeout=300,

@@ -43,7 +43,7 @@ TEST(RobotsTrain, ThreeRobotsWriteTheHeadlessTableForThreeRobots)
   // node's subscriptions are up, so the file is what is awaited.
   const std::string headless = dir + "/headless.yaml";
   const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --robots 3 --quiet --config " +
-                              CARTPOLE_CONFIG_DIR "/cartpole.yaml --save " + headless;
+                              CARTPOLE_CONFIG_DIR "/cartpole.yaml --no-run-folder --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
   const std::string expected = fileText(headless);
   const std::string trained = dir + "/q_table.yaml";

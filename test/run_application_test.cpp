@@ -496,6 +496,69 @@ TEST_F(RunApplicationTest, AnUnsolvedRunLeavesTheDefaultTable)
                              "it)"));
 }
 
+// train_headless --no-run-folder: nothing but the default table, and that only when solved.
+TEST_F(RunApplicationTest, WithoutARunFolderASolvedRunWritesTheDefaultTableAlone)
+{
+  settings_.run_folder = false;
+  settings_.checkpoint_every = 1;  // no folder to put checkpoints in: none made
+  settings_.save_on_shutdown = false;
+  Run run = startRun();
+  EXPECT_EQ("", run.app->runFolder());
+  EXPECT_FALSE(says(run.started, "checkpoints go to")) << all(run.started);
+  EXPECT_FALSE(says(run.started, "one row per episode")) << all(run.started);
+  episode(run, true);
+  EXPECT_TRUE(files().empty());
+  const EpisodeEnd end = episode(run, true, true);
+  EXPECT_TRUE(end.finished);
+  EXPECT_EQ(std::vector<std::string>{"q_table.yaml"}, files());
+  EXPECT_EQ(2u, loadQTableFile((dir_ / "q_table.yaml").string()).episodes);
+  EXPECT_TRUE(says(end.said, "; no run folder; the default table: saved 2 episodes")) << all(end.said);
+  EXPECT_TRUE(run.app->shutdown().empty());
+}
+
+TEST_F(RunApplicationTest, WithoutARunFolderOrDefaultTableNothingIsWritten)
+{
+  settings_.run_folder = false;
+  settings_.save_on_shutdown = false;
+  settings_.q_table_path.clear();
+  Run run = startRun();
+  episode(run, true);
+  const EpisodeEnd end = episode(run, true, true);
+  ASSERT_TRUE(run.session->lastEpisode().solved);
+  EXPECT_TRUE(end.finished);
+  EXPECT_TRUE(files().empty());
+  EXPECT_TRUE(says(end.said, "SOLVED after 2 episodes")) << all(end.said);
+  EXPECT_FALSE(says(end.said, "the default table")) << all(end.said);
+}
+
+// train_headless's command line: an absolute default table or start table is the user's own.
+TEST_F(RunApplicationTest, AbsoluteTablePathsAreTheUsersOwnOnlyWhenTheSettingsSaySo)
+{
+  const fs::path outside = dir_.string() + "_outside";
+  fs::create_directories(outside);
+  settings_.q_table_path = (outside / "mine.yaml").string();
+  {
+    Run run = startRun();
+    EXPECT_THROW(run.app->resolve(""), QTableFileError);  // the node's rule: inside q_table_dir
+  }
+  settings_.own_absolute_paths = true;
+  Run run = startRun();
+  EXPECT_EQ((outside / "mine.yaml").string(), run.app->resolve(""));
+  episode(run, true);
+  episode(run, true, true);
+  EXPECT_EQ(2u, loadQTableFile((outside / "mine.yaml").string()).episodes);
+  // The services still keep to the table folder.
+  EXPECT_FALSE(run.app->save((outside / "other.yaml").string()).success);
+  EXPECT_FALSE(fs::exists(outside / "other.yaml"));
+
+  // And it starts from an absolute table.
+  settings_.load_on_start = (outside / "mine.yaml").string();
+  Run loaded = startRun();
+  EXPECT_EQ(2u, loaded.session->episodesEnded());
+  EXPECT_TRUE(says(loaded.started, "loaded " + (outside / "mine.yaml").string())) << all(loaded.started);
+  fs::remove_all(outside);
+}
+
 TEST_F(RunApplicationTest, AFailedFinalSaveKeepsTheNodeUpWithTheErrorSaid)
 {
   config_.limits.max_episodes = 1;

@@ -137,6 +137,15 @@ public:
       stopProcess(pid_, signal);
     pid_ = -1;
   }
+  // Waits for the end and returns waitpid's status (0 when it was stopped already).
+  int wait()
+  {
+    int status = 0;
+    if (pid_ > 0)
+      ::waitpid(pid_, &status, 0);
+    pid_ = -1;
+    return status;
+  }
   pid_t pid() const
   {
     return pid_;

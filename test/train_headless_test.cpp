@@ -1,5 +1,9 @@
-// The train_headless executable as a user runs it: its last line, its exit codes, its messages.
+// The train_headless executable as a user runs it: its last line, its exit codes, its messages,
+// and what it writes (run folders, checkpoints, the default table) under $ROS_HOME, which every
+// test points to a folder of its own.
+#include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/training_run.h"
 
 #include "test_support.h"
 #include "trace_check.h"
@@ -15,6 +19,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <sys/stat.h>
@@ -23,18 +28,15 @@
 
 namespace fs = std::filesystem;
 
+using cartpole_qlearning::test::ChildProcess;
 using cartpole_qlearning::test::CommandRun;
 using cartpole_qlearning::test::fileText;
+using cartpole_qlearning::test::processGone;
 using cartpole_qlearning::test::runCommand;
 using cartpole_qlearning::test::TraceReading;
 
 namespace
 {
-CommandRun trainHeadless(const std::string& args)
-{
-  return runCommand(std::string(TRAIN_HEADLESS) + " " + args);
-}
-
 std::string config()
 {
   return std::string("--config ") + CARTPOLE_CONFIG_DIR "/cartpole.yaml";
@@ -67,8 +69,64 @@ protected:
       std::ofstream(path) << text;
     return path;
   }
+  // train_headless ARGS, with $ROS_HOME in this test's folder.
+  CommandRun trainHeadless(const std::string& args) const
+  {
+    return runCommand("ROS_HOME=" + dir_.string() + " " + TRAIN_HEADLESS + " " + args);
+  }
+  // The table folder of the default namespace.
+  fs::path tables() const
+  {
+    return dir_ / "cartpole_qlearning" / "cartpole";
+  }
+  // Every file under the table folders, as relative paths.
+  std::vector<std::string> written() const
+  {
+    std::vector<std::string> found;
+    if (fs::exists(dir_ / "cartpole_qlearning"))
+      for (const auto& entry : fs::recursive_directory_iterator(dir_ / "cartpole_qlearning"))
+        if (!entry.is_directory())
+          found.push_back(fs::relative(entry.path(), dir_ / "cartpole_qlearning").string());
+    std::sort(found.begin(), found.end());
+    return found;
+  }
+  // The run folder a run's output names ("run runs/...: checkpoints go to ..."), "" if none.
+  static std::string runFolder(const std::string& output)
+  {
+    std::smatch match;
+    return std::regex_search(output, match, std::regex("run (runs/[^ :]+): checkpoints go to")) ? match[1].str() : "";
+  }
+  // A config that trains until stopped (1,000,000 episodes, not stopping when solved).
+  std::string endlessConfig() const
+  {
+    return "--config " + file("endless.yaml", "training:\n  stop_when_solved: false\n  max_episodes: 1000000\n");
+  }
   fs::path dir_;
 };
+
+// The fields of a CSV line (no quoting: the package's own rows have none).
+std::vector<std::string> fields(const std::string& line)
+{
+  std::vector<std::string> found;
+  std::istringstream in(line);
+  for (std::string f; std::getline(in, f, ',');)
+    found.push_back(f);
+  if (!line.empty() && line.back() == ',')
+    found.push_back("");
+  return found;
+}
+
+// The episode numbers of a curve's rows, in order.
+std::vector<unsigned long> curveEpisodes(const std::string& path)
+{
+  std::vector<unsigned long> episodes;
+  std::istringstream in(fileText(path));
+  std::string line;
+  std::getline(in, line);  // the header
+  while (std::getline(in, line))
+    episodes.push_back(std::stoul(line.substr(0, line.find(','))));
+  return episodes;
+}
 }  // namespace
 
 TEST_F(TrainHeadlessTest, SolvesAndEndsWithTheResultLine)
@@ -81,54 +139,181 @@ TEST_F(TrainHeadlessTest, SolvesAndEndsWithTheResultLine)
   EXPECT_NE(std::string::npos, run.output.find("mean_return_100")) << run.output;
 }
 
-TEST_F(TrainHeadlessTest, SavedTableLoadsAndTheSameSeedWritesTheSameBytes)
+TEST_F(TrainHeadlessTest, TheSameSeedWritesTheSameBytesWhereverTheTableGoes)
 {
+  // --save to a path of one's own, with and without a run folder, and the default table.
   const std::string a = file("a.yaml");
   const std::string b = file("b.yaml");
-  ASSERT_EQ(0, trainHeadless(config() + " --seed 4 --quiet --save " + a).status);
-  ASSERT_EQ(0, trainHeadless(config() + " --seed 4 --quiet --save " + b).status);
-  const cartpole_qlearning::QTable table = cartpole_qlearning::loadQTableFile(a);
-  EXPECT_GT(table.episodes, 0u);
+  const CommandRun first = trainHeadless(config() + " --seed 4 --save " + a);
+  ASSERT_EQ(0, first.status) << first.output;
+  ASSERT_EQ(0, trainHeadless(config() + " --seed 4 --quiet --no-run-folder --save " + b).status);
+  const CommandRun by_default = trainHeadless(config() + " --seed 4 --quiet");
+  ASSERT_EQ(0, by_default.status) << by_default.output;
+  EXPECT_GT(cartpole_qlearning::loadQTableFile(a).episodes, 0u);
   EXPECT_EQ(fileText(a), fileText(b));
+  EXPECT_EQ(fileText(a), fileText((tables() / "q_table.yaml").string()));
+  // The run's own folder holds the same table, and its record says it solved.
+  const std::string folder = runFolder(first.output);
+  ASSERT_NE("", folder) << first.output;
+  EXPECT_EQ(fileText(a), fileText((tables() / folder / "q_table.yaml").string()));
+  EXPECT_EQ("solved", cartpole_qlearning::parseRunRecord(fileText((tables() / folder / "run.yaml").string())).finished);
+  EXPECT_NE(std::string::npos, first.output.find("; the default table: saved")) << first.output;
 }
 
-TEST_F(TrainHeadlessTest, ARelativeSaveGoesWhereTheControllerLooksAndNoSaveSaysSo)
+TEST_F(TrainHeadlessTest, RelativePathsAreUnderTheTableFolderAbsoluteOnesTheUsersOwn)
 {
-  // The one path rule: relative to $ROS_HOME/cartpole_qlearning/<ns>, as the services and the
-  // launch files take q_table paths (evaluate.launch q_table:=mine.yaml then finds it).
-  const std::string home = "ROS_HOME=" + dir_.string() + " ";
-  const CommandRun saved =
-      runCommand(home + TRAIN_HEADLESS + " " + config() + " --max-episodes 3 --save runs/mine.yaml");
+  // Relative: under $ROS_HOME/cartpole_qlearning/<ns>, where the services, evaluate.launch
+  // q_table:=... and the node's ~stats_csv take them.
+  const CommandRun saved = trainHeadless(config() + " --seed 0 --save mine/t.yaml --stats-csv curves/c.csv");
   ASSERT_EQ(0, saved.status) << saved.output;
-  const std::string expected = (dir_ / "cartpole_qlearning" / "cartpole" / "runs" / "mine.yaml").string();
-  EXPECT_EQ(3u, cartpole_qlearning::loadQTableFile(expected).episodes);
-  EXPECT_NE(std::string::npos, saved.output.find("saved the Q-table to " + expected)) << saved.output;
-  const CommandRun other =
-      runCommand(home + TRAIN_HEADLESS + " " + config() + " --max-episodes 3 --ns a/b --save t.yaml");
+  EXPECT_GT(cartpole_qlearning::loadQTableFile((tables() / "mine" / "t.yaml").string()).episodes, 0u);
+  EXPECT_NE(std::string::npos, saved.output.find("the default table: saved")) << saved.output;
+  EXPECT_NE(std::string::npos, saved.output.find((tables() / "mine" / "t.yaml").string())) << saved.output;
+  EXPECT_TRUE(fs::exists(tables() / "curves" / "c.csv"));
+  // --ns picks another namespace's folder.
+  const CommandRun other = trainHeadless(config() + " --seed 0 --quiet --ns a/b --save t.yaml");
   ASSERT_EQ(0, other.status) << other.output;
   EXPECT_TRUE(fs::exists(dir_ / "cartpole_qlearning" / "a" / "b" / "t.yaml"));
-  // Leaving the folder is refused, as over a service; nothing is written.
-  const CommandRun escape = runCommand(home + TRAIN_HEADLESS + " " + config() + " --max-episodes 3 --save ../x.yaml");
-  EXPECT_EQ(1, escape.status) << escape.output;
+  // Absolute: the user's own, the curve too.
+  const std::string own_table = file("own/t.yaml");
+  const std::string own_curve = file("own/c.csv");
+  const CommandRun own =
+      trainHeadless(config() + " --seed 0 --quiet --save " + own_table + " --stats-csv " + own_curve);
+  ASSERT_EQ(0, own.status) << own.output;
+  EXPECT_EQ(fileText(own_table), fileText((tables() / "mine" / "t.yaml").string()));
+  EXPECT_EQ(curveEpisodes(own_curve), curveEpisodes((tables() / "curves" / "c.csv").string()));
+  // Leaving the table folder is refused before training, as over a service; nothing is written.
+  const auto before = written();
+  for (const std::string bad : {"--save ../x.yaml", "--stats-csv ../x.csv", "--save mine/../../x.yaml"})
+  {
+    const CommandRun escape = trainHeadless(config() + " --seed 0 " + bad);
+    EXPECT_EQ(2, escape.status) << bad << ": " << escape.output;
+    EXPECT_NE(std::string::npos, escape.output.find(bad)) << escape.output;
+    EXPECT_EQ(std::string::npos, escape.output.find("solved=")) << escape.output;
+  }
+  EXPECT_EQ(before, written());
   EXPECT_FALSE(fs::exists(dir_ / "cartpole_qlearning" / "x.yaml"));
-  // Without --save nothing is written, and it says where --save would write.
-  const CommandRun unsaved = runCommand(home + TRAIN_HEADLESS + " " + config() + " --max-episodes 3");
-  EXPECT_EQ(0, unsaved.status);
-  EXPECT_NE(std::string::npos, unsaved.output.find("nothing saved (--save NAME writes the table to " +
-                                                   (dir_ / "cartpole_qlearning" / "cartpole").string()))
-      << unsaved.output;
 }
 
-// The fields of a CSV line (no quoting: the package's own rows have none).
-std::vector<std::string> fields(const std::string& line)
+TEST_F(TrainHeadlessTest, AnUnsolvedRunLeavesSavesFileAloneAndSaysWhereItsTableIs)
 {
-  std::vector<std::string> found;
-  std::istringstream in(line);
-  for (std::string f; std::getline(in, f, ',');)
-    found.push_back(f);
-  if (!line.empty() && line.back() == ',')
-    found.push_back("");
-  return found;
+  const std::string mine = file("mine.yaml", "the user's own table\n");
+  const CommandRun run = trainHeadless(config() + " --seed 0 --max-episodes 5 --save " + mine);
+  ASSERT_EQ(0, run.status) << run.output;
+  EXPECT_EQ(0u, run.lastLine().find("solved=false episodes=5 ")) << run.lastLine();
+  EXPECT_EQ("the user's own table\n", fileText(mine));
+  const std::string folder = runFolder(run.output);
+  ASSERT_NE("", folder) << run.output;
+  const std::string run_table = (tables() / folder / "q_table.yaml").string();
+  EXPECT_EQ(5u, cartpole_qlearning::loadQTableFile(run_table).episodes);
+  EXPECT_NE(std::string::npos, run.output.find("saved 5 episodes")) << run.output;
+  EXPECT_NE(std::string::npos, run.output.find(run_table + "; the default table " + mine + " is left as it was"))
+      << run.output;
+  EXPECT_FALSE(fs::exists(tables() / "q_table.yaml"));
+}
+
+TEST_F(TrainHeadlessTest, NoRunFolderWritesNothingButSave)
+{
+  const CommandRun unsaved = trainHeadless(config() + " --seed 0 --no-run-folder");
+  ASSERT_EQ(0, unsaved.status) << unsaved.output;
+  EXPECT_EQ(0u, unsaved.lastLine().find("solved=true ")) << unsaved.lastLine();
+  EXPECT_EQ(std::vector<std::string>(), written());
+  EXPECT_EQ(std::string::npos, unsaved.output.find("checkpoint")) << unsaved.output;
+  const CommandRun saved = trainHeadless(config() + " --seed 0 --quiet --no-run-folder --save t.yaml");
+  ASSERT_EQ(0, saved.status) << saved.output;
+  EXPECT_EQ(std::vector<std::string>{"cartpole/t.yaml"}, written());
+}
+
+TEST_F(TrainHeadlessTest, EvaluateRunsATableGreedilyAndEndsWithItsVerdict)
+{
+  ASSERT_EQ(0, trainHeadless(config() + " --seed 0 --quiet --no-run-folder --save trained.yaml").status);
+  const auto before = written();
+  const CommandRun trained = trainHeadless(config() + " --evaluate trained.yaml --episodes 20");
+  ASSERT_EQ(0, trained.status) << trained.output;
+  std::smatch verdict;
+  const std::string last = trained.lastLine();
+  ASSERT_TRUE(std::regex_match(last, verdict, std::regex("evaluated=20 balanced=([0-9]+) mean_return=([0-9.]+)")))
+      << last;
+  // Seed 0's table balanced 19 of these 20 when this was written.
+  EXPECT_GE(std::stoul(verdict[1]), 15u) << trained.output;
+  EXPECT_GT(std::stod(verdict[2]), 450.0) << trained.output;
+  EXPECT_NE(std::string::npos, trained.output.find("evaluation episode 20: ")) << trained.output;
+  EXPECT_EQ(before, written()) << "an evaluation writes nothing";
+  // 100 episodes by default; the path rule holds (an absolute table).
+  const CommandRun by_default = trainHeadless(config() + " --quiet --evaluate " + (tables() / "trained.yaml").string());
+  EXPECT_EQ(0, by_default.status) << by_default.output;
+  EXPECT_EQ(0u, by_default.lastLine().find("evaluated=100 balanced=")) << by_default.lastLine();
+
+  // A table of zeros pushes one way: every episode falls.
+  const auto shipped = cartpole_qlearning::readTrainingConfig(
+      *cartpole_qlearning::loadYamlParameters(CARTPOLE_CONFIG_DIR "/cartpole.yaml"));
+  const std::string zeros = file("zeros.yaml");
+  cartpole_qlearning::saveQTableFile(cartpole_qlearning::QTable(shipped.agent.discretiser, shipped.agent.actions),
+                                     zeros);
+  const CommandRun falls = trainHeadless(config() + " --quiet --evaluate " + zeros + " --episodes 10");
+  ASSERT_EQ(0, falls.status) << falls.output;
+  const std::string fell = falls.lastLine();
+  ASSERT_TRUE(std::regex_match(fell, verdict, std::regex("evaluated=10 balanced=0 mean_return=([0-9.]+)"))) << fell;
+  EXPECT_LT(std::stod(verdict[1]), 100.0);
+}
+
+TEST_F(TrainHeadlessTest, LoadTrainsFurtherFromTheTablesCounters)
+{
+  const CommandRun first = trainHeadless(config() + " --seed 1 --max-episodes 30");
+  ASSERT_EQ(0, first.status) << first.output;
+  const std::string folder = runFolder(first.output);
+  ASSERT_NE("", folder) << first.output;
+  const cartpole_qlearning::QTable table =
+      cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string());
+  ASSERT_EQ(30u, table.episodes);
+
+  const std::string curve = file("loaded.csv");
+  const CommandRun loaded = trainHeadless(config() + " --seed 1 --load " + folder +
+                                          "/q_table.yaml --max-episodes 40 --returns --stats-csv " + curve);
+  ASSERT_EQ(0, loaded.status) << loaded.output;
+  EXPECT_NE(std::string::npos, loaded.output.find("loaded " + (tables() / folder / "q_table.yaml").string() +
+                                                  " (30 episodes, " + std::to_string(table.steps) + " steps"))
+      << loaded.output;
+  // Ten more episodes, numbered on from 31; the steps add up from the table's (+1 a step).
+  std::smatch result;
+  const std::string last = loaded.lastLine();
+  ASSERT_TRUE(std::regex_match(last, result, std::regex("solved=false episodes=40 steps=([0-9]+) wall_s=.*"))) << last;
+  std::smatch returns;
+  ASSERT_TRUE(std::regex_search(loaded.output, returns, std::regex("returns=([0-9 ]+)\n"))) << loaded.output;
+  std::istringstream values(returns[1].str());
+  const std::vector<double> more{std::istream_iterator<double>(values), std::istream_iterator<double>()};
+  ASSERT_EQ(10u, more.size());
+  double sum = 0.0;
+  for (const double r : more)
+    sum += r;
+  EXPECT_EQ(static_cast<double>(table.steps) + sum, std::stod(result[1].str()));
+  EXPECT_EQ((std::vector<unsigned long>{31, 32, 33, 34, 35, 36, 37, 38, 39, 40}), curveEpisodes(curve));
+
+  // A table at or past --max-episodes has nothing to train.
+  const CommandRun past = trainHeadless(config() + " --load " + folder + "/q_table.yaml --max-episodes 30");
+  EXPECT_EQ(2, past.status) << past.output;
+  EXPECT_NE(std::string::npos, past.output.find("--load " + folder +
+                                                "/q_table.yaml: its table has 30 episodes of training already, and "
+                                                "training ends at episode 30"))
+      << past.output;
+
+  // The schedules go on from episode 30: the same epsilon and alpha as a run that never stopped.
+  const std::string straight = file("straight.csv");
+  ASSERT_EQ(
+      0,
+      trainHeadless(config() + " --seed 1 --quiet --no-run-folder --max-episodes 40 --stats-csv " + straight).status);
+  std::istringstream loaded_rows(fileText(curve));
+  std::istringstream straight_rows(fileText(straight));
+  std::string loaded_row;
+  std::string straight_row;
+  std::getline(loaded_rows, loaded_row);
+  for (int i = 0; i < 31; ++i)
+    std::getline(straight_rows, straight_row);
+  ASSERT_TRUE(std::getline(loaded_rows, loaded_row));
+  ASSERT_TRUE(std::getline(straight_rows, straight_row));
+  EXPECT_EQ(fields(straight_row).at(0), fields(loaded_row).at(0));
+  EXPECT_EQ(fields(straight_row).at(5), fields(loaded_row).at(5)) << "epsilon";
+  EXPECT_EQ(fields(straight_row).at(6), fields(loaded_row).at(6)) << "alpha";
 }
 
 TEST_F(TrainHeadlessTest, TheStatsCsvHasOneRowPerEpisodeEndingWhereTheResultLineSays)
@@ -241,12 +426,144 @@ TEST_F(TrainHeadlessTest, BadConfigStopsWithTheKeyTheValueAndTheRange)
   EXPECT_NE(std::string::npos, missing.output.find("nope.yaml: cannot be read")) << missing.output;
 }
 
-TEST_F(TrainHeadlessTest, BadArgumentsAreRefused)
+TEST_F(TrainHeadlessTest, BadArgumentsAreRefusedNamingThem)
 {
-  EXPECT_EQ(2, trainHeadless(config() + " --seed minus-one").status);
-  EXPECT_EQ(2, trainHeadless(config() + " --max-episodes 0").status);
-  EXPECT_EQ(2, trainHeadless(config() + " --bogus").status);
-  EXPECT_EQ(0, trainHeadless("--help").status);
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"--seed minus-one", "--seed minus-one is not allowed"},
+      {"--max-episodes 0", "--max-episodes 0 is not allowed"},
+      {"--checkpoint-every often", "--checkpoint-every often is not allowed"},
+      {"--evaluate t.yaml --episodes 0", "--episodes 0 is not allowed"},
+      {"--episodes 5", "--episodes: counts --evaluate's episodes"},
+      {"--load a.yaml --resume runs/b", "--load and --resume: give one"},
+      {"--evaluate t.yaml --save s.yaml", "--save with --evaluate"},
+      {"--evaluate t.yaml --load s.yaml", "--load with --evaluate"},
+      {"--no-run-folder --checkpoint-every 5", "--checkpoint-every with --no-run-folder"},
+      {"--load missing.yaml", "--load missing.yaml: cannot start from the table 'missing.yaml'"},
+      {"--evaluate missing.yaml", "--evaluate missing.yaml: cannot start from the table 'missing.yaml'"},
+      {"--resume runs/nothing_here", "--resume runs/nothing_here: run runs/nothing_here has no checkpoint"},
+      {"--resume ../elsewhere", "--resume ../elsewhere: cannot resume the run '../elsewhere'"},
+      {"--bogus", "unknown or incomplete argument '--bogus'"},
+      {"--save", "unknown or incomplete argument '--save'"},
+  };
+  for (const auto& c : cases)
+  {
+    const CommandRun run = trainHeadless(config() + " " + c.first);
+    EXPECT_EQ(2, run.status) << c.first << ": " << run.output;
+    EXPECT_NE(std::string::npos, run.output.find("train_headless: " + c.second)) << c.first << ": " << run.output;
+    EXPECT_FALSE(std::regex_search(run.output, std::regex("solved=(true|false) episodes=[0-9]"))) << run.output;
+  }
+  EXPECT_EQ(std::vector<std::string>(), written());
+  const CommandRun help = trainHeadless("--help");
+  EXPECT_EQ(0, help.status);
+  for (const std::string option : {"--resume FOLDER", "--load TABLE", "--evaluate TABLE", "--no-run-folder",
+                                   "--checkpoint-every N", "an absolute path is your own"})
+    EXPECT_NE(std::string::npos, help.output.find(option)) << help.output;
+}
+
+// A run stopped by a signal, then resumed: SIGINT saves into the run's folder on the way out (as
+// the controller's shutdown does); SIGKILL leaves the last checkpoint. --resume goes on from
+// what is there: the episode numbers, the steps and the curve carry on, no episode twice.
+class TrainHeadlessStopTest : public TrainHeadlessTest, public ::testing::WithParamInterface<int>
+{
+};
+
+TEST_P(TrainHeadlessStopTest, AStoppedRunGoesOnWithResume)
+{
+  const int signal = GetParam();
+  const std::string log = file("stopped.log");
+  ChildProcess training("/bin/sh",
+                        {"-c", "exec " + std::string(TRAIN_HEADLESS) + " " + endlessConfig() +
+                                   " --checkpoint-every 200 >" + log + " 2>&1"},
+                        {"ROS_HOME=" + dir_.string()});
+  // Stopped once a checkpoint or two are down.
+  std::string folder;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  for (;;)
+  {
+    folder = runFolder(fileText(log));
+    const std::string record = folder.empty() ? "" : fileText((tables() / folder / "run.yaml").string());
+    if (!record.empty() && cartpole_qlearning::parseRunRecord(record).episodes >= 400)
+      break;
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << fileText(log);
+    ASSERT_FALSE(processGone(training.pid())) << fileText(log);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(training.pid(), signal);
+  const int status = training.wait();
+  const std::string output = fileText(log);
+  const cartpole_qlearning::RunRecord record =
+      cartpole_qlearning::parseRunRecord(fileText((tables() / folder / "run.yaml").string()));
+  const cartpole_qlearning::QTable checkpoint =
+      cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string());
+  EXPECT_EQ("", record.finished);
+  const std::string curve = (tables() / folder / "episodes.csv").string();
+  if (signal == SIGKILL)
+  {
+    ASSERT_TRUE(WIFSIGNALED(status));
+    EXPECT_EQ(0u, checkpoint.episodes % 200) << "not a checkpoint's count: " << checkpoint.episodes;
+    // Killed between the table's save and the record's, the record is one checkpoint behind
+    // (the table wins on resume).
+    EXPECT_TRUE(record.episodes == checkpoint.episodes || record.episodes + 200 == checkpoint.episodes)
+        << record.episodes << " " << checkpoint.episodes;
+  }
+  else
+  {
+    ASSERT_TRUE(WIFEXITED(status)) << output;
+    EXPECT_EQ(record.episodes, checkpoint.episodes);
+    EXPECT_EQ(128 + signal, WEXITSTATUS(status)) << output;
+    EXPECT_NE(std::string::npos, output.find("on shutdown: saved " + std::to_string(record.episodes) + " episodes"))
+        << output;
+    // Saved where it stopped: every episode in the curve is in the table.
+    EXPECT_EQ(record.episodes, curveEpisodes(curve).back());
+    const CommandRun as_run{0, output};
+    EXPECT_EQ(0u, as_run.lastLine().find("solved=")) << output;
+  }
+
+  const std::uint64_t until = checkpoint.episodes + 30;
+  const CommandRun resumed =
+      trainHeadless(endlessConfig() + " --resume " + folder + " --max-episodes " + std::to_string(until));
+  ASSERT_EQ(0, resumed.status) << resumed.output;
+  EXPECT_NE(std::string::npos, resumed.output.find("run " + folder + " goes on from its checkpoint: episode " +
+                                                   std::to_string(checkpoint.episodes) + ", " +
+                                                   std::to_string(checkpoint.steps) + " steps"))
+      << resumed.output;
+  // (It may end solved: the last 100 episodes of so long a run balance.)
+  EXPECT_TRUE(
+      std::regex_match(resumed.lastLine(), std::regex("solved=(true|false) episodes=" + std::to_string(until) + " .*")))
+      << resumed.output;
+  const cartpole_qlearning::QTable table =
+      cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string());
+  EXPECT_EQ(until, table.episodes);
+  const std::string finished =
+      cartpole_qlearning::parseRunRecord(fileText((tables() / folder / "run.yaml").string())).finished;
+  EXPECT_TRUE(finished == "solved" || finished == "max_episodes") << finished;
+  // The curve: every episode once, in order, the rows after the checkpoint played again.
+  const std::vector<unsigned long> episodes = curveEpisodes(curve);
+  ASSERT_EQ(until, episodes.size());
+  for (std::size_t i = 0; i < episodes.size(); ++i)
+    ASSERT_EQ(i + 1, episodes[i]);
+  // A finished run has nothing left to do.
+  const CommandRun again = trainHeadless(endlessConfig() + " --resume " + folder);
+  EXPECT_EQ(0, again.status) << again.output;
+  EXPECT_NE(std::string::npos, again.output.find("has finished already (" + finished + "); nothing left to do"))
+      << again.output;
+  EXPECT_EQ("solved=" + std::string(finished == "solved" ? "true" : "false") + " episodes=" + std::to_string(until) +
+                " steps=" + std::to_string(table.steps) + " wall_s=0.000000",
+            again.lastLine());
+  EXPECT_EQ(until, cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string()).episodes);
+}
+
+INSTANTIATE_TEST_SUITE_P(Signals, TrainHeadlessStopTest, ::testing::Values(SIGINT, SIGTERM, SIGKILL));
+
+// Several robots are named as train.launch robots:=N names their namespaces, as the node logs.
+TEST_F(TrainHeadlessTest, TheTraceNamesRobotsByTheirNamespaces)
+{
+  const CommandRun run = trainHeadless(tutorialConfig() + " --trace --robots 2 --seed 3 --max-episodes 3");
+  ASSERT_EQ(0, run.status) << run.output;
+  EXPECT_NE(std::string::npos, run.output.find("\nrobot_0: episode 1 step 1: ")) << run.output;
+  EXPECT_NE(std::string::npos, run.output.find("\nrobot_1: episode 1 step 1: ")) << run.output;
+  EXPECT_TRUE(std::regex_search(run.output, std::regex("\nQ-table after robot_[01]'s episode 1 \\(1 in all\\):\n")))
+      << run.output;
 }
 
 // The tutorial's worked example (10 steps, alpha 0.5, gamma 0.9) replayed from the shipped file:

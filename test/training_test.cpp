@@ -97,6 +97,37 @@ TEST(HeadlessTrainer, EpisodeStatisticsAddUp)
   }
 }
 
+TEST(HeadlessTrainer, RunUntilEndsWhereTheCallerSaysOrAtOnceWhenStopped)
+{
+  TrainingConfig config = shippedConfig();
+  config.limits.max_episodes = 3;  // runUntil leaves the limits to the caller
+  HeadlessTrainer trainer(config, 2);
+  std::uint64_t seen = 0;
+  const TrainingResult result = trainer.runUntil([&](const EpisodeSummary& s) {
+    ++seen;
+    return s.episode == 7;
+  });
+  EXPECT_EQ(7u, seen);
+  EXPECT_EQ(7u, result.episodes);
+  EXPECT_EQ(7u, trainer.session().table().episodes);
+
+  // Stopped (Ctrl-C): no further episode ends, and the table keeps its counters.
+  const std::atomic<bool> stop{true};
+  const TrainingResult stopped = trainer.runUntil([](const EpisodeSummary&) { return false; }, &stop);
+  EXPECT_EQ(0u, stopped.episodes);
+  EXPECT_EQ(7u, trainer.session().table().episodes);
+}
+
+TEST(HeadlessTrainer, AnEvaluatingTrainerLearnsNothing)
+{
+  TrainingConfig config = shippedConfig();
+  HeadlessTrainer evaluator(config, 0, 2, false);
+  const std::vector<double> before = evaluator.session().table().values();
+  evaluator.runUntil([](const EpisodeSummary& s) { return s.episode == 4; });
+  EXPECT_TRUE(bitIdentical(before, evaluator.session().table().values()));
+  EXPECT_EQ(4u, evaluator.session().episodesEnded());
+}
+
 TEST(TrainingSession, TruncationBootstrapsAndAFallDoesNot)
 {
   TaskParams task;

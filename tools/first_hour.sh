@@ -261,7 +261,7 @@ run "train_headless --robots 4" 120 0 "rosrun cartpole_qlearning train_headless 
 
 # Training without ROS.
 run "train_headless --save headless.yaml" 120 0 "rosrun cartpole_qlearning train_headless --save headless.yaml" \
-  "saved the Q-table to $TABLES/headless.yaml" "^solved=true"
+  "the default table: saved .* to $TABLES/headless.yaml" "^solved=true"
 run "evaluate.launch q_table:=headless.yaml" 120 0 \
   "roslaunch cartpole_qlearning evaluate.launch q_table:=headless.yaml episodes:=1" "EVALUATED 1 episodes: 1 balanced"
 # The tutorial's worked example: its exact values, and the trace on the graph.

@@ -10,6 +10,7 @@
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/training_session.h"
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -56,7 +57,8 @@ inline std::vector<std::string> robotNamespaces(std::size_t count)
 class HeadlessTrainer
 {
 public:
-  HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed, std::size_t robots = 1);
+  // learning = false: greedy, no updates (an evaluation).
+  HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed, std::size_t robots = 1, bool learning = true);
 
   // Robot 0 alone: one whole episode from a random start; returns its summary.
   const EpisodeSummary& runEpisode();
@@ -64,6 +66,11 @@ public:
   // Rounds until solved (when limits.stop_when_solved) or limits.max_episodes; on_episode is
   // called after each episode.
   TrainingResult run(const std::function<void(const EpisodeSummary&)>& on_episode = {});
+  // Rounds until `finished` returns true after an episode (the caller decides: the application's
+  // limits, an evaluation's verdict) or until `stop` is set (looked at every round: Ctrl-C), the
+  // episodes under way then left unfinished.
+  TrainingResult runUntil(const std::function<bool(const EpisodeSummary&)>& finished,
+                          const std::atomic<bool>* stop = nullptr);
 
   const TrainingSession& session() const
   {

@@ -23,8 +23,11 @@ struct RunSettings
   // Tables are read and written under this folder (a relative path there; one that escapes it is
   // refused). "~/" at its start is the user's home.
   std::string q_table_dir;
-  std::string q_table_path = "q_table.yaml";  // the default table, relative to q_table_dir
+  std::string q_table_path = "q_table.yaml";  // the default table, relative to q_table_dir ("": none)
   std::string load_on_start;                  // a table to start from ("": none)
+  // An absolute q_table_path or load_on_start is the user's own, followed as the shell would
+  // (train_headless's command line); else it must lie inside q_table_dir (the node's parameters).
+  bool own_absolute_paths = false;
   // "" the run's folder/episodes.csv (training; none when evaluating), "none" no file, else a
   // path (relative: under q_table_dir; absolute: the user's own).
   std::string stats_csv;
@@ -32,7 +35,10 @@ struct RunSettings
   std::uint64_t evaluation_episodes = 10;  // evaluate: the verdict after this many episodes (0: never)
   std::uint64_t checkpoint_every = 100;    // training: a checkpoint every this many episodes (0: none)
   bool save_on_shutdown = true;            // training: save into the run's folder when stopped early
-  bool trace = false;                      // log every update and the table at each episode end
+  // false (train_headless --no-run-folder): no run folder at all (no checkpoints, record, curve of
+  // its own or save on shutdown); a solved run's only save is the default table.
+  bool run_folder = true;
+  bool trace = false;  // log every update and the table at each episode end
 };
 
 struct ControllerSettings

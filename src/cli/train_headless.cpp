@@ -1,52 +1,93 @@
-// train_headless: trains with the core alone (no ROS master), prints progress and ends with
-// one line "solved=true|false episodes=N steps=M wall_s=T". With --replay it learns from the
-// transitions of a file instead (the tutorial's worked example), tracing each update.
-#include "cartpole_qlearning/episode_csv.h"
+// train_headless: the controller node's application with the core alone (no ROS master): it
+// trains (from scratch, from a table, or on from a run's checkpoint) or evaluates a table
+// greedily, making the same RunApplication calls as the node, and prints what the node logs.
+// Training ends with one line "solved=true|false episodes=N steps=M wall_s=T", an evaluation
+// with "evaluated=N balanced=M mean_return=R". With --replay it learns from the transitions of a
+// file instead (the tutorial's worked example), tracing each update.
 #include "cartpole_qlearning/headless_trainer.h"
 #include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/run_application.h"
 #include "cartpole_qlearning/trace.h"
+#include "cartpole_qlearning/training_run.h"
 #include "cartpole_qlearning/transition_replay.h"
 
 #include <ros/package.h>
 
-#include <chrono>
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <string>
-#include <vector>
 
 namespace
 {
+std::atomic<int> g_signal{0};
+std::atomic<bool> g_stop{false};
+static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free,
+              "set from a signal handler");
+
+void onSignal(int signal)
+{
+  g_signal.store(signal);
+  g_stop.store(true);
+}
+
 void usage(std::ostream& out)
 {
-  out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--save PATH] [--ns NS] [--max-episodes N] "
-         "[--stats-csv FILE] [--quiet]\n"
-         "                      [--returns] [--trace] [--replay FILE]\n"
-         "  --config FILE     physics, task, learning and training parameters (YAML);\n"
-         "                    default: the package's config/cartpole.yaml\n"
-         "  --seed N          seed of the start states and of exploration (default 0)\n"
-         "  --robots N        N simulated robots feed one learner, served in lockstep rounds in robot order\n"
-         "                    (as train.launch robots:=N); robot r starts from seed S + r (default 1)\n"
-         "  --save PATH       write the final Q-table there (atomic); a relative PATH is taken under the\n"
-         "                    controller's table folder, $ROS_HOME/cartpole_qlearning/NS (~/.ros/...), where\n"
-         "                    evaluate.launch q_table:=PATH finds it; without --save nothing is written\n"
-         "  --ns NS           the namespace whose table folder --save uses (default cartpole)\n"
-         "  --max-episodes N  override training/max_episodes\n"
-         "  --stats-csv FILE  write one CSV row per episode there as it ends (the learning curve, for\n"
-         "                    rosrun cartpole_qlearning plot_learning_curve FILE); FILE is taken as given\n"
-         "                    (relative to the current directory); an earlier curve there is replaced, any\n"
-         "                    other file refused\n"
-         "  --quiet           no progress lines, only the result line\n"
-         "  --returns         before the result line, one line \"returns=R1 R2 ...\": every episode's return, in "
-         "order\n"
-         "  --trace           print every update as the tutorial works it (state, action, reward, next state,\n"
-         "                    old Q, target, new Q) and the Q-table at each episode's end\n"
-         "  --replay FILE     train on nothing else than the transitions listed in FILE ([state, action, reward,\n"
-         "                    next state], states named as the config's learning/state_names), traced as --trace\n"
-         "                    does; e.g. --config config/tutorial_4_states.yaml --replay "
-         "config/tutorial_10_steps.yaml\n";
+  out << "usage: train_headless [--config FILE] [--seed N] [--robots N] [--ns NS] [--max-episodes N] [--save PATH]\n"
+         "                      [--load TABLE | --resume FOLDER] [--checkpoint-every N] [--no-run-folder]\n"
+         "                      [--stats-csv FILE] [--quiet] [--returns] [--trace]\n"
+         "       train_headless --evaluate TABLE [--episodes N] [--config FILE] [--seed N] [--robots N] [--ns NS]\n"
+         "       train_headless --replay FILE [--config FILE] [--seed N] [--save PATH]\n"
+         "Trains as train.launch's controller does, with the core alone (no ROS master), writes what it writes and\n"
+         "prints what it logs. Training ends with \"solved=true|false episodes=N steps=M wall_s=T\" (N and M count\n"
+         "a loaded or resumed table's own), an evaluation with \"evaluated=N balanced=M mean_return=R\".\n"
+         "Paths (--save, --load, --resume, --evaluate, --stats-csv): a relative path is under the table folder\n"
+         "$ROS_HOME/cartpole_qlearning/NS (~/.ros/cartpole_qlearning/cartpole by default), where the launch files\n"
+         "and the controller's services look; an absolute path is your own (links followed as the shell would).\n"
+         "A training run has its own folder there, runs/<date>_<time>_<ns>_seed<N>, as the controller's has: its\n"
+         "table at every checkpoint, at the end and on Ctrl-C (q_table.yaml), its record (run.yaml) and its curve\n"
+         "(episodes.csv). A solved run also replaces the default table; an unsolved one leaves it as it was.\n"
+         "  --config FILE        physics, task, learning and training parameters (YAML); default: the package's\n"
+         "                       config/cartpole.yaml\n"
+         "  --seed N             seed of the start states and of exploration (default 0; with --resume the run's)\n"
+         "  --robots N           N simulated robots feed one learner, served in lockstep rounds in robot order, as\n"
+         "                       train.launch robots:=N (named by its namespaces robot_0 ...); robot r starts from\n"
+         "                       seed N + r (default 1)\n"
+         "  --ns NS              the namespace whose table folder the paths are under (default cartpole)\n"
+         "  --max-episodes N     override training/max_episodes (a loaded or resumed table's episodes count)\n"
+         "  --save PATH          the default table (the controller's ~q_table_path; default q_table.yaml, which\n"
+         "                       evaluate.launch loads), replaced only by a solved run\n"
+         "  --checkpoint-every N a checkpoint into the run's folder every N episodes (default 100; 0: none)\n"
+         "  --no-run-folder      write no run folder (no checkpoints, record or curve, nothing on Ctrl-C) and no\n"
+         "                       table but --save's (when solved): for scripts that run it many times\n"
+         "  --load TABLE         train further from a table: its episode and step counts go on, and with them the\n"
+         "                       schedules (epsilon, alpha) and --max-episodes\n"
+         "  --resume FOLDER      go on from the last checkpoint of a run folder under the table folder (runs/...,\n"
+         "                       as a run's first line says): its counters, schedules, solved window and curve;\n"
+         "                       give the run's --config and --robots. A finished run has nothing left to do:\n"
+         "                       --load its q_table.yaml to train it further\n"
+         "  --evaluate TABLE     run TABLE greedily, learning nothing and writing nothing; then M is how many of\n"
+         "                       the N episodes balanced to the step limit, R the mean return of the last\n"
+         "                       task/solved_window episodes (100: all of them by default)\n"
+         "  --episodes N         with --evaluate: how many episodes (default 100)\n"
+         "  --stats-csv FILE     one CSV row per episode, as each ends (the learning curve, for rosrun\n"
+         "                       cartpole_qlearning plot_learning_curve FILE) instead of the run's episodes.csv;\n"
+         "                       none: no curve. An earlier curve there is replaced, any other file refused\n"
+         "  --quiet              nothing but warnings, errors and the result line\n"
+         "  --returns            before the result line, one line \"returns=R1 R2 ...\": every episode's return\n"
+         "                       in order\n"
+         "  --trace              print every update as the tutorial works it (state, action, reward, next state,\n"
+         "                       old Q, target, new Q) and the Q-table at each episode's end\n"
+         "  --replay FILE        train on nothing else than the transitions listed in FILE ([state, action,\n"
+         "                       reward, next state], states named as the config's learning/state_names), traced\n"
+         "                       as --trace does; --save writes its table; e.g. --config\n"
+         "                       config/tutorial_4_states.yaml --replay config/tutorial_10_steps.yaml\n"
+         "Ctrl-C (SIGINT) or SIGTERM saves the table into the run's folder, as the controller does when stopped,\n"
+         "and exits with 128 + the signal's number. Exit 1: a table could not be saved; 2: a bad argument, config,\n"
+         "table or folder (the message names it).\n";
 }
 
 bool parseCount(const std::string& text, std::uint64_t& value)
@@ -69,6 +110,39 @@ std::string defaultConfigPath()
   const std::string share = ros::package::getPath("cartpole_qlearning");
   return share.empty() ? std::string() : share + "/config/cartpole.yaml";
 }
+
+// What the application says: information on stdout (none with --quiet), the rest on stderr.
+// Returns whether an error was said.
+bool say(const cartpole_qlearning::Saying& said, bool quiet)
+{
+  using cartpole_qlearning::Said;
+  bool error = false;
+  for (const Said& s : said)
+  {
+    error = error || s.level == Said::Level::Error;
+    if (s.level == Said::Level::Info)
+    {
+      if (!quiet)
+        std::printf("%s\n", s.text.c_str());
+    }
+    else
+    {
+      std::fflush(stdout);
+      std::fprintf(stderr, "train_headless: %s\n", s.text.c_str());
+    }
+  }
+  return error;
+}
+
+// A table for the services' path rule: an absolute path is the user's own, a relative one under
+// the table folder.
+void saveTable(const cartpole_qlearning::QTable& table, const std::string& table_dir, const std::string& path)
+{
+  if (path.front() == '/')
+    cartpole_qlearning::saveQTableFile(table, path);
+  else
+    cartpole_qlearning::saveQTableUnder(table, table_dir, path);
+}
 }  // namespace
 
 int run(int argc, char** argv)
@@ -78,13 +152,27 @@ int run(int argc, char** argv)
   std::string save_path;
   std::string stats_csv_path;
   std::string name_space = "/cartpole";
+  std::string load_path;
+  std::string resume_folder;
+  std::string evaluate_path;
   std::uint64_t seed = 0;
+  bool seed_given = false;
   std::uint64_t max_episodes = 0;
   std::uint64_t robots = 1;
+  std::uint64_t checkpoint_every = RunSettings().checkpoint_every;
+  bool checkpoint_given = false;
+  std::uint64_t evaluation_episodes = 100;
+  bool episodes_given = false;
+  bool no_run_folder = false;
   bool quiet = false;
   bool print_returns = false;
   bool trace = false;
   std::string replay_path;
+  // A value argument: its text, or a refusal that names it.
+  const auto refuse = [](const std::string& arg, const std::string& value, const std::string& allowed) {
+    std::cerr << "train_headless: " << arg << " " << value << " is not allowed (" << allowed << ")\n";
+    return 2;
+  };
   for (int i = 1; i < argc; ++i)
   {
     const std::string arg = argv[i];
@@ -100,6 +188,8 @@ int run(int argc, char** argv)
       print_returns = true;
     else if (arg == "--trace")
       trace = true;
+    else if (arg == "--no-run-folder")
+      no_run_folder = true;
     else if (arg == "--replay" && has_value)
       replay_path = argv[++i];
     else if (arg == "--config" && has_value)
@@ -108,41 +198,47 @@ int run(int argc, char** argv)
       save_path = argv[++i];
     else if (arg == "--stats-csv" && has_value)
       stats_csv_path = argv[++i];
+    else if (arg == "--load" && has_value)
+      load_path = argv[++i];
+    else if (arg == "--resume" && has_value)
+      resume_folder = argv[++i];
+    else if (arg == "--evaluate" && has_value)
+      evaluate_path = argv[++i];
     else if (arg == "--ns" && has_value)
     {
       name_space = argv[++i];
       if (name_space.empty() || name_space.find("..") != std::string::npos)
-      {
-        std::cerr << "train_headless: --ns '" << name_space << "' is not allowed (must be a ROS namespace)\n";
-        return 2;
-      }
+        return refuse(arg, "'" + name_space + "'", "must be a ROS namespace");
       if (name_space.front() != '/')
         name_space = "/" + name_space;
     }
     else if (arg == "--seed" && has_value)
     {
+      seed_given = true;
       if (!parseCount(argv[++i], seed))
-      {
-        std::cerr << "train_headless: --seed " << argv[i] << " is not allowed (must be a whole number >= 0)\n";
-        return 2;
-      }
+        return refuse(arg, argv[i], "must be a whole number >= 0");
     }
     else if (arg == "--robots" && has_value)
     {
       if (!parseCount(argv[++i], robots) || robots == 0 || robots > 1000)
-      {
-        std::cerr << "train_headless: --robots " << argv[i]
-                  << " is not allowed (must be a whole number in [1, 1000])\n";
-        return 2;
-      }
+        return refuse(arg, argv[i], "must be a whole number in [1, 1000]");
     }
     else if (arg == "--max-episodes" && has_value)
     {
       if (!parseCount(argv[++i], max_episodes) || max_episodes == 0)
-      {
-        std::cerr << "train_headless: --max-episodes " << argv[i] << " is not allowed (must be a whole number >= 1)\n";
-        return 2;
-      }
+        return refuse(arg, argv[i], "must be a whole number >= 1");
+    }
+    else if (arg == "--checkpoint-every" && has_value)
+    {
+      checkpoint_given = true;
+      if (!parseCount(argv[++i], checkpoint_every))
+        return refuse(arg, argv[i], "must be a whole number >= 0; 0: no checkpoints");
+    }
+    else if (arg == "--episodes" && has_value)
+    {
+      episodes_given = true;
+      if (!parseCount(argv[++i], evaluation_episodes) || evaluation_episodes == 0)
+        return refuse(arg, argv[i], "must be a whole number >= 1");
     }
     else
     {
@@ -151,6 +247,45 @@ int run(int argc, char** argv)
       return 2;
     }
   }
+
+  // Options that do not go together, each named.
+  const bool evaluating = !evaluate_path.empty();
+  const auto conflict = [](const std::string& what, const std::string& why) {
+    std::cerr << "train_headless: " << what << ": " << why << "\n";
+    return 2;
+  };
+  if (!load_path.empty() && !resume_folder.empty())
+    return conflict("--load and --resume", "give one: --resume goes on from a run's own checkpoint");
+  if (episodes_given && !evaluating)
+    return conflict("--episodes", "counts --evaluate's episodes (training: --max-episodes)");
+  if (evaluating)
+  {
+    for (const auto& [name, given] : {std::pair<std::string, bool>{"--load", !load_path.empty()},
+                                      {"--resume", !resume_folder.empty()},
+                                      {"--save", !save_path.empty()},
+                                      {"--max-episodes", max_episodes != 0},
+                                      {"--checkpoint-every", checkpoint_given},
+                                      {"--no-run-folder", no_run_folder},
+                                      {"--stats-csv", !stats_csv_path.empty()},
+                                      {"--trace", trace},
+                                      {"--replay", !replay_path.empty()}})
+      if (given)
+        return conflict(name + " with --evaluate", "an evaluation learns nothing and writes nothing");
+  }
+  if (!replay_path.empty())
+  {
+    for (const auto& [name, given] : {std::pair<std::string, bool>{"--robots", robots != 1},
+                                      {"--max-episodes", max_episodes != 0},
+                                      {"--stats-csv", !stats_csv_path.empty()},
+                                      {"--load", !load_path.empty()},
+                                      {"--resume", !resume_folder.empty()},
+                                      {"--checkpoint-every", checkpoint_given},
+                                      {"--no-run-folder", no_run_folder}})
+      if (given)
+        return conflict(name + " with --replay", "a replay learns from its file alone");
+  }
+  if (no_run_folder && checkpoint_given && checkpoint_every > 0)
+    return conflict("--checkpoint-every with --no-run-folder", "checkpoints go into the run's folder");
 
   if (config_path.empty())
   {
@@ -183,50 +318,25 @@ int run(int argc, char** argv)
               << " shows one table row per state: it needs learning/features bins (" << config_path << " has tiles)\n";
     return 2;
   }
-
-  // The one path rule: a relative table path is under the table folder (as the controller's
-  // services and the launch files take it); an absolute one is the user's own.
   const std::string table_dir = defaultTableDirectory(name_space);
-  const auto save = [&](const QTable& table) {
-    if (!save_path.empty())
+  // A relative --save must stay in the table folder, as over a service: said before training.
+  if (!save_path.empty() && save_path.front() != '/')
+  {
+    try
     {
-      try
-      {
-        std::string written = save_path;
-        if (save_path.front() == '/')
-          saveQTableFile(table, save_path);
-        else
-        {
-          saveQTableUnder(table, table_dir, save_path);
-          written = resolvePathUnder(table_dir, save_path);
-        }
-        if (!quiet)
-          std::printf("saved the Q-table to %s\n", written.c_str());
-      }
-      catch (const QTableFileError& e)
-      {
-        std::cerr << "train_headless: " << e.what() << "\n";
-        return 1;
-      }
+      relativePathUnder(table_dir, save_path);
     }
-    else if (!quiet)
+    catch (const FileError& e)
     {
-      std::printf("nothing saved (--save NAME writes the table to %s/NAME)\n", table_dir.c_str());
+      return refuse("--save", save_path, e.what());
     }
-    return 0;
-  };
+  }
 
   // Only the trace and the replay name states (one name per table row: built for them alone).
   const std::vector<std::string> names =
       trace || !replay_path.empty() ? stateNames(config.agent) : std::vector<std::string>();
   if (!replay_path.empty())
   {
-    if (robots != 1 || max_episodes != 0 || !stats_csv_path.empty())
-    {
-      std::cerr << "train_headless: --replay learns from its file alone: --robots, --max-episodes and --stats-csv do "
-                   "not apply\n";
-      return 2;
-    }
     // Every line is checked before the first update: a bad file changes nothing.
     std::vector<ReplayTransition> transitions;
     try
@@ -253,92 +363,196 @@ int run(int argc, char** argv)
         });
     std::printf("Q-table after transition %zu (the end of the replay):\n%s\n", transitions.size(),
                 qTableText(agent.table(), names).c_str());
-    return save(agent.table());
+    if (save_path.empty())
+      return 0;
+    try
+    {
+      saveTable(agent.table(), table_dir, save_path);
+      if (!quiet)
+        std::printf("saved the Q-table to %s\n",
+                    save_path.front() == '/' ? save_path.c_str() : resolvePathUnder(table_dir, save_path).c_str());
+    }
+    catch (const QTableFileError& e)
+    {
+      std::cerr << "train_headless: --save: " << e.what() << "\n";
+      return 1;
+    }
+    return 0;
   }
 
-  // Opened before training, so that a path that cannot be written is said at once.
-  std::unique_ptr<EpisodeCsvWriter> stats_csv;
-  if (!stats_csv_path.empty())
+  // --resume: the run's own seed unless another is given (its record says which).
+  RunRecord resumed;
+  if (!resume_folder.empty())
   {
     try
     {
-      stats_csv = std::make_unique<EpisodeCsvWriter>(AppendingFile::open(stats_csv_path));
+      resumed = parseRunRecord(readFileUnder(table_dir, resume_folder + "/" + kRunRecordFile, 1 << 20));
+      if (!seed_given)
+        seed = resumed.seed;
     }
-    catch (const FileError& e)
+    catch (const FileError&)
     {
-      std::cerr << "train_headless: --stats-csv: " << e.what() << "\n";
+      // RunApplication::resume says what is wrong with the folder.
+    }
+  }
+
+  // Training goes on from a table's episode count, and max_episodes counts it: a table at or past
+  // it has nothing to train (else one episode would run). A resumed run that has finished says
+  // so below; a table that cannot be read is said by RunApplication.
+  if (!resume_folder.empty() || !load_path.empty())
+  {
+    std::uint64_t episodes = 0;
+    try
+    {
+      episodes = !resume_folder.empty()     ? (resumed.finished.empty() ? resumed.episodes : 0)
+                 : load_path.front() == '/' ? loadQTableFile(load_path).episodes
+                                            : loadQTableUnder(table_dir, load_path).episodes;
+    }
+    catch (const FileError&)
+    {
+    }
+    if (episodes >= config.limits.max_episodes)
+    {
+      std::cerr << "train_headless: " << (resume_folder.empty() ? "--load " + load_path : "--resume " + resume_folder)
+                << ": its table has " << episodes << " episodes of training already, and training ends at episode "
+                << config.limits.max_episodes << " (--max-episodes, else training/max_episodes): nothing to train\n";
       return 2;
     }
   }
 
-  HeadlessTrainer trainer(config, seed, robots);
-  if (trace)
-  {
-    trainer.session().setTrace([&](std::size_t robot, const TraceStep& step) {
-      const std::string who = robots > 1 ? "robot " + std::to_string(robot) + ": " : std::string();
-      std::printf("%s%s\n", who.c_str(), traceLine(step, names, config.agent.actions).c_str());
-    });
-  }
-  const auto start = std::chrono::steady_clock::now();
-  const std::uint64_t every = quiet ? 0 : config.limits.progress_every;
-  std::uint64_t last_steps = 0;
-  auto last_time = start;
-  std::string returns;
-  // The robots' names in the CSV, as train.launch robots:=N gives them.
+  // The settings the controller reads from its private parameters, from the command line.
+  RunSettings settings;
+  settings.learning = !evaluating;
+  settings.seed = seed;
+  settings.name_space = name_space;
+  settings.q_table_dir = table_dir;
+  if (!save_path.empty())
+    settings.q_table_path = save_path;
+  else if (no_run_folder)
+    settings.q_table_path.clear();  // no default table either
+  settings.load_on_start = evaluating ? evaluate_path : load_path;
+  settings.stats_csv = !stats_csv_path.empty() ? stats_csv_path : no_run_folder ? "none" : "";
+  settings.evaluation_episodes = evaluation_episodes;
+  settings.checkpoint_every = no_run_folder ? 0 : checkpoint_every;
+  settings.save_on_shutdown = !no_run_folder;
+  settings.run_folder = !no_run_folder;
+  settings.trace = trace;
+  settings.own_absolute_paths = true;
+
+  HeadlessTrainer trainer(config, seed, robots, !evaluating);
   const std::vector<std::string> robot_names = robotNamespaces(robots);
-  const TrainingResult result = trainer.run([&](const EpisodeSummary& s) {
-    if (print_returns)
-    {
-      char text[32];
-      std::snprintf(text, sizeof text, "%s%.17g", returns.empty() ? "" : " ", s.episode_return);
-      returns += text;
-    }
-    if (trace)
-    {
-      const std::string which = robots > 1 ? "robot " + std::to_string(s.robot) + "'s episode " +
-                                                 std::to_string(s.robot_episode) + " (" + std::to_string(s.episode) +
-                                                 " in all)"
-                                           : "episode " + std::to_string(s.episode);
-      std::printf("Q-table after %s:\n%s\n", which.c_str(), qTableText(trainer.session().table(), names).c_str());
-    }
-    if (stats_csv)
-    {
-      const std::string& robot = robot_names[s.robot];
-      const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-      try
-      {
-        stats_csv->write(s, robot, now);
-      }
-      catch (const FileError& e)
-      {
-        // The curve is a by-product: training goes on, and its table is still saved.
-        std::cerr << "train_headless: --stats-csv: " << e.what() << "; the learning curve stops at episode "
-                  << s.episode - 1 << ", training goes on\n";
-        stats_csv.reset();
-      }
-    }
-    if (every == 0 || (s.episode % every != 0 && !config.limits.reached(s.episode, s.solved)))
-      return;
-    const auto now = std::chrono::steady_clock::now();
-    const double interval = std::chrono::duration<double>(now - last_time).count();
-    const double rate = interval > 0.0 ? static_cast<double>(s.total_steps - last_steps) / interval : 0.0;
-    const double elapsed = std::chrono::duration<double>(now - start).count();
-    std::printf("%s\n", progressLine(s, config.task.solved_window, rate, elapsed).c_str());
-    last_steps = s.total_steps;
-    last_time = now;
-  });
-  const int status = save(trainer.session().table());
+  std::unique_ptr<RunApplication> application;
+  bool error = false;
+  try
+  {
+    application = std::make_unique<RunApplication>(settings, config, trainer.session());
+    if (!evaluating && trace)
+      trainer.session().setTrace([&](std::size_t robot, const TraceStep& step) {
+        const std::string& name = robot_names[robot];
+        std::printf("%s%s\n", robots > 1 ? (name + ": ").c_str() : "",
+                    traceLine(step, names, config.agent.actions).c_str());
+      });
+    error = say(resume_folder.empty() ? application->start() : application->resume(resume_folder), quiet);
+  }
+  catch (const RunSettingError& e)
+  {
+    std::cerr << "train_headless: --stats-csv " << stats_csv_path << " is not allowed (" << e.why << ")\n";
+    return 2;
+  }
+  catch (const ConfigError& e)
+  {
+    // Named by the option whose table or folder it is.
+    const std::string option = !resume_folder.empty() ? "--resume " + resume_folder + ": "
+                               : evaluating           ? "--evaluate " + evaluate_path + ": "
+                               : !load_path.empty()   ? "--load " + load_path + ": "
+                                                      : "";
+    std::cerr << "train_headless: " << option << e.what() << "\n";
+    return 2;
+  }
+  if (application->finished())
+  {
+    // A resumed run that had finished: nothing to train; its counts, as a result line.
+    const EpisodeSummary& last = trainer.session().lastEpisode();
+    std::printf("solved=%s episodes=%llu steps=%llu wall_s=0.000000\n", resumed.finished == "solved" ? "true" : "false",
+                static_cast<unsigned long long>(last.episode), static_cast<unsigned long long>(last.total_steps));
+    return 0;
+  }
+
+  struct sigaction action = {};
+  action.sa_handler = onSignal;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+
+  std::string returns;
+  const TrainingResult result = trainer.runUntil(
+      [&](const EpisodeSummary& s) {
+        if (print_returns)
+        {
+          char text[32];
+          std::snprintf(text, sizeof text, "%s%.17g", returns.empty() ? "" : " ", s.episode_return);
+          returns += text;
+        }
+        const bool training_finished = !evaluating && config.limits.reached(s.episode, s.solved);
+        const EpisodeEnd end = application->endEpisode(robot_names[s.robot], training_finished);
+        error = say(end.said, quiet) || error;
+        return end.finished || training_finished;
+      },
+      &g_stop);
+  const bool stopped = g_stop.load();
+  if (stopped)
+  {
+    std::fflush(stdout);
+    std::fprintf(stderr, "train_headless: stopped by %s\n", g_signal.load() == SIGINT ? "SIGINT" : "SIGTERM");
+    error = say(application->shutdown(), quiet) || error;
+  }
   if (print_returns)
     std::printf("returns=%s\n", returns.c_str());
-  // Microseconds: a run to solved takes a few milliseconds.
-  std::printf("solved=%s episodes=%llu steps=%llu wall_s=%.6f\n", result.solved ? "true" : "false",
-              static_cast<unsigned long long>(result.episodes), static_cast<unsigned long long>(result.steps),
-              result.wall_s);
-  return status;
+  if (evaluating)
+  {
+    const EvaluationVerdict verdict = application->verdict();
+    std::printf("evaluated=%llu balanced=%llu mean_return=%.3f\n", static_cast<unsigned long long>(verdict.episodes),
+                static_cast<unsigned long long>(verdict.balanced), verdict.mean_return);
+  }
+  else
+  {
+    // A solved run's default table that could not be written is said in the final line above;
+    // it is an error all the same.
+    const EpisodeSummary& end = trainer.session().lastEpisode();
+    if (!stopped && end.solved && !settings.q_table_path.empty())
+    {
+      bool written = false;
+      try
+      {
+        const QTable saved = loadQTableFile(application->resolve(""));
+        written =
+            saved.episodes == trainer.session().table().episodes && saved.steps == trainer.session().table().steps;
+      }
+      catch (const FileError&)
+      {
+      }
+      if (!written)
+      {
+        std::fflush(stdout);
+        std::fprintf(stderr, "train_headless: the table was not saved to %s\n", application->resolve("").c_str());
+        error = true;
+      }
+    }
+    // The session's counts: a loaded or resumed table's episodes included, as the node counts them.
+    // Microseconds: a run to solved takes a few milliseconds.
+    const EpisodeSummary& last = trainer.session().lastEpisode();
+    std::printf("solved=%s episodes=%llu steps=%llu wall_s=%.6f\n", result.solved ? "true" : "false",
+                static_cast<unsigned long long>(last.episode), static_cast<unsigned long long>(last.total_steps),
+                result.wall_s);
+  }
+  return stopped ? 128 + g_signal.load() : error ? 1 : 0;
 }
 
 int main(int argc, char** argv)
 {
+  // Line by line, as the node logs: a log file followed with tail -f (or cut short by kill -9)
+  // holds whole lines up to the last one said.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   // What the checks above did not foresee still ends with a message and exit 2, not an abort.
   try
   {
