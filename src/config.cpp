@@ -214,13 +214,13 @@ std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, co
 
 void refuseUnknownSections(const ParameterSource& source)
 {
-  static const std::set<std::string> sections{"physics", "task", "learning", "training"};
+  static const std::set<std::string> sections{"physics", "perturbations", "task", "learning", "training"};
   for (const std::string& key : source.keysUnder(""))
   {
     const std::string section = key.substr(0, key.find('/'));
     if (sections.count(section) == 0 || key == section)
       throw ConfigError(source.origin() + ": unknown key " + key +
-                        " (the file holds the sections physics, task, learning and training)");
+                        " (the file holds the sections physics, perturbations, task, learning and training)");
   }
 }
 
@@ -244,11 +244,45 @@ void readPhysics(const ParameterSource& source, CartPoleParams& physics, double&
   reader.read("force_mag", physics.force_mag);
   reader.read("tau", physics.tau);
   readEnum(reader, "integrator", physics.integrator, integratorFromString);
+  reader.read("cart_friction", physics.cart_friction);
+  reader.read("pole_friction", physics.pole_friction);
   reader.read("start_state_bound", start_state_bound);
   reader.refuseUnknown();
   reader.check(physics.validate());
   if (!(std::isfinite(start_state_bound) && start_state_bound >= 0.0))
     reader.fail("start_state_bound", std::to_string(start_state_bound), "must be finite and >= 0");
+}
+
+PerturbationParams readPerturbations(const ParameterSource& source)
+{
+  PerturbationParams p;
+  SectionReader reader(source, "perturbations");
+  std::int64_t delay = p.delay_steps;
+  reader.read("delay_steps", delay);
+  if (delay < 0 || delay > 1000)
+    reader.fail("delay_steps", std::to_string(delay), "must be a whole number in [0, 1000]");
+  p.delay_steps = static_cast<unsigned>(delay);
+  reader.readDimensions("noise_std", p.noise_std, false);
+  reader.readDimensions("noise_fraction", p.noise_fraction, false);
+  for (const auto& [name, range] : {std::pair<const char*, ScaleRange*>{"mass_cart", &p.mass_cart},
+                                    {"mass_pole", &p.mass_pole},
+                                    {"half_length", &p.half_length},
+                                    {"motor", &p.motor}})
+  {
+    std::vector<double> bounds;
+    reader.know(name);
+    if (!source.get(reader.key(name), bounds))
+      continue;
+    if (bounds.size() != 2)
+      reader.fail(name, SectionReader::listText(bounds), "must list 2 factors: [low, high]");
+    range->low = bounds[0];
+    range->high = bounds[1];
+  }
+  reader.read("push_probability", p.push_probability);
+  reader.read("push_force", p.push_force);
+  reader.refuseUnknown();
+  reader.check(p.validate());
+  return p;
 }
 
 TaskParams readTask(const ParameterSource& source)
@@ -301,6 +335,7 @@ TrainingConfig readTrainingConfig(const ParameterSource& source)
 {
   TrainingConfig config;
   readPhysics(source, config.physics, config.start_state_bound);
+  config.perturbations = readPerturbations(source);
   config.task = readTask(source);
   config.agent = readAgent(source);
   config.limits = readLimits(source);
