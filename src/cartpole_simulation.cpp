@@ -29,10 +29,12 @@ void CartPoleSimulation::beginEpisode()
 {
   applied_force_ = 0.0;
   last_push_ = 0.0;
-  delay_.reset();
+  unsigned delay = perturbations_.delay_steps;
   if (perturbations_.mass_cart.varies() || perturbations_.mass_pole.varies() ||
-      perturbations_.half_length.varies() || perturbations_.motor.varies())
-    dynamics_ = CartPoleDynamics(drawEpisodePhysics(nominal_, perturbations_, perturbation_rng_, motor_factor_));
+      perturbations_.half_length.varies() || perturbations_.motor.varies() ||
+      perturbations_.delay_steps_max != perturbations_.delay_steps)
+    dynamics_ = CartPoleDynamics(drawEpisodePhysics(nominal_, perturbations_, perturbation_rng_, motor_factor_, delay));
+  delay_.reset(delay);
   observation_ = perturbations_.noisy() ? addSensorNoise(state_, perturbations_, noise_rng_) : state_;
 }
 

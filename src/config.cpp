@@ -257,11 +257,31 @@ PerturbationParams readPerturbations(const ParameterSource& source)
 {
   PerturbationParams p;
   SectionReader reader(source, "perturbations");
-  std::int64_t delay = p.delay_steps;
-  reader.read("delay_steps", delay);
-  if (delay < 0 || delay > 1000)
-    reader.fail("delay_steps", std::to_string(delay), "must be a whole number in [0, 1000]");
-  p.delay_steps = static_cast<unsigned>(delay);
+  // One number of steps, or [low, high]: drawn per episode.
+  reader.know("delay_steps");
+  const char* const allowed = "must be a whole number of steps in [0, 1000], or [low, high] of them";
+  std::int64_t steps = 0;
+  bool single = false;
+  try
+  {
+    single = source.get(reader.key("delay_steps"), steps);
+  }
+  catch (const ConfigError&)
+  {
+    std::vector<double> delay;
+    source.get(reader.key("delay_steps"), delay);  // not a list either: throws naming the key
+    if (delay.size() != 2 || delay[0] != std::floor(delay[0]) || delay[1] != std::floor(delay[1]) || delay[0] < 0 ||
+        delay[1] < delay[0] || delay[1] > 1000)
+      reader.fail("delay_steps", SectionReader::listText(delay), allowed);
+    p.delay_steps = static_cast<unsigned>(delay[0]);
+    p.delay_steps_max = static_cast<unsigned>(delay[1]);
+  }
+  if (single)
+  {
+    if (steps < 0 || steps > 1000)
+      reader.fail("delay_steps", std::to_string(steps), allowed);
+    p.delay_steps = p.delay_steps_max = static_cast<unsigned>(steps);
+  }
   reader.readDimensions("noise_std", p.noise_std, false);
   reader.readDimensions("noise_fraction", p.noise_fraction, false);
   for (const auto& [name, range] : {std::pair<const char*, ScaleRange*>{"mass_cart", &p.mass_cart},
@@ -310,6 +330,7 @@ AgentParams readAgent(const ParameterSource& source)
   reader.readDimensions("bins", agent.discretiser.bins, true);
   reader.read("tilings", agent.tilings, 1, kMaxTilings);
   reader.readDimensions("tiles", agent.tiles, true);
+  reader.read("previous_action", agent.previous_action);
   reader.readDimensions("lower_bounds", agent.discretiser.lower, false);
   reader.readDimensions("upper_bounds", agent.discretiser.upper, false);
   readSchedule(reader, "epsilon", agent.epsilon);

@@ -26,7 +26,7 @@ bool PerturbationParams::noisy() const
 
 bool PerturbationParams::any() const
 {
-  return delay_steps > 0 || noisy() || mass_cart.varies() || mass_pole.varies() || half_length.varies() ||
+  return delay_steps > 0 || delay_steps_max > 0 || noisy() || mass_cart.varies() || mass_pole.varies() || half_length.varies() ||
          motor.varies() || (push_probability > 0.0 && push_force != 0.0);
 }
 
@@ -56,6 +56,8 @@ std::string PerturbationParams::validate() const
   }
   if (delay_steps > 1000)
     return bad("delay_steps", delay_steps, "must be a whole number in [0, 1000]");
+  if (delay_steps_max < delay_steps || delay_steps_max > 1000)
+    return bad("delay_steps (high)", delay_steps_max, "must be a whole number in [low, 1000]");
   if (!(std::isfinite(push_probability) && push_probability >= 0.0 && push_probability <= 1.0))
     return bad("push_probability", push_probability, "must be in [0, 1]");
   if (!(std::isfinite(push_force) && push_force >= 0.0))
@@ -64,8 +66,11 @@ std::string PerturbationParams::validate() const
 }
 
 CartPoleParams drawEpisodePhysics(const CartPoleParams& nominal, const PerturbationParams& p, RandomStream& rng,
-                                  double& motor_factor)
+                                  double& motor_factor, unsigned& delay_steps)
 {
+  delay_steps = p.delay_steps_max == p.delay_steps
+                    ? p.delay_steps
+                    : p.delay_steps + static_cast<unsigned>(rng.uniformIndex(p.delay_steps_max - p.delay_steps + 1));
   CartPoleParams physics = nominal;
   physics.mass_cart = nominal.mass_cart * draw(p.mass_cart, rng);
   physics.mass_pole = nominal.mass_pole * draw(p.mass_pole, rng);
@@ -79,8 +84,9 @@ ActuationDelay::ActuationDelay(unsigned steps) : steps_(steps)
   reset();
 }
 
-void ActuationDelay::reset()
+void ActuationDelay::reset(unsigned steps)
 {
+  steps_ = steps;
   line_.assign(steps_, 0.0);
 }
 

@@ -3,6 +3,7 @@
 #include "cartpole_qlearning/cartpole_simulation.h"
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/headless_trainer.h"
+#include "cartpole_qlearning/trace.h"
 
 #include <gtest/gtest.h>
 
@@ -58,7 +59,7 @@ TEST(Perturbations, ADelayOfOneStepAppliesThePreviousCommand)
 {
   const CartPoleParams params;
   PerturbationParams p;
-  p.delay_steps = 1;
+  p.delay_steps = p.delay_steps_max = 1;
   CartPoleSimulation late(params, 0.05, 3, p);
   const CartPoleDynamics ideal(params);
   CartPoleState expected = late.resetRandom();
@@ -77,6 +78,35 @@ TEST(Perturbations, ADelayOfOneStepAppliesThePreviousCommand)
   EXPECT_EQ(late.appliedForce(), 0.0);
   late.step(-5.0);
   EXPECT_EQ(late.appliedForce(), 5.0);
+}
+
+TEST(Perturbations, ADelayRangeIsDrawnPerEpisode)
+{
+  PerturbationParams p;
+  p.delay_steps = 0;
+  p.delay_steps_max = 2;
+  CartPoleSimulation sim(CartPoleParams(), 0.05, 8, p);
+  int seen[3] = {0, 0, 0};
+  for (int episode = 0; episode < 300; ++episode)
+  {
+    sim.resetRandom();
+    ASSERT_LE(sim.delaySteps(), 2u);
+    ++seen[sim.delaySteps()];
+    // The command given now acts after exactly the drawn delay.
+    for (unsigned k = 0; k < sim.delaySteps(); ++k)
+    {
+      sim.step(k == 0 ? 7.0 : 0.0);
+      ASSERT_EQ(sim.appliedForce(), 0.0);
+    }
+    sim.step(sim.delaySteps() == 0 ? 7.0 : 0.0);
+    ASSERT_EQ(sim.appliedForce(), 7.0);
+  }
+  for (const int count : seen)
+    EXPECT_NEAR(count, 100, 35);
+  const auto source = parseYamlParameters("perturbations: {delay_steps: [0, 1]}", "test.yaml");
+  const PerturbationParams read = readPerturbations(*source);
+  EXPECT_EQ(read.delay_steps, 0u);
+  EXPECT_EQ(read.delay_steps_max, 1u);
 }
 
 TEST(Perturbations, ThreeStepsLateThenInOrder)
@@ -260,6 +290,7 @@ TEST(Perturbations, ReadFromTheirSectionAndRefusedWhenBad)
   EXPECT_EQ(config.physics.cart_friction, 0.0005);
   EXPECT_EQ(config.physics.pole_friction, 0.000002);
   EXPECT_EQ(config.perturbations.delay_steps, 1u);
+  EXPECT_EQ(config.perturbations.delay_steps_max, 1u);
   EXPECT_EQ(config.perturbations.noise_std[2], 0.0087);
   EXPECT_EQ(config.perturbations.noise_fraction[3], 0.05);
   EXPECT_EQ(config.perturbations.mass_cart.low, 0.7);
@@ -270,6 +301,9 @@ TEST(Perturbations, ReadFromTheirSectionAndRefusedWhenBad)
   EXPECT_TRUE(config.perturbations.any());
 
   EXPECT_NE(configError("perturbations: {delay_steps: -1}").find("perturbations/delay_steps = -1"), std::string::npos);
+  EXPECT_NE(configError("perturbations: {delay_steps: [2, 1]}").find("perturbations/delay_steps = [2, 1]"),
+            std::string::npos);
+  EXPECT_NE(configError("perturbations: {delay_steps: fast}").find("delay_steps"), std::string::npos);
   EXPECT_NE(configError("perturbations: {mass_cart: [1.3, 0.7]}").find("mass_cart/high = 0.7"), std::string::npos);
   EXPECT_NE(configError("perturbations: {mass_cart: [1.0]}").find("[low, high]"), std::string::npos);
   EXPECT_NE(configError("perturbations: {push_probability: 2}").find("push_probability = 2"), std::string::npos);
@@ -283,7 +317,7 @@ TEST(Perturbations, HeadlessTrainingIsReproducibleAndTheLearnerSeesTheNoisyState
 {
   TrainingConfig config;
   config.limits.max_episodes = 30;
-  config.perturbations.delay_steps = 1;
+  config.perturbations.delay_steps = config.perturbations.delay_steps_max = 1;
   config.perturbations.noise_std = {0.01, 0.0, 0.0087, 0.0};
   config.perturbations.push_probability = 0.02;
   config.perturbations.push_force = 2.0;
@@ -299,4 +333,93 @@ TEST(Perturbations, HeadlessTrainingIsReproducibleAndTheLearnerSeesTheNoisyState
   HeadlessTrainer c(ideal, 4);
   c.run();
   EXPECT_NE(a.session().table().values(), c.session().table().values());
+}
+
+TEST(PreviousAction, EachPreviousActionHasItsOwnBlockOfRows)
+{
+  FeatureParams f;
+  f.previous_action = true;
+  const FeatureMap map(f, 2);
+  ASSERT_EQ(map.rowCount(), 72u * 3u);
+  const CartPoleState s(0.0, 0.0, 0.01, 0.1);
+  ActiveRows none;
+  ActiveRows after_left;
+  ActiveRows after_right;
+  map.activeRows(s, none, 0);
+  map.activeRows(s, after_left, 1);
+  map.activeRows(s, after_right, 2);
+  EXPECT_LT(none.rows[0], 72u);
+  EXPECT_EQ(after_left.rows[0], none.rows[0] + 72u);
+  EXPECT_EQ(after_right.rows[0], none.rows[0] + 144u);
+  // Off: the previous action changes nothing.
+  const FeatureMap plain(FeatureParams(), 2);
+  ActiveRows a;
+  ActiveRows b;
+  plain.activeRows(s, a, 0);
+  plain.activeRows(s, b, 2);
+  EXPECT_EQ(a.rows[0], b.rows[0]);
+  // Tiles: every tiling's tile moves by the same block.
+  FeatureParams t;
+  t.kind = FeatureKind::Tiles;
+  t.tilings = 4;
+  t.previous_action = true;
+  const FeatureMap tiles(t, 2);
+  ActiveRows t0;
+  ActiveRows t2;
+  tiles.activeRows(s, t0, 0);
+  tiles.activeRows(s, t2, 2);
+  ASSERT_EQ(t0.count, 4u);
+  for (unsigned i = 0; i < 4; ++i)
+    EXPECT_EQ(t2.rows[i], t0.rows[i] + 2 * tiles.rowCount() / 3);
+}
+
+TEST(PreviousAction, TheSessionShowsTheLearnerTheActionItTookLast)
+{
+  AgentParams agent;
+  agent.previous_action = true;
+  TrainingSession session(TaskParams(), agent, 3);
+  std::vector<std::size_t> states;
+  std::vector<std::size_t> actions;
+  session.setTrace([&](std::size_t, const TraceStep& step) {
+    states.push_back(step.state);
+    actions.push_back(step.action);
+  });
+  CartPoleSimulation sim(CartPoleParams(), 0.05, 3);
+  double effort = session.beginEpisode(sim.resetRandom());
+  for (int k = 0; k < 20; ++k)
+  {
+    const Decision d = session.observe(sim.step(effort));
+    if (d.episode_over)
+      break;
+    effort = d.effort;
+  }
+  ASSERT_GT(states.size(), 3u);
+  EXPECT_LT(states[0], 72u);  // the first state: no action before it
+  for (std::size_t k = 1; k < states.size(); ++k)
+    EXPECT_EQ(states[k] / 72u, actions[k - 1] + 1) << "step " << k;
+}
+
+TEST(PreviousAction, WithADelayedMotorTheLearnerThatSeesItLearnsToBalance)
+{
+  // The command acts one step late: the state alone is not enough to choose by, the state and
+  // the action still under way are.
+  TrainingConfig config;
+  config.perturbations.delay_steps = config.perturbations.delay_steps_max = 1;
+  config.limits.max_episodes = 2000;
+  config.limits.stop_when_solved = false;
+  const auto mean_return = [&](bool previous_action) {
+    TrainingConfig c = config;
+    c.agent.previous_action = previous_action;
+    HeadlessTrainer trainer(c, 0);
+    double last_500 = 0.0;
+    trainer.run([&](const EpisodeSummary& s) {
+      if (s.episode > 1500)
+        last_500 += s.episode_return;
+    });
+    return last_500 / 500.0;
+  };
+  const double blind = mean_return(false);
+  const double seeing = mean_return(true);
+  EXPECT_LT(blind, 150.0);
+  EXPECT_GT(seeing, 250.0);
 }

@@ -46,6 +46,11 @@ public:
   {
     return motor_factor_;
   }
+  // This episode's actuation delay [steps].
+  unsigned delaySteps() const
+  {
+    return delay_.steps();
+  }
   // The push that acted during the last step [N] (0: none).
   double lastPush() const
   {

@@ -30,8 +30,10 @@ struct PerturbationParams
 {
   // Actuation delay [steps]: a command takes effect this many steps after the state it answers
   // (a controller over topics on ros_control hardware: one control period). Until then the
-  // earlier commands act; after a reset, zero.
+  // earlier commands act; after a reset, zero. Drawn per episode, uniformly among the whole
+  // numbers in [delay_steps, delay_steps_max] (one value when they are equal).
   unsigned delay_steps = 0;
+  unsigned delay_steps_max = 0;
   // Sensor noise: each observed value is the true one plus Gaussian noise of standard deviation
   // noise_std[i] + noise_fraction[i] * |value| ([m, m/s, rad, rad/s]; a fraction). The true
   // state, which the physics integrates, is untouched.
@@ -58,17 +60,25 @@ struct PerturbationParams
 constexpr std::uint64_t kPerturbationStream = 3;
 
 // The physics of one episode: the configured physics with the drawn factors applied (the motor
-// factor is kept apart: it scales commands, not force_mag's clamp).
+// factor is kept apart: it scales commands, not force_mag's clamp), and its delay.
 CartPoleParams drawEpisodePhysics(const CartPoleParams& nominal, const PerturbationParams& perturbations,
-                                  RandomStream& rng, double& motor_factor);
+                                  RandomStream& rng, double& motor_factor, unsigned& delay_steps);
 
 // A command line that delivers each command delay_steps steps after it was given.
 class ActuationDelay
 {
 public:
   explicit ActuationDelay(unsigned steps = 0);
-  // Empties the line: zero acts until new commands come through.
-  void reset();
+  // Empties the line (zero acts until new commands come through), now `steps` long.
+  void reset(unsigned steps);
+  void reset()
+  {
+    reset(steps_);
+  }
+  unsigned steps() const
+  {
+    return steps_;
+  }
   // Takes the command for this step and returns the one that acts now.
   double apply(double command);
 
