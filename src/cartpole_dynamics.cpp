@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace cartpole_qlearning
 {
@@ -41,6 +42,16 @@ std::string CartPoleParams::validate() const
     out << name << " = " << value << " is not allowed (must be finite and > 0)";
     return out.str();
   };
+  for (const auto& [name, value] : {std::pair<const char*, double>{"cart_friction", cart_friction},
+                                    {"pole_friction", pole_friction}})
+  {
+    if (!(std::isfinite(value) && value >= 0.0))
+    {
+      std::ostringstream out;
+      out << name << " = " << value << " is not allowed (must be finite and >= 0)";
+      return out.str();
+    }
+  }
   for (const auto& check :
        {positive("gravity", gravity), positive("mass_cart", mass_cart), positive("mass_pole", mass_pole),
         positive("half_length", half_length), positive("force_mag", force_mag), positive("tau", tau)})
@@ -67,6 +78,20 @@ CartPoleState CartPoleDynamics::derivative(const CartPoleState& state, double fo
   const double theta_dot = state[3];
   const double costheta = std::cos(theta);
   const double sintheta = std::sin(theta);
+  if (params_.cart_friction != 0.0 || params_.pole_friction != 0.0)
+  {
+    // Barto, Sutton and Anderson's equations with their friction terms (kept apart, so that the
+    // frictionless model stays Gymnasium's operation for operation).
+    const double sign_x_dot = state[1] > 0.0 ? 1.0 : (state[1] < 0.0 ? -1.0 : 0.0);
+    const double temp =
+        (force + polemass_length * (theta_dot * theta_dot) * sintheta - params_.cart_friction * sign_x_dot) /
+        total_mass;
+    const double thetaacc =
+        (params_.gravity * sintheta - costheta * temp - params_.pole_friction * theta_dot / polemass_length) /
+        (params_.half_length * (4.0 / 3.0 - params_.mass_pole * (costheta * costheta) / total_mass));
+    const double xacc = temp - polemass_length * thetaacc * costheta / total_mass;
+    return CartPoleState(state[1], xacc, theta_dot, thetaacc);
+  }
   const double temp = (force + polemass_length * (theta_dot * theta_dot) * sintheta) / total_mass;
   const double thetaacc = (params_.gravity * sintheta - costheta * temp) /
                           (params_.half_length * (4.0 / 3.0 - params_.mass_pole * (costheta * costheta) / total_mass));

@@ -214,13 +214,13 @@ std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, co
 
 void refuseUnknownSections(const ParameterSource& source)
 {
-  static const std::set<std::string> sections{"physics", "task", "learning", "training"};
+  static const std::set<std::string> sections{"physics", "perturbations", "task", "learning", "training"};
   for (const std::string& key : source.keysUnder(""))
   {
     const std::string section = key.substr(0, key.find('/'));
     if (sections.count(section) == 0 || key == section)
       throw ConfigError(source.origin() + ": unknown key " + key +
-                        " (the file holds the sections physics, task, learning and training)");
+                        " (the file holds the sections physics, perturbations, task, learning and training)");
   }
 }
 
@@ -244,11 +244,65 @@ void readPhysics(const ParameterSource& source, CartPoleParams& physics, double&
   reader.read("force_mag", physics.force_mag);
   reader.read("tau", physics.tau);
   readEnum(reader, "integrator", physics.integrator, integratorFromString);
+  reader.read("cart_friction", physics.cart_friction);
+  reader.read("pole_friction", physics.pole_friction);
   reader.read("start_state_bound", start_state_bound);
   reader.refuseUnknown();
   reader.check(physics.validate());
   if (!(std::isfinite(start_state_bound) && start_state_bound >= 0.0))
     reader.fail("start_state_bound", std::to_string(start_state_bound), "must be finite and >= 0");
+}
+
+PerturbationParams readPerturbations(const ParameterSource& source)
+{
+  PerturbationParams p;
+  SectionReader reader(source, "perturbations");
+  // One number of steps, or [low, high]: drawn per episode.
+  reader.know("delay_steps");
+  const char* const allowed = "must be a whole number of steps in [0, 1000], or [low, high] of them";
+  std::int64_t steps = 0;
+  bool single = false;
+  try
+  {
+    single = source.get(reader.key("delay_steps"), steps);
+  }
+  catch (const ConfigError&)
+  {
+    std::vector<double> delay;
+    source.get(reader.key("delay_steps"), delay);  // not a list either: throws naming the key
+    if (delay.size() != 2 || delay[0] != std::floor(delay[0]) || delay[1] != std::floor(delay[1]) || delay[0] < 0 ||
+        delay[1] < delay[0] || delay[1] > 1000)
+      reader.fail("delay_steps", SectionReader::listText(delay), allowed);
+    p.delay_steps = static_cast<unsigned>(delay[0]);
+    p.delay_steps_max = static_cast<unsigned>(delay[1]);
+  }
+  if (single)
+  {
+    if (steps < 0 || steps > 1000)
+      reader.fail("delay_steps", std::to_string(steps), allowed);
+    p.delay_steps = p.delay_steps_max = static_cast<unsigned>(steps);
+  }
+  reader.readDimensions("noise_std", p.noise_std, false);
+  reader.readDimensions("noise_fraction", p.noise_fraction, false);
+  for (const auto& [name, range] : {std::pair<const char*, ScaleRange*>{"mass_cart", &p.mass_cart},
+                                    {"mass_pole", &p.mass_pole},
+                                    {"half_length", &p.half_length},
+                                    {"motor", &p.motor}})
+  {
+    std::vector<double> bounds;
+    reader.know(name);
+    if (!source.get(reader.key(name), bounds))
+      continue;
+    if (bounds.size() != 2)
+      reader.fail(name, SectionReader::listText(bounds), "must list 2 factors: [low, high]");
+    range->low = bounds[0];
+    range->high = bounds[1];
+  }
+  reader.read("push_probability", p.push_probability);
+  reader.read("push_force", p.push_force);
+  reader.refuseUnknown();
+  reader.check(p.validate());
+  return p;
 }
 
 TaskParams readTask(const ParameterSource& source)
@@ -276,6 +330,7 @@ AgentParams readAgent(const ParameterSource& source)
   reader.readDimensions("bins", agent.discretiser.bins, true);
   reader.read("tilings", agent.tilings, 1, kMaxTilings);
   reader.readDimensions("tiles", agent.tiles, true);
+  reader.read("previous_action", agent.previous_action);
   reader.readDimensions("lower_bounds", agent.discretiser.lower, false);
   reader.readDimensions("upper_bounds", agent.discretiser.upper, false);
   readSchedule(reader, "epsilon", agent.epsilon);
@@ -301,6 +356,7 @@ TrainingConfig readTrainingConfig(const ParameterSource& source)
 {
   TrainingConfig config;
   readPhysics(source, config.physics, config.start_state_bound);
+  config.perturbations = readPerturbations(source);
   config.task = readTask(source);
   config.agent = readAgent(source);
   config.limits = readLimits(source);

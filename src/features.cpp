@@ -34,9 +34,14 @@ std::string FeatureParams::validate() const
   return kind == FeatureKind::Tiles ? tileCoder().validate() : discretiser.validate();
 }
 
-std::size_t FeatureParams::rowCount() const
+std::size_t FeatureParams::stateRowCount() const
 {
   return kind == FeatureKind::Tiles ? TileCoder(tileCoder()).tileCount() : Discretiser(discretiser).stateCount();
+}
+
+std::size_t FeatureParams::rowCount(std::size_t actions) const
+{
+  return stateRowCount() * blocks(actions);
 }
 
 namespace
@@ -67,6 +72,9 @@ std::string FeatureParams::mismatch(const FeatureParams& other) const
 {
   if (kind != other.kind)
     return "features " + toString(other.kind) + " differ from " + toString(kind);
+  if (previous_action != other.previous_action)
+    return std::string("previous_action ") + (other.previous_action ? "true" : "false") + " differs from " +
+           (previous_action ? "true" : "false");
   if (kind == FeatureKind::Bins)
   {
     if (discretiser.bins != other.discretiser.bins)
@@ -95,16 +103,17 @@ const FeatureParams& checked(const FeatureParams& params)
 }
 }  // namespace
 
-FeatureMap::FeatureMap(const FeatureParams& params)
+FeatureMap::FeatureMap(const FeatureParams& params, std::size_t actions)
   : params_(checked(params)),
     discretiser_(params.kind == FeatureKind::Bins ? params.discretiser : DiscretiserParams()),
-    row_count_(discretiser_.stateCount())
+    state_rows_(discretiser_.stateCount())
 {
   if (params_.kind == FeatureKind::Tiles)
   {
     tile_coder_.emplace(params_.tileCoder());
-    row_count_ = tile_coder_->tileCount();
+    state_rows_ = tile_coder_->tileCount();
   }
+  row_count_ = state_rows_ * params_.blocks(actions);
 }
 
 }  // namespace cartpole_qlearning

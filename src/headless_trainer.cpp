@@ -8,16 +8,19 @@ HeadlessTrainer::HeadlessTrainer(const TrainingConfig& config, std::uint64_t see
   : config_(config), session_(config.task, config.agent, seed, learning, robots)
 {
   for (std::size_t r = 0; r < robots; ++r)
-    simulations_.emplace_back(config.physics, config.start_state_bound, robotSeed(seed, r));
+    simulations_.emplace_back(config.physics, config.start_state_bound, robotSeed(seed, r), config.perturbations);
 }
 
 const EpisodeSummary& HeadlessTrainer::runEpisode()
 {
   CartPoleSimulation& simulation = simulations_.front();
-  double effort = session_.beginEpisode(simulation.resetRandom());
+  simulation.resetRandom();
+  // The learner sees what the sensors read (the true state when they are not noisy).
+  double effort = session_.beginEpisode(simulation.observation());
   for (;;)
   {
-    const Decision decision = session_.observe(simulation.step(effort));
+    simulation.step(effort);
+    const Decision decision = session_.observe(simulation.observation());
     if (decision.episode_over)
       return session_.lastEpisode();
     effort = decision.effort;
@@ -55,10 +58,12 @@ TrainingResult HeadlessTrainer::runUntil(const std::function<bool(const EpisodeS
       CartPoleSimulation& simulation = simulations_[r];
       if (!session_.inEpisode(r))
       {
-        efforts[r] = session_.beginEpisode(simulation.state(), r);
+        // The learner sees what the sensors read (the true state when they are not noisy).
+        efforts[r] = session_.beginEpisode(simulation.observation(), r);
         continue;
       }
-      const Decision decision = session_.observe(simulation.step(efforts[r]), r);
+      simulation.step(efforts[r]);
+      const Decision decision = session_.observe(simulation.observation(), r);
       if (!decision.episode_over)
       {
         efforts[r] = decision.effort;

@@ -18,7 +18,7 @@ ControllerProtocolParams protocolParams(const TrainingConfig& config, std::size_
 
 LockstepLoopback::Robot::Robot(const TrainingConfig& config, std::uint64_t seed, TrainingSession& session,
                                std::size_t index)
-  : simulation(config.physics, config.start_state_bound, robotSeed(seed, index)),
+  : simulation(config.physics, config.start_state_bound, robotSeed(seed, index), config.perturbations),
     // No message is ever lost here, so no state is ever repeated.
     sim_protocol(tickOf(config.physics.tau), WallClock::duration::max()),
     controller_protocol(session, protocolParams(config, index))
@@ -48,7 +48,7 @@ TrainingResult LockstepLoopback::run(const std::function<void(const EpisodeSumma
   {
     for (auto& robot : robots_)
     {
-      const Reaction reaction = robot->controller_protocol.onState(robot->stamp, robot->simulation.state());
+      const Reaction reaction = robot->controller_protocol.onState(robot->stamp, robot->simulation.observation());
       if (reaction.episode_ended)
       {
         const EpisodeSummary& summary = session_.lastEpisode();

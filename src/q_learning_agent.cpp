@@ -76,6 +76,7 @@ FeatureParams AgentParams::featureParams() const
   params.discretiser = discretiser;
   params.tilings = tilings;
   params.tiles = tiles;
+  params.previous_action = previous_action;
   return params;
 }
 
@@ -106,6 +107,8 @@ std::string AgentParams::validate() const
   // Names label table rows, one per state: tiles have no such rows.
   error = features == FeatureKind::Tiles && !state_names.empty()
               ? "state_names is not allowed with features tiles (it names the rows of bins, one per state)"
+          : previous_action && !state_names.empty()
+              ? "state_names is not allowed with previous_action (the rows repeat per previous action)"
               : stateNamesError(state_names, discretiser);
   if (!error.empty())
     return error;
@@ -131,7 +134,7 @@ const AgentParams& checked(const AgentParams& params)
 
 QLearningAgent::QLearningAgent(const AgentParams& params, std::uint64_t seed)
   : params_(checked(params)),
-    features_(params.featureParams()),
+    features_(params.featureParams(), params.actions.size()),
     epsilon_(params.epsilon),
     alpha_(params.alpha),
     table_(params.featureParams(), params.actions),

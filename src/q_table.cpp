@@ -21,7 +21,7 @@ QTable::QTable(const DiscretiserParams& discretiser, const std::vector<double>& 
 }
 
 QTable::QTable(const FeatureParams& features, const std::vector<double>& actions)
-  : features_(features), actions_(actions), state_count_(FeatureMap(features).rowCount())
+  : features_(features), actions_(actions), state_count_(FeatureMap(features, actions.size()).rowCount())
 {
   if (actions_.empty())
     throw std::invalid_argument("a Q-table needs at least one action");

@@ -65,6 +65,9 @@ std::string checksumOf(const QTable& table)
   }
   for (double a : table.actions())
     sum.add(a);
+  // Summed only when on, so that every other table keeps its checksum.
+  if (f.previous_action)
+    sum.add(std::uint64_t{1});
   sum.add(table.episodes);
   sum.add(table.steps);
   for (double v : table.values())
@@ -191,7 +194,13 @@ std::string formatQTable(const QTable& table)
         << "dimensions: [x, x_dot, theta, theta_dot]\n"
         << "bins: " << flowList(d.bins) << "\n";
   out << "lower_bounds: " << flowList(d.lower) << "\n"
-      << "upper_bounds: " << flowList(d.upper) << "\n"
+      << "upper_bounds: " << flowList(d.upper) << "\n";
+  // Written only when on: a table without it is the file it always was.
+  if (f.previous_action)
+    out << "# The rows repeat once per previous action: first for none (an episode's first state), then\n"
+        << "# for each action in order; the learner sees the action it took last.\n"
+        << "previous_action: true\n";
+  out
       << "# The effort [N] of each action: one column of values per action.\n"
       << "actions: " << flowList(table.actions()) << "\n"
       << "# Training that produced this table.\n"
@@ -281,6 +290,13 @@ QTable parseQTable(const std::string& text)
   const std::vector<double> upper = readNumbers(required(root, "upper_bounds"), "upper_bounds", kStateDimensions);
   std::copy(lower.begin(), lower.end(), discretiser.lower.begin());
   std::copy(upper.begin(), upper.end(), discretiser.upper.begin());
+  // Absent in older files: the state alone.
+  if (const YAML::Node previous = root["previous_action"])
+  {
+    if (!previous.IsScalar() || (previous.Scalar() != "true" && previous.Scalar() != "false"))
+      refuse("previous_action is not true or false");
+    features.previous_action = previous.Scalar() == "true";
+  }
   const std::string invalid = features.validate();
   if (!invalid.empty())
     refuse("invalid " + toString(features.kind) + ": " + invalid);
@@ -292,7 +308,7 @@ QTable parseQTable(const std::string& text)
   // Every count is checked against the rows the file really holds before the table (up to
   // kMaxStates rows of kMaxActions values: 8 GB) is allocated, so a short file that claims a
   // huge table costs nothing.
-  const std::size_t row_count = features.rowCount();
+  const std::size_t row_count = features.rowCount(actions.size());
   const char* const rows_key = version1 ? "states" : "rows";
   const std::uint64_t rows_said = readCount(required(root, rows_key), rows_key);
   if (rows_said != row_count)

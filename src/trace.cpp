@@ -12,9 +12,16 @@ std::vector<std::string> stateNames(const AgentParams& params)
     return params.state_names;
   const std::size_t states = Discretiser(params.discretiser).stateCount();
   std::vector<std::string> names;
-  names.reserve(states + 1);
-  for (std::size_t s = 0; s < states; ++s)
-    names.push_back("S" + std::to_string(s));
+  // With previous_action the rows repeat per previous action: none first, then each action.
+  const std::size_t blocks = params.featureParams().blocks(params.actions.size());
+  names.reserve(states * blocks + 1);
+  for (std::size_t b = 0; b < blocks; ++b)
+  {
+    const std::string after =
+        blocks == 1 ? "" : (b == 0 ? " at start" : " after " + traceNumber(params.actions[b - 1]));
+    for (std::size_t s = 0; s < states; ++s)
+      names.push_back("S" + std::to_string(s) + after);
+  }
   names.push_back("fallen");
   return names;
 }

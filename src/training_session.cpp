@@ -67,7 +67,8 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   ++e.steps;
   decision.outcome = task_.evaluate(state, e.steps);
   e.episode_return += decision.outcome.reward;
-  agent_.activeRows(state, e.next());
+  // The action just taken: with previous_action, part of what the learner sees of this state.
+  agent_.activeRows(state, e.next(), e.action + 1);
   if (learning_)
   {
     const QUpdate update =

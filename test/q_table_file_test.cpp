@@ -450,4 +450,47 @@ TEST(DefaultTableDirectory, EachNamespaceHasAFolderOfItsOwnUnderRosHome)
             defaultTableDirectory("/first"));
   if (before != nullptr)
     ::setenv("ROS_HOME", saved.c_str(), 1);
+
+TEST_F(QTableFileTest, APreviousActionTableSaysSoAndAnOlderFileLoadsWithout)
+{
+  FeatureParams f;
+  f.previous_action = true;
+  QTable table(f, {-10.0, 10.0});
+  ASSERT_EQ(72u * 3u, table.stateCount());  // none, after -10, after +10
+  std::vector<double> values(table.values().size());
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = 1.0 / (1.0 + static_cast<double>(i));
+  table.setValues(values);
+  saveQTableFile(table, path("previous.yaml"));
+  const std::string text = readFile(path("previous.yaml"));
+  EXPECT_NE(std::string::npos, text.find("previous_action: true\n")) << text;
+  EXPECT_NE(std::string::npos, text.find("rows: 216\n")) << text;
+  const QTable loaded = loadQTableFile(path("previous.yaml"));
+  EXPECT_TRUE(loaded.features().previous_action);
+  EXPECT_TRUE(bitIdentical(table.values(), loaded.values()));
+
+  // A table without it is written as it always was (no key, the same checksum), and reads back without it.
+  saveQTableFile(awkwardTable(), path("plain.yaml"));
+  EXPECT_EQ(std::string::npos, readFile(path("plain.yaml")).find("previous_action"));
+  EXPECT_FALSE(loadQTableFile(path("plain.yaml")).features().previous_action);
+
+  // The checksum covers it: the key taken away (rows made to fit) is refused.
+  std::string stripped = text;
+  stripped.replace(stripped.find("previous_action: true\n"), 22, "");
+  write(path("stripped.yaml"), stripped);
+  EXPECT_THROW(loadQTableFile(path("stripped.yaml")), QTableFileError);
+  std::string bad = text;
+  bad.replace(bad.find("previous_action: true"), 21, "previous_action: yes!");
+  write(path("bad.yaml"), bad);
+  EXPECT_THROW(loadQTableFile(path("bad.yaml")), QTableFileError);
+
+  // A learner that sees the previous action takes no table that does not, and the other way round.
+  AgentParams plain;
+  TrainingSession plain_session(TaskParams(), plain, 0);
+  EXPECT_EQ("previous_action true differs from false", loadInto(plain_session, path("previous.yaml")));
+  AgentParams with;
+  with.previous_action = true;
+  TrainingSession with_session(TaskParams(), with, 0);
+  EXPECT_EQ("previous_action false differs from true", loadInto(with_session, path("plain.yaml")));
+  EXPECT_EQ("", loadInto(with_session, path("previous.yaml")));
 }

@@ -30,6 +30,11 @@ struct CartPoleParams
   double force_mag = 10.0;   // [N] largest force the actuator applies; commands are clamped to it
   double tau = 0.02;         // [s] one step
   Integrator integrator = Integrator::Euler;
+  // Friction, as in Barto, Sutton and Anderson's original equations (1983): of the cart on the
+  // track [N, against the cart's velocity's sign] and of the pole on its hinge [N m s]. 0: none
+  // (Gymnasium's model; their paper used 0.0005 and 0.000002).
+  double cart_friction = 0.0;
+  double pole_friction = 0.0;
 
   // Empty when valid, else a message naming the first bad field, its value and the allowed range.
   std::string validate() const;

@@ -6,6 +6,7 @@
 #include "cartpole_qlearning/cartpole_dynamics.h"
 #include "cartpole_qlearning/cartpole_task.h"
 #include "cartpole_qlearning/discretiser.h"
+#include "cartpole_qlearning/perturbations.h"
 #include "cartpole_qlearning/q_learning_agent.h"
 
 #include <algorithm>
@@ -202,7 +203,7 @@ private:
 std::unique_ptr<ParameterSource> loadYamlParameters(const std::string& path);
 std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin);
 
-// Refuses top-level keys other than the sections physics, task, learning and training (for a
+// Refuses top-level keys other than the sections physics, perturbations, task, learning and training (for a
 // file that holds only those; the parameter server holds other names beside them).
 void refuseUnknownSections(const ParameterSource& source);
 
@@ -223,6 +224,7 @@ struct TrainingConfig
 {
   CartPoleParams physics;
   double start_state_bound = 0.05;  // [m, m/s, rad, rad/s] random starts are uniform in +-this
+  PerturbationParams perturbations;  // what a real cart-pole does (none by default)
   TaskParams task;
   AgentParams agent;
   TrainingLimits limits;
@@ -231,6 +233,8 @@ struct TrainingConfig
 // Each reader starts from the defaults, overrides what the source sets, validates, and throws
 // ConfigError naming the key on a bad value or an unknown key in its section.
 void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound);
+// The perturbations section (a late command, sensor noise, physics drawn per episode, pushes).
+PerturbationParams readPerturbations(const ParameterSource& source);
 TaskParams readTask(const ParameterSource& source);
 AgentParams readAgent(const ParameterSource& source);
 TrainingLimits readLimits(const ParameterSource& source);

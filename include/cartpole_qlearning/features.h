@@ -32,12 +32,24 @@ struct FeatureParams
   DiscretiserParams discretiser;
   unsigned tilings = 8;
   std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
+  // The learner also sees the action it took last: what a robot that answers a step late is
+  // still carrying out, which the state alone does not show. The rows repeat once for "none"
+  // (an episode's first state) and once per action.
+  bool previous_action = false;
 
   TileCoderParams tileCoder() const;
   // Empty when the kind in use is valid, else validate()'s message of its parameters.
   std::string validate() const;
-  // Weight rows: states for bins, tiles of every tiling for tiles. Valid params only.
-  std::size_t rowCount() const;
+  // Weight rows: states for bins, tiles of every tiling for tiles, times the previous action's
+  // blocks. Valid params only.
+  std::size_t rowCount(std::size_t actions) const;
+  // The rows of one block: what the state alone activates.
+  std::size_t stateRowCount() const;
+  // 1, or (previous_action) one block for "none" and one per action.
+  std::size_t blocks(std::size_t actions) const
+  {
+    return previous_action ? actions + 1 : 1;
+  }
   // Empty when both map states to the same rows, else what differs ("tilings 4 differ from 8"),
   // the other's value first. Only the parameters of the kind in use count.
   std::string mismatch(const FeatureParams& other) const;
@@ -63,8 +75,9 @@ struct ActiveRows
 class FeatureMap
 {
 public:
-  // Throws std::invalid_argument with validate()'s message.
-  explicit FeatureMap(const FeatureParams& params = FeatureParams());
+  // actions: how many actions the table has (the previous action's blocks). Throws
+  // std::invalid_argument with validate()'s message.
+  explicit FeatureMap(const FeatureParams& params = FeatureParams(), std::size_t actions = 2);
 
   const FeatureParams& params() const
   {
@@ -80,22 +93,28 @@ public:
     return discretiser_;
   }
 
-  void activeRows(const CartPoleState& state, ActiveRows& active) const
+  // previous: 0 for none (an episode's first state), 1 + the index of the action taken last;
+  // ignored unless params().previous_action.
+  void activeRows(const CartPoleState& state, ActiveRows& active, std::size_t previous = 0) const
   {
+    const auto offset = static_cast<std::uint32_t>(params_.previous_action ? previous * state_rows_ : 0);
     if (!tile_coder_)
     {
-      active.rows[0] = static_cast<std::uint32_t>(discretiser_.index(state));
+      active.rows[0] = static_cast<std::uint32_t>(discretiser_.index(state)) + offset;
       active.count = 1;
       return;
     }
     tile_coder_->activeTiles(state, active.rows.data());
     active.count = tile_coder_->tilings();
+    for (unsigned i = 0; offset != 0 && i < active.count; ++i)
+      active.rows[i] += offset;
   }
 
 private:
   FeatureParams params_;
   Discretiser discretiser_;
   std::optional<TileCoder> tile_coder_;
+  std::size_t state_rows_;
   std::size_t row_count_;
 };
 

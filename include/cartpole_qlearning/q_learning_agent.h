@@ -24,6 +24,7 @@ struct AgentParams
   DiscretiserParams discretiser;
   unsigned tilings = 8;
   std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
+  bool previous_action = false;               // the action taken last is part of what the learner sees
   std::vector<double> actions{-10.0, 10.0};   // [N] the effort of each action
   double gamma = 0.99;                        // discount, in [0, 1]
   ScheduleParams epsilon = defaultEpsilon();  // exploration rate per episode
@@ -74,9 +75,10 @@ public:
     return features_.discretiser();
   }
   // The rows a state activates. No allocation.
-  void activeRows(const CartPoleState& state, ActiveRows& active) const
+  // previous: 0 for none (an episode's first state), else 1 + the action taken last.
+  void activeRows(const CartPoleState& state, ActiveRows& active, std::size_t previous = 0) const
   {
-    features_.activeRows(state, active);
+    features_.activeRows(state, active, previous);
   }
   const QTable& table() const
   {
