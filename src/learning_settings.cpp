@@ -136,4 +136,37 @@ std::string learningSettingsText(const LearningSettings& s)
   return out.str();
 }
 
+Saying liveTuningSaid(const LearningSettings& in_use, const LearningSettings& wanted, const std::string& error,
+                      bool restarted, bool learning)
+{
+  if (!error.empty())
+  {
+    if (restarted)
+      return {{Said::Level::Warn, "restarted; the live tuning left by the controller before the restart is refused (" +
+                                      error +
+                                      "): this run goes on with its configuration's: " + learningSettingsText(in_use)}};
+    return {{Said::Level::Warn, "live tuning refused (asked: " + learningChangesText(in_use, wanted) + "): " + error +
+                                    "; nothing changed, in use: " + learningSettingsText(in_use)}};
+  }
+  const std::string changes = learningChangesText(in_use, wanted);
+  if (changes.empty())
+    return {};
+  const std::string applies = learning ? "gamma from the next update, epsilon and alpha from the next episode"
+                                       : "evaluating, so none of it applies: actions stay greedy (epsilon 0), nothing "
+                                         "is learnt (alpha 0, gamma unused)";
+  if (restarted)
+    return {{Said::Level::Warn, "restarted; the live tuning of this run before the restart applies again: " + changes +
+                                    " (" + applies + ")"}};
+  return {{Said::Level::Info, "live tuning: " + changes + " (" + applies + ")"}};
+}
+
+Saying liveTuningReplacedSaid(const LearningSettings& left, const LearningSettings& configured)
+{
+  const std::string replaced = learningChangesText(left, configured);
+  if (replaced.empty())
+    return {};
+  return {{Said::Level::Info,
+           "a new run: live-tuning values left on the parameter server replaced by its configuration's: " + replaced}};
+}
+
 }  // namespace cartpole_qlearning

@@ -13,21 +13,6 @@ namespace cartpole_qlearning
 {
 namespace
 {
-__attribute__((format(printf, 1, 2))) std::string format(const char* pattern, ...)
-{
-  std::va_list args;
-  va_start(args, pattern);
-  std::va_list again;
-  va_copy(again, args);
-  const int size = std::vsnprintf(nullptr, 0, pattern, args);
-  va_end(args);
-  std::string text(size > 0 ? static_cast<std::size_t>(size) : 0, '\0');
-  if (size > 0)
-    std::vsnprintf(text.data(), text.size() + 1, pattern, again);
-  va_end(again);
-  return text;
-}
-
 unsigned long long count(std::uint64_t value)
 {
   return static_cast<unsigned long long>(value);
@@ -193,8 +178,8 @@ void RunApplication::State::loadOnStart(Saying& said)
                       "' (~load_on_start, which the launch files' q_table or load argument sets): " + e.what());
   }
   say(said, Said::Level::Info,
-      format("loaded %s (%llu episodes, %llu steps of training)", path.c_str(), count(session.table().episodes),
-             count(session.table().steps)));
+      formatText("loaded %s (%llu episodes, %llu steps of training)", path.c_str(), count(session.table().episodes),
+                 count(session.table().steps)));
 }
 
 void RunApplication::State::openStatsFile()
@@ -246,12 +231,13 @@ void RunApplication::State::openRun(const RunIdentity& previous, Saying& said)
   catch (const FileError& e)
   {
     say(said, Said::Level::Error,
-        format("cannot make this run's folder (%s): checkpoints will fail; ~save_q_table can still save the table "
-               "elsewhere",
-               e.what()));
+        formatText("cannot make this run's folder (%s): checkpoints will fail; ~save_q_table can still save the table "
+                   "elsewhere",
+                   e.what()));
   }
   say(said, Said::Level::Info,
-      format("run %s: checkpoints go to %s", run_folder.c_str(), resolve(run_folder + "/" + kRunTableFile).c_str()));
+      formatText("run %s: checkpoints go to %s", run_folder.c_str(),
+                 resolve(run_folder + "/" + kRunTableFile).c_str()));
 }
 
 void RunApplication::State::resumeRun(bool respawn, Saying& said)
@@ -273,8 +259,8 @@ void RunApplication::State::resumeRun(bool respawn, Saying& said)
     // Killed before its first checkpoint (or the checkpoint is unusable): the run starts over.
     run.started = localTimeText(clocks.calendar());
     say(said, Said::Level::Warn,
-        format("restarted; run %s has no checkpoint to go on from (%s): starting it over", run_folder.c_str(),
-               e.what()));
+        formatText("restarted; run %s has no checkpoint to go on from (%s): starting it over", run_folder.c_str(),
+                   e.what()));
     return;
   }
   // A crash between the table's save and the record's leaves the record one checkpoint behind:
@@ -289,16 +275,17 @@ void RunApplication::State::resumeRun(bool respawn, Saying& said)
   const EpisodeSummary& s = session.lastEpisode();
   steps_at_last_episode = steps_at_last_progress = s.total_steps;
   say(said, Said::Level::Warn,
-      format("%srun %s goes on from its checkpoint: episode %llu, %llu steps%s", restarted, run_folder.c_str(),
-             count(s.episode), count(s.total_steps),
-             record_matches ? "" : " (its record was one checkpoint behind: the solved window starts empty)"));
+      formatText("%srun %s goes on from its checkpoint: episode %llu, %llu steps%s", restarted, run_folder.c_str(),
+                 count(s.episode), count(s.total_steps),
+                 record_matches ? "" : " (its record was one checkpoint behind: the solved window starts empty)"));
   if (!record.finished.empty())
   {
     // Ended (or killed) after its final save: nothing to train. A controller stays up rather
     // than exit, which under respawn would only start it again.
     finished = final_saved = true;
     say(said, Said::Level::Info,
-        format("run %s has finished already (%s); nothing left to do", run_folder.c_str(), record.finished.c_str()));
+        formatText("run %s has finished already (%s); nothing left to do", run_folder.c_str(),
+                   record.finished.c_str()));
   }
 }
 
@@ -501,13 +488,13 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
     // Evaluation: every episode said, and after evaluation_episodes a one-line verdict.
     st.balanced += s.truncated && !s.terminated;
     say(end.said, Said::Level::Info,
-        format("evaluation episode %llu: %u steps, return %.1f, %s", count(s.episode), s.steps, s.episode_return,
-               s.terminated ? "fell" : "balanced to the step limit"));
+        formatText("evaluation episode %llu: %u steps, return %.1f, %s", count(s.episode), s.steps, s.episode_return,
+                   s.terminated ? "fell" : "balanced to the step limit"));
     if (st.settings.evaluation_episodes == 0 || s.episode < st.settings.evaluation_episodes)
       return end;
     say(end.said, Said::Level::Info,
-        format("EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f",
-               count(s.episode), count(st.balanced), st.config.task.max_episode_steps, s.mean_return_window));
+        formatText("EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f",
+                   count(s.episode), count(st.balanced), st.config.task.max_episode_steps, s.mean_return_window));
     st.finished = end.finished = true;
     return end;
   }
@@ -518,15 +505,15 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
     {
       // Keep the trained table alive: the user can still save it elsewhere with ~save_q_table.
       say(end.said, Said::Level::Error,
-          format("training ended (%s, episode %llu) but the table could not be saved: %s. The node keeps running: "
-                 "call ~save_q_table with another path",
-                 s.solved ? "solved" : "max_episodes", count(s.episode), saved.c_str()));
+          formatText("training ended (%s, episode %llu) but the table could not be saved: %s. The node keeps running: "
+                     "call ~save_q_table with another path",
+                     s.solved ? "solved" : "max_episodes", count(s.episode), saved.c_str()));
       return end;
     }
     say(end.said, Said::Level::Info,
-        format("%s after %llu episodes, %llu steps, %.1f s (mean return of the last %u: %.2f); %s",
-               s.solved ? "SOLVED" : "NOT solved, max_episodes reached", count(s.episode), count(s.total_steps),
-               seconds(now - st.started), st.config.task.solved_window, s.mean_return_window, saved.c_str()));
+        formatText("%s after %llu episodes, %llu steps, %.1f s (mean return of the last %u: %.2f); %s",
+                   s.solved ? "SOLVED" : "NOT solved, max_episodes reached", count(s.episode), count(s.total_steps),
+                   seconds(now - st.started), st.config.task.solved_window, s.mean_return_window, saved.c_str()));
     end.finished = true;
     return end;
   }
@@ -575,8 +562,8 @@ ServiceAnswer RunApplication::load(const std::string& path)
       {
         s.csv->startOver();
         say(answer.said, Said::Level::Info,
-            format("the learning curve %s starts over from the loaded table's episode %llu", s.csv->path().c_str(),
-                   count(episodes)));
+            formatText("the learning curve %s starts over from the loaded table's episode %llu", s.csv->path().c_str(),
+                       count(episodes)));
       }
       catch (const FileError& e)
       {

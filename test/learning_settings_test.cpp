@@ -170,3 +170,43 @@ TEST(LearningSettings, ChangesAreSaidFieldByFieldAndNothingWhenNothingChanged)
   EXPECT_EQ(0u, text.find("epsilon 0 (override; schedule ")) << text;
   EXPECT_NE(std::string::npos, text.find(", alpha constant 0.5, gamma 0.95")) << text;
 }
+
+TEST(LearningSettings, LiveTuningSaysWhatAppliedWhatWasRefusedAndWhatARespawnFound)
+{
+  const LearningSettings in_use = LearningSettings::of(AgentParams());
+  LearningSettings wanted = in_use;
+  wanted.gamma = 0.95;
+  const Saying applied = liveTuningSaid(in_use, wanted, "", false, true);
+  ASSERT_EQ(applied.size(), 1u);
+  EXPECT_EQ(applied[0].level, Said::Level::Info);
+  EXPECT_EQ(applied[0].text,
+            "live tuning: gamma 0.99 -> 0.95 (gamma from the next update, epsilon and alpha from "
+            "the next episode)");
+  const Saying evaluating = liveTuningSaid(in_use, wanted, "", false, false);
+  ASSERT_EQ(evaluating.size(), 1u);
+  EXPECT_NE(evaluating[0].text.find("evaluating, so none of it applies"), std::string::npos);
+  const Saying respawn = liveTuningSaid(in_use, wanted, "", true, true);
+  ASSERT_EQ(respawn.size(), 1u);
+  EXPECT_EQ(respawn[0].level, Said::Level::Warn);
+  EXPECT_EQ(respawn[0].text.find("restarted; the live tuning of this run before the restart applies again: gamma"), 0u);
+  EXPECT_TRUE(liveTuningSaid(in_use, in_use, "", false, true).empty());
+
+  const Saying refused = liveTuningSaid(in_use, wanted, "epsilon_min = 0.9 is not allowed", false, true);
+  ASSERT_EQ(refused.size(), 1u);
+  EXPECT_EQ(refused[0].level, Said::Level::Warn);
+  EXPECT_EQ(refused[0].text.find("live tuning refused (asked: gamma 0.99 -> 0.95): epsilon_min = 0.9 is not allowed; "
+                                 "nothing changed, in use: "),
+            0u)
+      << refused[0].text;
+  const Saying refused_respawn = liveTuningSaid(in_use, wanted, "epsilon_min = 0.9 is not allowed", true, true);
+  EXPECT_EQ(refused_respawn[0].text.find("restarted; the live tuning left by the controller before the restart is "
+                                         "refused (epsilon_min = 0.9 is not allowed): this run goes on with"),
+            0u);
+
+  EXPECT_TRUE(liveTuningReplacedSaid(in_use, in_use).empty());
+  const Saying replaced = liveTuningReplacedSaid(wanted, in_use);
+  ASSERT_EQ(replaced.size(), 1u);
+  EXPECT_EQ(replaced[0].text,
+            "a new run: live-tuning values left on the parameter server replaced by its "
+            "configuration's: gamma 0.95 -> 0.99");
+}

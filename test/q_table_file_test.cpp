@@ -450,6 +450,7 @@ TEST(DefaultTableDirectory, EachNamespaceHasAFolderOfItsOwnUnderRosHome)
             defaultTableDirectory("/first"));
   if (before != nullptr)
     ::setenv("ROS_HOME", saved.c_str(), 1);
+}
 
 TEST_F(QTableFileTest, APreviousActionTableSaysSoAndAnOlderFileLoadsWithout)
 {

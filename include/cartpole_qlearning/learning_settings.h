@@ -4,6 +4,7 @@
 #pragma once
 
 #include "cartpole_qlearning/q_learning_agent.h"
+#include "cartpole_qlearning/said.h"
 #include "cartpole_qlearning/schedule.h"
 
 #include <optional>
@@ -39,5 +40,16 @@ std::string learningChangesText(const LearningSettings& before, const LearningSe
 // The settings in use, for the console: "epsilon 0 (override; schedule log 1 -> 0.01
 // (log_divisor 25)), alpha log 1 -> 0.05 (log_divisor 15), gamma 0.99".
 std::string learningSettingsText(const LearningSettings& settings);
+
+// What live tuning says about a client's change. in_use: the settings before it; wanted: what
+// was asked; error: why it was refused, with the field named as the server names it ("" when it
+// applied); restarted: the first change a respawned controller gets (its predecessor's tuning of
+// this run, served again); learning: training (else evaluating, where none of it applies).
+// Nothing is said of a change that changes nothing.
+Saying liveTuningSaid(const LearningSettings& in_use, const LearningSettings& wanted, const std::string& error,
+                      bool restarted, bool learning);
+// A new run found values an earlier controller left on the parameter server and replaces them
+// by its configuration's (nothing said when they were the same).
+Saying liveTuningReplacedSaid(const LearningSettings& left, const LearningSettings& configured);
 
 }  // namespace cartpole_qlearning

@@ -12,6 +12,7 @@
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/episode_csv.h"
 #include "cartpole_qlearning/node_settings.h"
+#include "cartpole_qlearning/said.h"
 #include "cartpole_qlearning/training_run.h"
 #include "cartpole_qlearning/training_session.h"
 
@@ -26,24 +27,6 @@
 
 namespace cartpole_qlearning
 {
-// One line to say, without any "qlearning_controller: " prefix (the caller adds its own, in one
-// place).
-struct Said
-{
-  enum class Level
-  {
-    Info,
-    Warn,
-    Error
-  };
-  Level level = Level::Info;
-  std::string text;
-  // false: said as it is, with no prefix (the progress lines and the trace: the same lines
-  // train_headless prints).
-  bool prefixed = true;
-};
-using Saying = std::vector<Said>;
-
 // The clocks a run reads, injected so that tests drive them.
 struct RunClocks
 {

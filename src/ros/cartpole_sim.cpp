@@ -72,11 +72,12 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
     timer_ = nh_.createSteadyTimer(ros::WallDuration(settings_.physics.tau), &CartPoleSimNode::onRealtimeTick, this);
     publishState(ros::Time::now());
   }
-  ROS_INFO("cartpole_sim: %s mode, tau %g s, integrator %s, seed %llu, start state [%g, %g, %g, %g]%s",
-           settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau,
-           toString(settings_.physics.integrator).c_str(), static_cast<unsigned long long>(settings_.seed),
-           simulation_->state()[0], simulation_->state()[1], simulation_->state()[2], simulation_->state()[3],
-           settings_.publish_clock ? ", publishing /clock" : "");
+  ROS_INFO_NAMED("cartpole_sim",
+                 "cartpole_sim: %s mode, tau %g s, integrator %s, seed %llu, start state [%g, %g, %g, %g]%s",
+                 settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau,
+                 toString(settings_.physics.integrator).c_str(), static_cast<unsigned long long>(settings_.seed),
+                 simulation_->state()[0], simulation_->state()[1], simulation_->state()[2], simulation_->state()[3],
+                 settings_.publish_clock ? ", publishing /clock" : "");
 }
 
 void CartPoleSimNode::readParameters()
@@ -89,12 +90,13 @@ bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
   if (!std::isfinite(requested))
   {
     if (nonfinite_warning_.ready())
-      ROS_WARN("cartpole_sim: refused a non-finite effort (%f)", requested);
+      ROS_WARN_NAMED("cartpole_sim", "cartpole_sim: refused a non-finite effort (%f)", requested);
     return false;
   }
   effort = std::clamp(requested, -settings_.effort_limit, settings_.effort_limit);
   if (effort != requested && clamp_warning_.ready())
-    ROS_WARN("cartpole_sim: effort %g N clamped to the limit of %g N", requested, settings_.effort_limit);
+    ROS_WARN_NAMED("cartpole_sim", "cartpole_sim: effort %g N clamped to the limit of %g N", requested,
+                   settings_.effort_limit);
   return true;
 }
 
@@ -105,7 +107,7 @@ void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
   if (!requested)
   {
     if (bad_command_warning_.ready())
-      ROS_WARN("cartpole_sim: %s", requested.refusal.c_str());
+      ROS_WARN_NAMED("cartpole_sim", "cartpole_sim: %s", requested.refusal.c_str());
     return;
   }
   double effort = 0.0;
@@ -115,7 +117,7 @@ void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
   if (settings_.mode == SimMode::Realtime)
   {
     if (!hold_->set(effort, msg->header.stamp.toNSec(), now))
-      ROS_DEBUG("cartpole_sim: dropped a joint_command older than the one held");
+      ROS_DEBUG_NAMED("cartpole_sim", "cartpole_sim: dropped a joint_command older than the one held");
     return;
   }
   apply(lockstep_->onCommand(msg->header.stamp.toNSec(), now), effort, msg->header.stamp);
@@ -158,9 +160,9 @@ void CartPoleSimNode::apply(SimProtocol::Verdict verdict, double effort, const r
   // Stale and duplicate answers are expected now and then (a reset with an answer in flight, a
   // repeat answered twice); future and unstamped ones come from a misbehaving publisher.
   if (verdict == SimProtocol::Verdict::Stale || verdict == SimProtocol::Verdict::Duplicate)
-    ROS_INFO("%s", text);
+    ROS_INFO_NAMED("cartpole_sim", "%s", text);
   else
-    ROS_WARN("%s", text);
+    ROS_WARN_NAMED("cartpole_sim", "%s", text);
 }
 
 void CartPoleSimNode::advance(double effort, const ros::Time& stamp)
@@ -184,7 +186,8 @@ void CartPoleSimNode::onLockstepTimer(const ros::SteadyTimerEvent&)
   const std::lock_guard<std::mutex> lock(mutex_);
   if (!lockstep_->repeatDue(WallClock::now()))
     return;
-  ROS_DEBUG("cartpole_sim: no command for %.3f s, publishing the state again", settings_.lockstep_timeout);
+  ROS_DEBUG_NAMED("cartpole_sim", "cartpole_sim: no command for %.3f s, publishing the state again",
+                  settings_.lockstep_timeout);
   republishState();
 }
 

@@ -373,11 +373,7 @@ void QLearningControllerNode::startLiveTuning()
       left.__fromServer__(pnh_);  // only the fields present there change
       LearningSettings left_settings = running;
       fromConfig(left, left_settings);
-      const std::string replaced = learningChangesText(left_settings, running);
-      if (!replaced.empty())
-        say(Said::Level::Info,
-            "a new run: live-tuning values left on the parameter server replaced by its configuration's: %s",
-            replaced.c_str());
+      say(liveTuningReplacedSaid(left_settings, running));
       toConfig(session_->learningSettings()).__toServer__(pnh_);
     }
   }
@@ -398,31 +394,7 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
   // What the server keeps, answers and publishes: the values in use (a refused change undone,
   // an override given as any negative number shown as -1).
   config = toConfig(session_->learningSettings());
-  if (!error.empty())
-  {
-    if (first && app_->respawned())
-      say(Said::Level::Warn,
-          "restarted; the live tuning left by the controller before the restart is refused (%s): this run goes on "
-          "with its configuration's: %s",
-          asServerField(error).c_str(), learningSettingsText(in_use).c_str());
-    else
-      say(Said::Level::Warn, "live tuning refused (asked: %s): %s; nothing changed, in use: %s",
-          learningChangesText(in_use, wanted).c_str(), asServerField(error).c_str(),
-          learningSettingsText(in_use).c_str());
-    return;
-  }
-  const std::string changes = learningChangesText(in_use, wanted);
-  if (changes.empty())
-    return;
-  const char* applies = settings_.run.learning
-                            ? "gamma from the next update, epsilon and alpha from the next episode"
-                            : "evaluating, so none of it applies: actions stay greedy (epsilon 0), nothing "
-                              "is learnt (alpha 0, gamma unused)";
-  if (first && app_->respawned())
-    say(Said::Level::Warn, "restarted; the live tuning of this run before the restart applies again: %s (%s)",
-        changes.c_str(), applies);
-  else
-    say(Said::Level::Info, "live tuning: %s (%s)", changes.c_str(), applies);
+  say(liveTuningSaid(in_use, wanted, asServerField(error), first && app_->respawned(), settings_.run.learning));
 }
 
 void QLearningControllerNode::requestReset(std::size_t robot)
@@ -455,14 +427,8 @@ void QLearningControllerNode::say(Said::Level level, const char* format, ...) co
 {
   std::va_list args;
   va_start(args, format);
-  std::va_list again;
-  va_copy(again, args);
-  const int size = std::vsnprintf(nullptr, 0, format, args);
+  const std::string text = formatTextV(format, args);
   va_end(args);
-  std::string text(size > 0 ? static_cast<std::size_t>(size) : 0, '\0');
-  if (size > 0)
-    std::vsnprintf(text.data(), text.size() + 1, format, again);
-  va_end(again);
   say({{level, text}});
 }
 

@@ -149,9 +149,9 @@ void ResetCaller::carryOut(const ResetCalls::Orders& orders)
   for (const ResetCalls::Say& say : orders.say)
   {
     if (say.level == ResetCalls::Say::Level::Warn)
-      ROS_WARN("qlearning_controller: %s", say.text.c_str());
+      ROS_WARN_NAMED("qlearning_controller", "qlearning_controller: %s", say.text.c_str());
     else
-      ROS_INFO("qlearning_controller: %s", say.text.c_str());
+      ROS_INFO_NAMED("qlearning_controller", "qlearning_controller: %s", say.text.c_str());
   }
   if (orders.call)
   {
