@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -23,7 +24,8 @@ template <typename CoreHeader>
 std::vector<std::string> foreignIncludes(const std::string& text, CoreHeader core_header)
 {
   // <vector>, <cstdint>; <unistd.h>, <sys/stat.h>; <Eigen/Core>; <yaml-cpp/yaml.h>
-  static const std::regex allowed_system(R"(<([a-z_]+|[a-z_]+\.h|sys/[a-z_]+\.h|Eigen/[A-Za-z]+|yaml-cpp/[a-z_/]+\.h)>)");
+  static const std::regex allowed_system(
+      R"(<([a-z_]+|[a-z_]+\.h|sys/[a-z_]+\.h|Eigen/[A-Za-z]+|yaml-cpp/[a-z_/]+\.h)>)");
   static const std::regex include(R"re(^\s*#\s*include\s*([<"][^>"]*[>"]))re");
   static const std::regex own(R"re("cartpole_qlearning/([a-z0-9_]+\.h)")re");
   std::vector<std::string> foreign;
@@ -36,8 +38,8 @@ std::vector<std::string> foreignIncludes(const std::string& text, CoreHeader cor
       continue;
     const std::string target = m[1];
     std::smatch o;
-    const bool ok = std::regex_match(target, allowed_system) ||
-                    (std::regex_match(target, o, own) && core_header(o[1].str()));
+    const bool ok =
+        std::regex_match(target, allowed_system) || (std::regex_match(target, o, own) && core_header(o[1].str()));
     if (!ok)
       foreign.push_back("line " + std::to_string(number) + ": " + line);
   }
@@ -90,6 +92,74 @@ TEST(CoreLayoutTest, NoCoreFileIncludesAHeaderFromOutsideTheCore)
     }
   }
   EXPECT_GT(files, 40u) << "the core's files were not found under " << kSource;
+}
+
+// The names in backquotes in the README's Layout row that starts with `first_cell`, leaving out
+// paths and patterns (they name folders, not files).
+std::set<std::string> layoutNames(const std::string& readme, const std::string& first_cell)
+{
+  const std::size_t layout = readme.find("## Layout\n");
+  const std::size_t row = readme.find("\n| " + first_cell + " |", layout);
+  std::set<std::string> names;
+  if (layout == std::string::npos || row == std::string::npos)
+    return names;
+  const std::string line = readme.substr(row + 1, readme.find('\n', row + 1) - row - 1);
+  const std::string cells = line.substr(first_cell.size() + 4);
+  static const std::regex quoted("`([^`]+)`");
+  for (std::sregex_iterator it(cells.begin(), cells.end(), quoted), end; it != end; ++it)
+  {
+    const std::string name = (*it)[1];
+    if (name.find('/') == std::string::npos && name.find('*') == std::string::npos)
+      names.insert(name);
+  }
+  return names;
+}
+
+// The files of folders (stems: the name without its extension, for a header and source pair).
+std::set<std::string> filesIn(const std::vector<fs::path>& folders, bool stems)
+{
+  std::set<std::string> names;
+  for (const fs::path& folder : folders)
+  {
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+    {
+      if (entry.is_regular_file())
+        names.insert(stems ? entry.path().stem().string() : entry.path().filename().string());
+    }
+  }
+  return names;
+}
+
+TEST(CoreLayoutTest, TheReadmesLayoutListsTheTreeAsItIs)
+{
+  const std::string readme = readText(kSource / "README.md");
+  const fs::path include = kSource / "include" / "cartpole_qlearning";
+  struct Row
+  {
+    std::string first_cell;
+    std::vector<fs::path> folders;
+    bool stems;
+  };
+  const Row rows[] = {
+      {"`include/cartpole_qlearning/`, `src/`", {include, kSource / "src"}, true},
+      {"`include/cartpole_qlearning/ros/`, `src/ros/`", {include / "ros", kSource / "src" / "ros"}, true},
+      {"`src/cli/`", {kSource / "src" / "cli"}, true},
+      {"`config/`", {kSource / "config"}, false},
+      {"`launch/`", {kSource / "launch"}, false},
+      {"`scripts/`", {kSource / "scripts"}, false},
+      {"`tools/`", {kSource / "tools"}, false},
+  };
+  for (const Row& row : rows)
+  {
+    const std::set<std::string> listed = layoutNames(readme, row.first_cell);
+    const std::set<std::string> present = filesIn(row.folders, row.stems);
+    for (const std::string& name : present)
+      EXPECT_EQ(listed.count(name), 1u) << name << " is in the tree but not in the README's Layout row "
+                                        << row.first_cell;
+    for (const std::string& name : listed)
+      EXPECT_EQ(present.count(name), 1u) << name << " is in the README's Layout row " << row.first_cell
+                                         << " but not in the tree";
+  }
 }
 
 }  // namespace
