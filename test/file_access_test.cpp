@@ -2,6 +2,8 @@
 // atomic saves (a process killed mid-save leaves the old file or the new one, whole).
 #include "cartpole_qlearning/file_access.h"
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -45,14 +47,7 @@ protected:
   // Every file below the test directory, as "relative/path".
   std::vector<std::string> files() const
   {
-    std::vector<std::string> found;
-    for (const auto& entry : fs::recursive_directory_iterator(dir_))
-    {
-      if (!entry.is_directory())
-        found.push_back(fs::relative(entry.path(), dir_).string());
-    }
-    std::sort(found.begin(), found.end());
-    return found;
+    return test::filesBelow(dir_);
   }
 
   // A file beside q.yaml in tables/: a save's temporary file.

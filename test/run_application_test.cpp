@@ -5,6 +5,8 @@
 #include "cartpole_qlearning/q_table_file.h"
 #include "cartpole_qlearning/run_application.h"
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -102,14 +104,7 @@ protected:
   // Every file below the table folder, as "relative/path".
   std::vector<std::string> files() const
   {
-    std::vector<std::string> found;
-    for (const auto& entry : fs::recursive_directory_iterator(dir_))
-    {
-      if (!entry.is_directory())
-        found.push_back(fs::relative(entry.path(), dir_).string());
-    }
-    std::sort(found.begin(), found.end());
-    return found;
+    return test::filesBelow(dir_);
   }
   static std::string folderName()
   {

@@ -1,8 +1,10 @@
 // Helpers the tests share, without ROS: running a command as a user would, reading a file.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -50,6 +52,19 @@ inline CommandRun runCommand(const std::string& command)
   run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return run;
+}
+
+// Every file below a folder, as "relative/path", sorted.
+inline std::vector<std::string> filesBelow(const std::filesystem::path& folder)
+{
+  std::vector<std::string> found;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(folder))
+  {
+    if (!entry.is_directory())
+      found.push_back(std::filesystem::relative(entry.path(), folder).string());
+  }
+  std::sort(found.begin(), found.end());
+  return found;
 }
 
 inline std::string fileText(const std::string& path)
