@@ -3,10 +3,12 @@
 #include "cartpole_qlearning/file_access.h"
 #include "cartpole_qlearning/headless_trainer.h"
 #include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/robustness_suite.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 namespace cartpole_qlearning
@@ -114,6 +116,29 @@ void readRobots(const ParameterSource& source, SectionReader& priv, const Contro
   }
   robots = std::move(names);
 }
+
+// ~suite and ~suite_case (the sim and the controller alike): the case, loaded with the suite's
+// episodes and seed, or nullopt when no case is named. base: the physics the cases vary.
+std::optional<std::pair<RobustnessSuite, SuiteCase>> readSuiteCase(SectionReader& priv, const TrainingConfig& base)
+{
+  std::string path;
+  std::string name;
+  priv.read("suite", path);
+  priv.read("suite_case", name);
+  if (name.empty())
+    return std::nullopt;
+  if (path.empty())
+    priv.fail("suite_case", "'" + name + "'", "needs ~suite, the suite file that holds the case");
+  const RobustnessSuite suite = loadRobustnessSuite(path, base);
+  std::string names;
+  for (const SuiteCase& c : suite.cases)
+  {
+    if (c.name == name)
+      return std::make_pair(suite, c);
+    names += (names.empty() ? "" : ", ") + c.name;
+  }
+  priv.fail("suite_case", "'" + name + "'", "the cases of " + path + ": " + names);
+}
 }  // namespace
 
 ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& source,
@@ -185,6 +210,18 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   priv.know("run/launcher");
   priv.know("run/folder");
   priv.read("evaluation_episodes", run.evaluation_episodes, 0);
+  // What the sim poses as (evaluate.launch suite_case:=NAME), for the verdict to say.
+  if (const auto found = readSuiteCase(priv, settings.training))
+  {
+    const auto& [suite, suite_case] = *found;
+    if (run.learning)
+      priv.fail("suite_case", "'" + suite_case.name + "'", "only with mode evaluate: the verdict says the case");
+    if (source.keysUnder("evaluation_episodes").empty())
+      run.evaluation_episodes = suite.episodes;
+    run.evaluation_case = "case " + suite_case.name + " of " + suite.origin;
+    // The case's pass count, for as many episodes as the verdict comes after (rounded up).
+    run.evaluation_pass = (suite_case.pass * run.evaluation_episodes + suite.episodes - 1) / suite.episodes;
+  }
   priv.read("checkpoint_every", run.checkpoint_every, 0);
   priv.read("save_on_shutdown", run.save_on_shutdown);
   priv.read("shutdown_when_finished", settings.shutdown_when_finished);
@@ -227,6 +264,23 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
   priv.readChoice("mode", mode, {"realtime", "lockstep"});
   settings.mode = mode == "lockstep" ? SimMode::Lockstep : SimMode::Realtime;
   priv.read("seed", settings.seed, 0);
+  settings.perturbations = readPerturbations(shared);
+  // A suite case's physics, start region and perturbations replace the shared ones, as
+  // train_headless --evaluate TABLE --suite FILE runs it; its seed is the suite's unless ~seed is set.
+  TrainingConfig base;
+  base.physics = settings.physics;
+  base.start_state_bound = settings.start_state_bound;
+  if (const auto found = readSuiteCase(priv, base))
+  {
+    const auto& [suite, suite_case] = *found;
+    settings.suite = suite.origin;
+    settings.suite_case = suite_case.name;
+    settings.physics = suite_case.physics;
+    settings.start_state_bound = suite_case.start_state_bound;
+    settings.perturbations = suite_case.perturbations;
+    if (source.keysUnder("seed").empty())
+      settings.seed = suite.seed;
+  }
   priv.readAtLeast("command_timeout", settings.command_timeout, 0.0, true);
   priv.readAtLeast("lockstep_timeout", settings.lockstep_timeout, 0.0, true);
   priv.readAtLeast("tf_rate", settings.tf_rate, 0.0, true);
@@ -235,9 +289,31 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
   if (settings.effort_limit > settings.physics.force_mag)
     priv.fail("effort_limit", SectionReader::numberText(settings.effort_limit),
               "must be <= physics/force_mag = " + SectionReader::numberText(settings.physics.force_mag));
-  priv.readAtLeast("position_noise_std", settings.position_noise_std, 0.0, false);
-  priv.readAtLeast("velocity_noise_std", settings.velocity_noise_std, 0.0, false);
-  priv.readAtLeast("effort_noise_std", settings.effort_noise_std, 0.0, false);
+  // The sim's own noise keys gave way to the core's model, which train_headless shares.
+  for (const auto& [name, instead] :
+       {std::pair<const char*, const char*>{"position_noise_std", "noise_std: [x, x_dot, theta, theta_dot]"},
+        {"velocity_noise_std", "noise_std and noise_fraction: [x, x_dot, theta, theta_dot]"},
+        {"effort_noise_std",
+         "motor: [low, high] (the motor's strength per episode), push_probability and "
+         "push_force"}})
+  {
+    if (source.keysUnder(name).empty())
+      continue;
+    std::string value;
+    try
+    {
+      double number = 0.0;
+      source.get(name, number);
+      value = SectionReader::numberText(number);
+    }
+    catch (const ConfigError&)
+    {
+      value = anyValueText(source, name);
+    }
+    priv.fail(name, value,
+              std::string("replaced by the shared perturbations section, as in config/cartpole.yaml: perturbations/") +
+                  instead);
+  }
   priv.read("publish_clock", settings.publish_clock);
   priv.read("publish_tf", settings.publish_tf);
   priv.read("track_y", settings.track_y);

@@ -26,8 +26,8 @@ bool PerturbationParams::noisy() const
 
 bool PerturbationParams::any() const
 {
-  return delay_steps > 0 || delay_steps_max > 0 || noisy() || mass_cart.varies() || mass_pole.varies() || half_length.varies() ||
-         motor.varies() || (push_probability > 0.0 && push_force != 0.0);
+  return delay_steps > 0 || delay_steps_max > 0 || noisy() || mass_cart.varies() || mass_pole.varies() ||
+         half_length.varies() || motor.varies() || (push_probability > 0.0 && push_force != 0.0);
 }
 
 std::string PerturbationParams::validate() const
@@ -98,6 +98,42 @@ double ActuationDelay::apply(double command)
   const double acting = line_.front();
   line_.pop_front();
   return acting;
+}
+
+std::string describePerturbations(const PerturbationParams& p, double tau)
+{
+  std::ostringstream out;
+  const auto item = [&out]() -> std::ostringstream& {
+    if (out.tellp() > 0)
+      out << ", ";
+    return out;
+  };
+  const auto list = [](const std::array<double, 4>& values) {
+    std::ostringstream text;
+    text << "[" << values[0] << ", " << values[1] << ", " << values[2] << ", " << values[3] << "]";
+    return text.str();
+  };
+  if (p.delay_steps_max > 0)
+  {
+    item() << "delay ";
+    if (p.delay_steps_max == p.delay_steps)
+      out << p.delay_steps << (p.delay_steps == 1 ? " step (" : " steps (") << p.delay_steps * tau << " s)";
+    else
+      out << p.delay_steps << "-" << p.delay_steps_max << " steps (" << p.delay_steps * tau << "-"
+          << p.delay_steps_max * tau << " s)";
+  }
+  if (p.noisy())
+    item() << "noise_std " << list(p.noise_std) << " + noise_fraction " << list(p.noise_fraction);
+  const std::pair<const char*, const ScaleRange*> ranges[] = {
+      {"mass_cart", &p.mass_cart}, {"mass_pole", &p.mass_pole}, {"half_length", &p.half_length}, {"motor", &p.motor}};
+  for (const auto& [name, range] : ranges)
+  {
+    if (range->varies())
+      item() << name << " x[" << range->low << ", " << range->high << "]";
+  }
+  if (p.push_probability > 0.0 && p.push_force != 0.0)
+    item() << "pushes of " << p.push_force << " N on " << p.push_probability << " of the steps";
+  return out.tellp() > 0 ? out.str() : "none";
 }
 
 CartPoleState addSensorNoise(const CartPoleState& state, const PerturbationParams& p, RandomStream& rng)

@@ -492,9 +492,14 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
                    s.terminated ? "fell" : "balanced to the step limit"));
     if (st.settings.evaluation_episodes == 0 || s.episode < st.settings.evaluation_episodes)
       return end;
-    say(end.said, Said::Level::Info,
+    std::string verdict =
         formatText("EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f",
-                   count(s.episode), count(st.balanced), st.config.task.max_episode_steps, s.mean_return_window));
+                   count(s.episode), count(st.balanced), st.config.task.max_episode_steps, s.mean_return_window);
+    if (!st.settings.evaluation_case.empty())
+      verdict += formatText("; %s: %s (needs %llu)", st.settings.evaluation_case.c_str(),
+                            st.balanced >= st.settings.evaluation_pass ? "PASSED" : "FAILED",
+                            count(st.settings.evaluation_pass));
+    say(end.said, Said::Level::Info, verdict);
     st.finished = end.finished = true;
     return end;
   }

@@ -337,9 +337,8 @@ TEST(SimSettings, DefaultsAreTheDocumentedOnes)
   EXPECT_EQ("world", s.world_frame);
   EXPECT_EQ("cart", s.cart_frame);
   EXPECT_EQ("pole", s.pole_frame);
-  EXPECT_EQ(0.0, s.position_noise_std);
-  EXPECT_EQ(0.0, s.velocity_noise_std);
-  EXPECT_EQ(0.0, s.effort_noise_std);
+  EXPECT_FALSE(s.perturbations.any());
+  EXPECT_EQ("", s.suite_case);
   EXPECT_EQ(0.05, s.start_state_bound);
   EXPECT_EQ(0.02, s.physics.tau);
 }
@@ -349,7 +348,7 @@ TEST(SimSettings, ReadsValidParametersAndThePhysics)
   // node_parameters_fail.test's ok fixture, and the rest.
   const SimSettings s = readSim(
       "{mode: lockstep, effort_limit: 5.0, seed: 4, publish_clock: true, publish_tf: false, tf_rate: 10, "
-      "track_y: -2, cart_frame: robot_1/cart, position_noise_std: 0.01, lockstep_timeout: 0.2}",
+      "track_y: -2, cart_frame: robot_1/cart, lockstep_timeout: 0.2}",
       "physics: {mass_pole: 0.2, tau: 0.01, integrator: rk4, force_mag: 20, start_state_bound: 0.1}");
   EXPECT_EQ(SimMode::Lockstep, s.mode);
   EXPECT_EQ(5.0, s.effort_limit);
@@ -359,7 +358,6 @@ TEST(SimSettings, ReadsValidParametersAndThePhysics)
   EXPECT_EQ(10.0, s.tf_rate);
   EXPECT_EQ(-2.0, s.track_y);
   EXPECT_EQ("robot_1/cart", s.cart_frame);
-  EXPECT_EQ(0.01, s.position_noise_std);
   EXPECT_EQ(0.2, s.lockstep_timeout);
   EXPECT_EQ(0.2, s.physics.mass_pole);
   EXPECT_EQ(0.01, s.physics.tau);
@@ -409,10 +407,60 @@ TEST(SimSettings, RefusesBadTimesRatesAndNoise)
   EXPECT_SAYS(simError("command_timeout: 0"), "command_timeout = 0 is not allowed (must be finite and > 0)");
   EXPECT_SAYS(simError("lockstep_timeout: -1"), "lockstep_timeout = -1 is not allowed (must be finite and > 0)");
   EXPECT_SAYS(simError("tf_rate: 0"), "tf_rate = 0 is not allowed (must be finite and > 0)");
-  EXPECT_SAYS(simError("velocity_noise_std: -0.1"),
-              "velocity_noise_std = -0.1 is not allowed (must be finite and >= 0)");
-  EXPECT_EQ("", simError("{position_noise_std: 0, velocity_noise_std: 0, effort_noise_std: 0}"));
-  EXPECT_SAYS(simError("effort_noise_std: .nan"), "effort_noise_std = nan is not allowed (must be finite and >= 0)");
+}
+
+TEST(SimSettings, ReadsThePerturbationsAsTrainHeadlessReadsThem)
+{
+  const std::string shared =
+      "{physics: {cart_friction: 0.0005, pole_friction: 0.000002}, perturbations: {delay_steps: [1, 2], "
+      "noise_std: [0.01, 0, 0.0087, 0], noise_fraction: [0, 0.05, 0, 0.05], motor: [0.8, 0.9], "
+      "push_probability: 0.2, push_force: 2.0}}";
+  const SimSettings s = readSim("", shared);
+  const TrainingConfig config = readTrainingConfig(*parseYamlParameters(shared, "config.yaml"));
+  EXPECT_EQ(1u, s.perturbations.delay_steps);
+  EXPECT_EQ(2u, s.perturbations.delay_steps_max);
+  EXPECT_EQ(config.perturbations.noise_std, s.perturbations.noise_std);
+  EXPECT_EQ(config.perturbations.noise_fraction, s.perturbations.noise_fraction);
+  EXPECT_EQ(0.8, s.perturbations.motor.low);
+  EXPECT_EQ(0.9, s.perturbations.motor.high);
+  EXPECT_EQ(0.2, s.perturbations.push_probability);
+  EXPECT_EQ(2.0, s.perturbations.push_force);
+  EXPECT_EQ(0.0005, s.physics.cart_friction);
+  EXPECT_EQ(0.000002, s.physics.pole_friction);
+  EXPECT_SAYS(simError("", "perturbations: {delay_steps: -1}"), "perturbations/delay_steps = -1 is not allowed");
+  EXPECT_SAYS(simError("", "perturbations: {noise: 1}"), "unknown key perturbations/noise");
+}
+
+TEST(SimSettings, RefusesTheFormerNoiseKeysNamingTheirReplacement)
+{
+  EXPECT_SAYS(simError("position_noise_std: 0.01"),
+              "position_noise_std = 0.01 is not allowed (replaced by the shared perturbations section, as in "
+              "config/cartpole.yaml: perturbations/noise_std");
+  // Even a zero: the key would do nothing, silently.
+  EXPECT_SAYS(simError("velocity_noise_std: 0"), "perturbations/noise_std and noise_fraction");
+  EXPECT_SAYS(simError("effort_noise_std: 0.5"), "perturbations/motor: [low, high]");
+}
+
+TEST(SimSettings, PosesAsACaseOfTheSuite)
+{
+  const std::string suite = std::string(CARTPOLE_CONFIG_DIR) + "/robust_suite.yaml";
+  // The case's perturbations replace the shared ones; its seed is the suite's unless ~seed is set.
+  const SimSettings late = readSim("{suite: " + suite + ", suite_case: one_step_late}",
+                                   "{physics: {tau: 0.01}, perturbations: {push_probability: 0.5, push_force: 1}}");
+  EXPECT_EQ(1u, late.perturbations.delay_steps);
+  EXPECT_EQ(0.0, late.perturbations.push_probability);
+  EXPECT_EQ(0.01, late.physics.tau);
+  EXPECT_EQ(0.05, late.start_state_bound);
+  EXPECT_EQ(1000u, late.seed);
+  EXPECT_EQ("one_step_late", late.suite_case);
+  EXPECT_EQ(7u, readSim("{suite: " + suite + ", suite_case: wide_starts, seed: 7}").seed);
+  EXPECT_EQ(0.1, readSim("{suite: " + suite + ", suite_case: wide_starts}").start_state_bound);
+  // A suite without a case changes nothing.
+  EXPECT_FALSE(readSim("suite: " + suite).perturbations.any());
+  EXPECT_SAYS(simError("{suite: " + suite + ", suite_case: late}"),
+              "suite_case = 'late' is not allowed (the cases of " + suite + ": nominal, one_step_late, sensor_noise");
+  EXPECT_SAYS(simError("suite_case: nominal"), "suite_case = 'nominal' is not allowed (needs ~suite");
+  EXPECT_SAYS(simError("{suite: /nonexistent.yaml, suite_case: nominal}"), "/nonexistent.yaml: cannot be read");
 }
 
 TEST(SimSettings, RefusesAnInfiniteTrackOrAnEmptyFrame)
@@ -420,4 +468,23 @@ TEST(SimSettings, RefusesAnInfiniteTrackOrAnEmptyFrame)
   EXPECT_SAYS(simError("track_y: .inf"), "track_y = inf is not allowed (must be finite)");
   EXPECT_SAYS(simError("pole_frame: ''"), "pole_frame = '' is not allowed (frame names must not be empty)");
   EXPECT_SAYS(simError("world_frame: ''"), "world_frame = '' is not allowed (frame names must not be empty)");
+}
+
+TEST(ControllerSettings, AnEvaluationOfASuiteCaseSaysTheCaseAndItsPassCount)
+{
+  const std::string suite = std::string(CARTPOLE_CONFIG_DIR) + "/robust_suite.yaml";
+  const ControllerSettings s = readController("{mode: evaluate, suite: " + suite + ", suite_case: all_at_once}");
+  EXPECT_EQ("case all_at_once of " + suite, s.run.evaluation_case);
+  // The suite's episodes unless evaluation_episodes is set, the pass count scaled to them.
+  EXPECT_EQ(100u, s.run.evaluation_episodes);
+  EXPECT_EQ(90u, s.run.evaluation_pass);
+  const ControllerSettings shorter =
+      readController("{mode: evaluate, evaluation_episodes: 20, suite: " + suite + ", suite_case: nominal}");
+  EXPECT_EQ(20u, shorter.run.evaluation_episodes);
+  EXPECT_EQ(19u, shorter.run.evaluation_pass);  // 95 of 100: 19 of 20
+  EXPECT_EQ("", readController("{mode: evaluate, suite: " + suite + "}").run.evaluation_case);
+  EXPECT_SAYS(controllerError("{mode: train, suite: " + suite + ", suite_case: nominal}"),
+              "suite_case = 'nominal' is not allowed (only with mode evaluate");
+  EXPECT_SAYS(controllerError("{mode: evaluate, suite: " + suite + ", suite_case: heavy}"),
+              "suite_case = 'heavy' is not allowed (the cases of " + suite + ": nominal");
 }

@@ -307,8 +307,7 @@ TEST(Perturbations, ReadFromTheirSectionAndRefusedWhenBad)
   EXPECT_NE(configError("perturbations: {mass_cart: [1.3, 0.7]}").find("mass_cart/high = 0.7"), std::string::npos);
   EXPECT_NE(configError("perturbations: {mass_cart: [1.0]}").find("[low, high]"), std::string::npos);
   EXPECT_NE(configError("perturbations: {push_probability: 2}").find("push_probability = 2"), std::string::npos);
-  EXPECT_NE(configError("perturbations: {noise_std: [0, -1, 0, 0]}").find("noise_std[x_dot] = -1"),
-            std::string::npos);
+  EXPECT_NE(configError("perturbations: {noise_std: [0, -1, 0, 0]}").find("noise_std[x_dot] = -1"), std::string::npos);
   EXPECT_NE(configError("perturbations: {delay: 1}").find("unknown key perturbations/delay"), std::string::npos);
   EXPECT_NE(configError("physics: {cart_friction: -0.1}").find("cart_friction = -0.1"), std::string::npos);
 }
@@ -422,4 +421,24 @@ TEST(PreviousAction, WithADelayedMotorTheLearnerThatSeesItLearnsToBalance)
   const double seeing = mean_return(true);
   EXPECT_LT(blind, 150.0);
   EXPECT_GT(seeing, 250.0);
+}
+
+TEST(Perturbations, DescribesWhatIsOnForTheSimsLog)
+{
+  PerturbationParams p;
+  EXPECT_EQ("none", describePerturbations(p, 0.02));
+  p.delay_steps = p.delay_steps_max = 1;
+  p.noise_std = {0.01, 0.0, 0.0087, 0.0};
+  p.motor = {0.8, 0.8};
+  p.push_probability = 0.2;
+  p.push_force = 2.0;
+  EXPECT_EQ(
+      "delay 1 step (0.02 s), noise_std [0.01, 0, 0.0087, 0] + noise_fraction [0, 0, 0, 0], motor x[0.8, 0.8], "
+      "pushes of 2 N on 0.2 of the steps",
+      describePerturbations(p, 0.02));
+  p = PerturbationParams();
+  p.delay_steps = 1;
+  p.delay_steps_max = 3;
+  p.mass_cart = {0.7, 1.3};
+  EXPECT_EQ("delay 1-3 steps (0.01-0.03 s), mass_cart x[0.7, 1.3]", describePerturbations(p, 0.01));
 }

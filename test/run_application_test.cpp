@@ -625,6 +625,25 @@ TEST_F(RunApplicationTest, EvaluationGivesItsVerdictAfterItsEpisodesAndWritesNot
   EXPECT_TRUE(files().empty());
 }
 
+TEST_F(RunApplicationTest, AnEvaluationOfASuiteCaseSaysTheCaseAndItsVerdict)
+{
+  settings_.learning = false;
+  settings_.evaluation_episodes = 2;
+  settings_.evaluation_case = "case one_step_late of robust_suite.yaml";
+  for (const auto& [pass, verdict] :
+       {std::pair<std::uint64_t, const char*>{1, "PASSED (needs 1)"}, {2, "FAILED (needs 2)"}})
+  {
+    settings_.evaluation_pass = pass;
+    Run run = startRun();
+    episode(run, true);
+    const EpisodeEnd last = episode(run);
+    EXPECT_EQ(std::string("EVALUATED 2 episodes: 1 balanced to the step limit (5 steps), mean return 3.0; case "
+                          "one_step_late of robust_suite.yaml: ") +
+                  verdict,
+              last.said.at(1).text);
+  }
+}
+
 TEST_F(RunApplicationTest, EvaluationWithoutEpisodeCountNeverEnds)
 {
   settings_.learning = false;

@@ -170,18 +170,21 @@ private:
   pid_t pid_ = -1;
 };
 
-// `roslaunch cartpole_qlearning train.launch ARGS` in the background, as a user runs it, with
-// ROS_HOME set to `ros_home` (tables, logs) and its whole output, nodes included, in
-// ros_home/NAME.log. Ended with Ctrl-C (SIGINT) if still running when it goes out of scope.
+// `roslaunch cartpole_qlearning train.launch ARGS` (or another of the package's launch files) in
+// the background, as a user runs it, with ROS_HOME set to `ros_home` (tables, logs) and its whole
+// output, nodes included, in ros_home/NAME.log. Ended with Ctrl-C (SIGINT) if still running when
+// it goes out of scope.
 class TrainLaunch
 {
 public:
-  TrainLaunch(const std::string& ros_home, const std::string& name, const std::string& args)
+  TrainLaunch(const std::string& ros_home, const std::string& name, const std::string& args,
+              const std::string& launch_file = "train.launch")
     : log_(ros_home + "/" + name + ".log")
   {
     const std::string roslaunch = runCommand("command -v roslaunch").lastLine();
     pid_ = startProcess(
-        "/bin/sh", {"-c", "exec " + roslaunch + " cartpole_qlearning train.launch " + args + " >" + log_ + " 2>&1"},
+        "/bin/sh",
+        {"-c", "exec " + roslaunch + " cartpole_qlearning " + launch_file + " " + args + " >" + log_ + " 2>&1"},
         {"ROS_HOME=" + ros_home, "PYTHONUNBUFFERED=1"});
   }
   ~TrainLaunch()

@@ -33,8 +33,12 @@ struct RunSettings
   std::string stats_csv;
   std::string run_id;                      // the launch's own id: a respawn finds its run by it
   std::uint64_t evaluation_episodes = 10;  // evaluate: the verdict after this many episodes (0: never)
-  std::uint64_t checkpoint_every = 100;    // training: a checkpoint every this many episodes (0: none)
-  bool save_on_shutdown = true;            // training: save into the run's folder when stopped early
+  // evaluate: what the robot poses as ("case one_step_late of .../robust_suite.yaml"; "": not
+  // said) and the balanced episodes its verdict needs to pass.
+  std::string evaluation_case;
+  std::uint64_t evaluation_pass = 0;
+  std::uint64_t checkpoint_every = 100;  // training: a checkpoint every this many episodes (0: none)
+  bool save_on_shutdown = true;          // training: save into the run's folder when stopped early
   // false (train_headless --no-run-folder): no run folder at all (no checkpoints, record, curve of
   // its own or save on shutdown); a solved run's only save is the default table.
   bool run_folder = true;
@@ -94,13 +98,18 @@ struct SimSettings
   std::string world_frame = "world";
   std::string cart_frame = "cart";
   std::string pole_frame = "pole";
-  double position_noise_std = 0.0;  // [m, rad] on published positions
-  double velocity_noise_std = 0.0;  // [m/s, rad/s] on published velocities
-  double effort_noise_std = 0.0;    // [N] on the applied force
+  // What a real cart-pole does (the shared perturbations section, as train_headless reads it from
+  // its config), or the suite case's when ~suite_case names one.
+  PerturbationParams perturbations;
+  // ~suite and ~suite_case: the sim poses as this case of the suite file (its physics, start
+  // region and perturbations over the shared ones; its seed unless ~seed is given). "": none.
+  std::string suite;
+  std::string suite_case;
 };
 
-// Reads the physics section from `shared` and the sim's private parameters from `priv`; throws
-// ConfigError as readControllerSettings does.
+// Reads the physics and perturbations sections from `shared` and the sim's private parameters
+// from `priv` (loading ~suite when ~suite_case is set); throws ConfigError as
+// readControllerSettings does.
 SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource& priv);
 
 }  // namespace cartpole_qlearning

@@ -87,6 +87,10 @@ private:
   std::deque<double> line_;
 };
 
+// What is on, for a log line: "delay 1 step (0.02 s), noise_std [0.01, 0, 0.0087, 0], motor x[0.8, 0.8]"
+// (tau: the step [s]); "none" when nothing is.
+std::string describePerturbations(const PerturbationParams& perturbations, double tau);
+
 // Adds the sensor noise to a state (the draws come from rng, one normal per noisy value).
 CartPoleState addSensorNoise(const CartPoleState& state, const PerturbationParams& perturbations, RandomStream& rng);
 

@@ -2,10 +2,12 @@
 // trains (from scratch, from a table, or on from a run's checkpoint) or evaluates a table
 // greedily, making the same RunApplication calls as the node, and prints what the node logs.
 // Training ends with one line "solved=true|false episodes=N steps=M wall_s=T", an evaluation
-// with "evaluated=N balanced=M mean_return=R". With --replay it learns from the transitions of a
+// with "evaluated=N balanced=M mean_return=R", a robustness suite (--evaluate TABLE --suite FILE)
+// with "suite=PASSED|FAILED cases=N passed=K worst=M/E". With --replay it learns from the transitions of a
 // file instead (the tutorial's worked example), tracing each update.
 #include "cartpole_qlearning/headless_trainer.h"
 #include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/robustness_suite.h"
 #include "cartpole_qlearning/run_application.h"
 #include "cartpole_qlearning/trace.h"
 #include "cartpole_qlearning/training_run.h"
@@ -40,6 +42,7 @@ void usage(std::ostream& out)
          "                      [--load TABLE | --resume FOLDER] [--checkpoint-every N] [--no-run-folder]\n"
          "                      [--stats-csv FILE] [--quiet] [--returns] [--trace]\n"
          "       train_headless --evaluate TABLE [--episodes N] [--config FILE] [--seed N] [--robots N] [--ns NS]\n"
+         "       train_headless --evaluate TABLE --suite FILE [--config FILE] [--seed N] [--ns NS] [--quiet]\n"
          "       train_headless --replay FILE [--config FILE] [--seed N] [--save PATH]\n"
          "Trains as train.launch's controller does, with the core alone (no ROS master), writes what it writes and\n"
          "prints what it logs. Training ends with \"solved=true|false episodes=N steps=M wall_s=T\" (N and M count\n"
@@ -73,6 +76,11 @@ void usage(std::ostream& out)
          "                       the N episodes balanced to the step limit, R the mean return of the last\n"
          "                       task/solved_window episodes (100: all of them by default)\n"
          "  --episodes N         with --evaluate: how many episodes (default 100)\n"
+         "  --suite FILE         with --evaluate: run TABLE greedily on each case of a robustness suite\n"
+         "                       (config/robust_suite.yaml: its episodes, pass counts and seed; --seed N replaces\n"
+         "                       the seed; the cases vary --config's physics), print a table of balanced episodes\n"
+         "                       per case and end with \"suite=PASSED|FAILED cases=N passed=K worst=M/E\" (M of E\n"
+         "                       episodes balanced in the worst case); exit 0 whatever the verdict\n"
          "  --stats-csv FILE     one CSV row per episode, as each ends (the learning curve, for rosrun\n"
          "                       cartpole_qlearning plot_learning_curve FILE) instead of the run's episodes.csv;\n"
          "                       none: no curve. An earlier curve there is replaced, any other file refused\n"
@@ -143,6 +151,49 @@ void saveTable(const cartpole_qlearning::QTable& table, const std::string& table
   else
     cartpole_qlearning::saveQTableUnder(table, table_dir, path);
 }
+// --evaluate TABLE --suite FILE: every case of the suite, greedily; exit 0 when it ran (the verdict
+// is in the last line), 2 on a bad suite, table or configuration.
+int runSuite(const cartpole_qlearning::TrainingConfig& config, const std::string& suite_path,
+             const std::string& table_path, const std::string& table_dir, bool seed_given, std::uint64_t seed,
+             bool quiet)
+{
+  using namespace cartpole_qlearning;
+  RobustnessSuite suite;
+  try
+  {
+    suite = loadRobustnessSuite(suite_path, config);
+  }
+  catch (const ConfigError& e)
+  {
+    std::cerr << "train_headless: --suite: " << e.what() << "\n";
+    return 2;
+  }
+  if (seed_given)
+    suite.seed = seed;
+  SuiteResult result;
+  try
+  {
+    const QTable table =
+        table_path.front() == '/' ? loadQTableFile(table_path) : loadQTableUnder(table_dir, table_path);
+    result = cartpole_qlearning::evaluateSuite(table, config, suite);
+  }
+  catch (const std::runtime_error& e)  // FileError, ConfigError: the table cannot be read or does not fit
+  {
+    std::cerr << "train_headless: --evaluate " << table_path << ": " << e.what() << "\n";
+    return 2;
+  }
+  if (!quiet)
+    std::printf("suite %s: %zu cases, %llu greedy episodes each, seed %llu\n%s\n", suite_path.c_str(),
+                suite.cases.size(), static_cast<unsigned long long>(suite.episodes),
+                static_cast<unsigned long long>(suite.seed), result.table().c_str());
+  std::size_t passed = 0;
+  for (const CaseResult& c : result.cases)
+    passed += c.passed();
+  std::printf("suite=%s cases=%zu passed=%zu worst=%llu/%llu\n", result.passed() ? "PASSED" : "FAILED",
+              result.cases.size(), passed, static_cast<unsigned long long>(result.worstBalanced()),
+              static_cast<unsigned long long>(suite.episodes));
+  return 0;
+}
 }  // namespace
 
 int run(int argc, char** argv)
@@ -155,6 +206,7 @@ int run(int argc, char** argv)
   std::string load_path;
   std::string resume_folder;
   std::string evaluate_path;
+  std::string suite_path;
   std::uint64_t seed = 0;
   bool seed_given = false;
   std::uint64_t max_episodes = 0;
@@ -204,6 +256,8 @@ int run(int argc, char** argv)
       resume_folder = argv[++i];
     else if (arg == "--evaluate" && has_value)
       evaluate_path = argv[++i];
+    else if (arg == "--suite" && has_value)
+      suite_path = argv[++i];
     else if (arg == "--ns" && has_value)
     {
       name_space = argv[++i];
@@ -284,6 +338,16 @@ int run(int argc, char** argv)
       if (given)
         return conflict(name + " with --replay", "a replay learns from its file alone");
   }
+  if (!suite_path.empty())
+  {
+    if (!evaluating)
+      return conflict("--suite", "runs a table: give it with --evaluate TABLE");
+    for (const auto& [name, given] : {std::pair<std::string, bool>{"--episodes", episodes_given},
+                                      {"--robots", robots != 1},
+                                      {"--returns", print_returns}})
+      if (given)
+        return conflict(name + " with --suite", "the suite file gives each case's episodes, run on one robot");
+  }
   if (no_run_folder && checkpoint_given && checkpoint_every > 0)
     return conflict("--checkpoint-every with --no-run-folder", "checkpoints go into the run's folder");
 
@@ -331,6 +395,9 @@ int run(int argc, char** argv)
       return refuse("--save", save_path, e.what());
     }
   }
+
+  if (!suite_path.empty())
+    return runSuite(config, suite_path, evaluate_path, table_dir, seed_given, seed, quiet);
 
   // Only the trace and the replay name states (one name per table row: built for them alone).
   const std::vector<std::string> names =

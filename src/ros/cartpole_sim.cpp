@@ -34,8 +34,10 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
 {
   const std::lock_guard<std::mutex> lock(mutex_);
   readParameters();
-  simulation_ = std::make_unique<CartPoleSimulation>(settings_.physics, settings_.start_state_bound, settings_.seed);
-  noise_ = std::make_unique<RandomStream>(settings_.seed, kNoiseStream);
+  // The core's simulation, perturbations included, built as train_headless builds its own: the same
+  // seed and config give the same episodes.
+  simulation_ = std::make_unique<CartPoleSimulation>(settings_.physics, settings_.start_state_bound, settings_.seed,
+                                                     settings_.perturbations);
 
   if (settings_.mode == SimMode::Lockstep)
     joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>(
@@ -78,6 +80,12 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
                  toString(settings_.physics.integrator).c_str(), static_cast<unsigned long long>(settings_.seed),
                  simulation_->state()[0], simulation_->state()[1], simulation_->state()[2], simulation_->state()[3],
                  settings_.publish_clock ? ", publishing /clock" : "");
+  if (!settings_.suite_case.empty())
+    ROS_INFO_NAMED("cartpole_sim", "cartpole_sim: posing as case %s of %s", settings_.suite_case.c_str(),
+                   settings_.suite.c_str());
+  if (settings_.perturbations.any())
+    ROS_INFO_NAMED("cartpole_sim", "cartpole_sim: perturbations on (%s)",
+                   describePerturbations(settings_.perturbations, settings_.physics.tau).c_str());
 }
 
 void CartPoleSimNode::readParameters()
@@ -167,11 +175,9 @@ void CartPoleSimNode::apply(SimProtocol::Verdict verdict, double effort, const r
 
 void CartPoleSimNode::advance(double effort, const ros::Time& stamp)
 {
-  double force = effort;
-  if (settings_.effort_noise_std > 0.0)
-    force = std::clamp(effort + settings_.effort_noise_std * noise_->normal(), -settings_.effort_limit,
-                       settings_.effort_limit);
-  simulation_->step(force);
+  // The delay, the motor factor and the pushes are the simulation's: in realtime the delay is
+  // counted in ticks as in lockstep, delay_steps x tau seconds.
+  simulation_->step(effort);
   publishState(stamp);
 }
 
@@ -252,18 +258,10 @@ void CartPoleSimNode::republishState()
 
 void CartPoleSimNode::publishState(const ros::Time& stamp)
 {
+  // joint_states carry what the sensors read; TF shows the true state.
   const CartPoleState& s = simulation_->state();
-  auto msg = boost::make_shared<sensor_msgs::JointState>(jointStateFromState(s, simulation_->appliedForce(), stamp));
-  if (settings_.position_noise_std > 0.0)
-  {
-    msg->position[0] += settings_.position_noise_std * noise_->normal();
-    msg->position[1] += settings_.position_noise_std * noise_->normal();
-  }
-  if (settings_.velocity_noise_std > 0.0)
-  {
-    msg->velocity[0] += settings_.velocity_noise_std * noise_->normal();
-    msg->velocity[1] += settings_.velocity_noise_std * noise_->normal();
-  }
+  auto msg = boost::make_shared<sensor_msgs::JointState>(
+      jointStateFromState(simulation_->observation(), simulation_->appliedForce(), stamp));
   joint_state_ = msg;
   republishState();
 

@@ -8,7 +8,6 @@
 #include "cartpole_qlearning/cartpole_simulation.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
 #include "cartpole_qlearning/node_settings.h"
-#include "cartpole_qlearning/random.h"
 #include "cartpole_qlearning/wall_throttle.h"
 
 #include <ros/callback_queue.h>
@@ -65,7 +64,6 @@ private:
   SimSettings settings_;
 
   std::unique_ptr<CartPoleSimulation> simulation_;
-  std::unique_ptr<RandomStream> noise_;
   std::unique_ptr<SimProtocol> lockstep_;  // lockstep mode
   std::unique_ptr<CommandHold> hold_;      // realtime mode
 
