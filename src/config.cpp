@@ -348,6 +348,16 @@ TrainingLimits readLimits(const ParameterSource& source)
   reader.read("max_episodes", limits.max_episodes, 1);
   reader.read("stop_when_solved", limits.stop_when_solved);
   reader.read("progress_every", limits.progress_every, 0);
+  reader.read("suite", limits.suite);
+  if (limits.suite.empty())
+    reader.fail("suite", "''", "a suite file, or none");
+  reader.read("suite_every", limits.suite_every, 0);
+  std::string until = limits.until == TrainUntil::Solved ? "solved" : "suite_passes";
+  reader.readChoice("until", until, {"solved", "suite_passes"});
+  limits.until = until == "solved" ? TrainUntil::Solved : TrainUntil::SuitePasses;
+  if (limits.until == TrainUntil::SuitePasses && (limits.suite_every == 0 || limits.suite == "none"))
+    reader.fail("until", "suite_passes",
+                "needs training/suite_every > 0 and a training/suite: the suite is evaluated during training");
   reader.refuseUnknown();
   return limits;
 }

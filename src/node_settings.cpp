@@ -243,6 +243,7 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   readRobots(source, priv, context, settings.robots);
   priv.read("sync", settings.sync);
   priv.read("trace", run.trace);
+  run.suite_folders = context.suite_folders;
   if (run.trace && settings.training.agent.features == FeatureKind::Tiles)
     priv.fail("trace", "true", "the trace shows one table row per state: learning/features bins only");
   for (const std::string& key : context.other_keys)

@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -32,6 +33,21 @@ std::uint64_t wholeNumber(const YAML::Node& node, const std::string& where, std:
                       ", " + std::to_string(max) + "])");
   return static_cast<std::uint64_t>(value);
 }
+
+double boundValue(const YAML::Node& node, const std::string& where)
+{
+  double value = -1.0;
+  try
+  {
+    value = node.as<double>();
+  }
+  catch (const YAML::Exception&)
+  {
+  }
+  if (!(std::isfinite(value) && value >= 0.0))
+    throw ConfigError(where + " = '" + YAML::Dump(node) + "' is not allowed (must be a finite number >= 0)");
+  return value;
+}
 }  // namespace
 
 RobustnessSuite parseRobustnessSuite(const std::string& yaml, const std::string& origin, const TrainingConfig& base)
@@ -56,8 +72,14 @@ RobustnessSuite parseRobustnessSuite(const std::string& yaml, const std::string&
       suite.episodes = wholeNumber(entry.second, origin + ": episodes", 1, 1000000);
     else if (key == "seed")
       suite.seed = wholeNumber(entry.second, origin + ": seed", 0, std::numeric_limits<long long>::max());
+    else if (key == "max_episode_steps")
+      suite.max_episode_steps = static_cast<unsigned>(
+          wholeNumber(entry.second, origin + ": max_episode_steps", 1, std::numeric_limits<int>::max()));
+    else if (key == "start_state_bound")
+      suite.start_state_bound = boundValue(entry.second, origin + ": start_state_bound");
     else if (key != "cases")
-      throw ConfigError(origin + ": unknown key " + key + " (known keys: episodes, seed, cases)");
+      throw ConfigError(origin + ": unknown key " + key +
+                        " (known keys: episodes, seed, max_episode_steps, start_state_bound, cases)");
   }
   const YAML::Node cases = root["cases"];
   if (!cases || !cases.IsSequence() || cases.size() == 0)
@@ -74,7 +96,7 @@ RobustnessSuite parseRobustnessSuite(const std::string& yaml, const std::string&
     if (!names.insert(c.name).second)
       throw ConfigError(where + ": the name " + c.name + " is used twice");
     c.physics = base.physics;
-    c.start_state_bound = base.start_state_bound;
+    c.start_state_bound = suite.start_state_bound;
     YAML::Node sections(YAML::NodeType::Map);
     for (const auto& entry : node)
     {
@@ -141,9 +163,11 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
 
 SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite)
 {
+  TrainingConfig judged = config;
+  judged.task.max_episode_steps = suite.max_episode_steps;
   SuiteResult result;
   for (const SuiteCase& c : suite.cases)
-    result.cases.push_back(evaluateCase(table, config, c, suite.episodes, suite.seed));
+    result.cases.push_back(evaluateCase(table, judged, c, suite.episodes, suite.seed));
   return result;
 }
 

@@ -2,10 +2,12 @@
 
 #include "cartpole_qlearning/file_access.h"
 #include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/robustness_suite.h"
 #include "cartpole_qlearning/trace.h"
 
 #include <cstdarg>
 #include <cstdio>
+#include <fstream>
 #include <map>
 #include <utility>
 
@@ -26,6 +28,12 @@ void say(Saying& said, Said::Level level, std::string text)
 double seconds(std::chrono::steady_clock::duration duration)
 {
   return std::chrono::duration<double>(duration).count();
+}
+
+// A table that passes beats one that does not; then the more balanced in its worst case.
+bool better(const SuiteResult& a, const SuiteResult& b)
+{
+  return std::make_pair(a.passed(), a.worstBalanced()) > std::make_pair(b.passed(), b.worstBalanced());
 }
 }  // namespace
 
@@ -71,6 +79,9 @@ struct RunApplication::State
   void startStatsCsv(Saying& said);
   void writeStatsRow(const std::string& robot, const EpisodeSummary& summary, Saying& said);
   void startClocks();
+  void loadSuite(Saying& said);
+  // Judges the session's table on the suite at this episode, keeping it when it is the best so far.
+  SuiteResult judge(std::uint64_t episode);
 
   RunSettings settings;
   TrainingConfig config;
@@ -92,6 +103,12 @@ struct RunApplication::State
   bool folder_made_late = false;
 
   std::uint64_t balanced = 0;
+
+  std::unique_ptr<RobustnessSuite> suite;  // none: no verdict (training/suite none, or not found)
+  std::string suite_path;
+  std::unique_ptr<QTable> best;  // the best table judged so far (suite_every > 0) and its verdict
+  SuiteResult best_result;
+  std::uint64_t best_episode = 0;
 
   std::chrono::steady_clock::time_point started;
   std::chrono::steady_clock::time_point last_episode_end;
@@ -365,6 +382,54 @@ void RunApplication::State::writeStatsRow(const std::string& robot, const Episod
   }
 }
 
+void RunApplication::State::loadSuite(Saying& said)
+{
+  const std::string& name = config.limits.suite;
+  if (!settings.learning || name == "none")
+    return;
+  std::string where;
+  if (name.front() == '/')
+    suite_path = name;
+  for (std::size_t i = 0; suite_path.empty() && i < settings.suite_folders.size(); ++i)
+  {
+    where += (where.empty() ? "" : ", ") + settings.suite_folders[i];
+    if (std::ifstream(settings.suite_folders[i] + "/" + name).good())
+      suite_path = settings.suite_folders[i] + "/" + name;
+  }
+  const bool needed = config.limits.suite_every > 0;
+  try
+  {
+    if (suite_path.empty())
+      throw ConfigError("training/suite = '" + name + "' is not allowed (no such file in " +
+                        (where.empty() ? std::string("no folder") : where) + ")");
+    suite = std::make_unique<RobustnessSuite>(loadRobustnessSuite(suite_path, config));
+  }
+  catch (const ConfigError& e)
+  {
+    if (needed)
+      throw;
+    say(said, Said::Level::Warn, std::string("this run will end without a robustness verdict: ") + e.what());
+    return;
+  }
+  if (needed)
+    say(said, Said::Level::Info,
+        formatText("the robustness suite %s runs on the table every %llu episodes%s; the best table is kept",
+                   suite_path.c_str(), count(config.limits.suite_every),
+                   config.limits.until == TrainUntil::SuitePasses ? ", and training ends when it passes" : ""));
+}
+
+SuiteResult RunApplication::State::judge(std::uint64_t episode)
+{
+  SuiteResult result = evaluateSuite(session.table(), config, *suite);
+  if (config.limits.suite_every > 0 && (!best || better(result, best_result)))
+  {
+    best = std::make_unique<QTable>(session.table());
+    best_result = result;
+    best_episode = episode;
+  }
+  return result;
+}
+
 void RunApplication::State::startClocks()
 {
   started = last_episode_end = last_progress = clocks.steady();
@@ -383,6 +448,7 @@ Saying RunApplication::start(const RunIdentity& previous, int launcher)
   State& s = *state_;
   Saying said;
   s.launcher = launcher;
+  s.loadSuite(said);
   s.loadOnStart(said);
   s.openStatsFile();
   if (s.settings.learning)
@@ -398,6 +464,7 @@ Saying RunApplication::resume(const std::string& folder)
   if (!s.settings.learning)
     throw ConfigError("a run is resumed to train it further, not to evaluate it");
   Saying said;
+  s.loadSuite(said);
   try
   {
     s.run_folder = relativePathUnder(s.settings.q_table_dir, folder);
@@ -434,9 +501,47 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
   end.robot_steps_per_second = robot_wall > 0.0 ? s.steps / robot_wall : 0.0;
   st.steps_at_last_episode = s.total_steps;
 
+  // The suite at its cadence (and at the end): on a copy of the table, the best one kept.
+  const TrainingLimits& limits = st.config.limits;
+  const bool until_suite = limits.until == TrainUntil::SuitePasses;
+  std::unique_ptr<SuiteResult> verdict;
+  if (st.settings.learning && st.suite && limits.suite_every > 0 &&
+      (s.episode % limits.suite_every == 0 || training_finished))
+  {
+    verdict = std::make_unique<SuiteResult>(st.judge(s.episode));
+    say(end.said, Said::Level::Info,
+        formatText("robustness at episode %llu (%llu steps): %s", count(s.episode), count(s.total_steps),
+                   verdict->summary().c_str()));
+    training_finished = training_finished || (until_suite && verdict->passed());
+  }
+  if (st.settings.learning && training_finished && st.suite)
+  {
+    if (st.best && better(st.best_result, *verdict))
+    {
+      // The best table seen is what the run saves (and what the session holds from now on).
+      say(end.said, Said::Level::Info,
+          formatText("keeping the table of episode %llu (worst case %llu balanced) over the last one (%llu)",
+                     count(st.best_episode), count(st.best_result.worstBalanced()), count(verdict->worstBalanced())));
+      st.session.replaceTable(*st.best);
+      *verdict = st.best_result;
+    }
+    if (!verdict)
+      verdict = std::make_unique<SuiteResult>(evaluateSuite(st.session.table(), st.config, *st.suite));
+    end.robustness = st.run.robustness = verdict->summary();
+    end.said.push_back({Said::Level::Info,
+                        formatText("robustness of the saved table (%s, greedy, %llu episodes per case):\n",
+                                   st.suite_path.c_str(), count(st.suite->episodes)) +
+                            verdict->table(),
+                        false});
+  }
+  const bool passed = verdict && verdict->passed();
+  const bool done_well = until_suite ? passed : s.solved;
+  const char* finished_as = !done_well ? "max_episodes" : until_suite ? "suite_passed" : "solved";
+
   // When training ends here, the table is saved before the caller says so: whoever acts on the
-  // last episode_stats finds the final file. Into the run's folder; a solved run also replaces
-  // the default table (the one evaluate.launch loads), an unsolved one leaves it as it was.
+  // last episode_stats finds the final file. Into the run's folder; a solved run (under until
+  // suite_passes: one whose suite passed) also replaces the default table (the one
+  // evaluate.launch loads), any other leaves it as it was.
   std::string saved;
   bool saved_ok = true;
   if (training_finished)
@@ -444,10 +549,10 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
     // The default table first: a crash between the two saves then leaves a run not yet marked
     // finished, which a respawn finishes again.
     std::string published;
-    const bool publishes = s.solved && !st.settings.q_table_path.empty();
+    const bool publishes = done_well && !st.settings.q_table_path.empty();
     const bool published_ok = publishes && st.save("", published);
     if (st.settings.run_folder)
-      saved_ok = st.checkpoint(s.solved ? "solved" : "max_episodes", saved);
+      saved_ok = st.checkpoint(finished_as, saved);
     else
     {
       // The default table is the only save, if there is one.
@@ -458,8 +563,8 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
     if (publishes)
       saved += published_ok ? "; the default table: " + published : "; BUT NOT the default table: " + published;
     else if (!st.settings.q_table_path.empty())
-      saved += "; the default table " + st.resolve("") +
-               " is left as it was (this run did not solve: ~save_q_table saves it there if you want it)";
+      saved += "; the default table " + st.resolve("") + " is left as it was (this run did not " +
+               (until_suite ? "pass the suite" : "solve") + ": ~save_q_table saves it there if you want it)";
   }
 
   if (st.settings.trace && st.settings.learning)
@@ -471,7 +576,6 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
         {Said::Level::Info, "Q-table after " + which + ":\n" + qTableText(st.session.table(), st.state_names), false});
   }
 
-  const TrainingLimits& limits = st.config.limits;
   if (limits.progress_every > 0 && s.episode % limits.progress_every == 0)
   {
     const double interval = seconds(now - st.last_progress);
@@ -512,13 +616,16 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
       say(end.said, Said::Level::Error,
           formatText("training ended (%s, episode %llu) but the table could not be saved: %s. The node keeps running: "
                      "call ~save_q_table with another path",
-                     s.solved ? "solved" : "max_episodes", count(s.episode), saved.c_str()));
+                     finished_as, count(s.episode), saved.c_str()));
       return end;
     }
     say(end.said, Said::Level::Info,
         formatText("%s after %llu episodes, %llu steps, %.1f s (mean return of the last %u: %.2f); %s",
-                   s.solved ? "SOLVED" : "NOT solved, max_episodes reached", count(s.episode), count(s.total_steps),
-                   seconds(now - st.started), st.config.task.solved_window, s.mean_return_window, saved.c_str()));
+                   until_suite ? (passed ? "SUITE PASSED" : "suite NOT passed, max_episodes reached")
+                   : s.solved  ? "SOLVED"
+                               : "NOT solved, max_episodes reached",
+                   count(s.episode), count(s.total_steps), seconds(now - st.started), st.config.task.solved_window,
+                   s.mean_return_window, saved.c_str()));
     end.finished = true;
     return end;
   }

@@ -63,6 +63,8 @@ std::string formatRunRecord(const RunRecord& record)
   out << YAML::Key << "steps" << YAML::Value << record.steps;
   out << YAML::Key << "recent_returns" << YAML::Value << YAML::Flow << record.recent_returns;
   out << YAML::Key << "finished" << YAML::Value << YAML::DoubleQuoted << record.finished;
+  if (!record.robustness.empty())
+    out << YAML::Key << "robustness" << YAML::Value << YAML::DoubleQuoted << record.robustness;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
@@ -91,6 +93,8 @@ RunRecord parseRunRecord(const std::string& text)
     record.steps = get("steps").as<std::uint64_t>();
     record.recent_returns = get("recent_returns").as<std::vector<double>>();
     record.finished = get("finished").as<std::string>();
+    if (root["robustness"])
+      record.robustness = root["robustness"].as<std::string>();
   }
   catch (const YAML::Exception& e)
   {
@@ -101,8 +105,9 @@ RunRecord parseRunRecord(const std::string& text)
     if (!std::isfinite(r))
       refuse("a recent return is not finite");
   }
-  if (record.finished != "" && record.finished != "solved" && record.finished != "max_episodes")
-    refuse("finished is '" + record.finished + "' (allowed: '', 'solved', 'max_episodes')");
+  if (record.finished != "" && record.finished != "solved" && record.finished != "suite_passed" &&
+      record.finished != "max_episodes")
+    refuse("finished is '" + record.finished + "' (allowed: '', 'solved', 'suite_passed', 'max_episodes')");
   return record;
 }
 

@@ -98,6 +98,10 @@ TEST(Config, BadValuesNameTheKeyTheValueAndTheRange)
   EXPECT_NE(std::string::npos, errorOf("learning: {epsilon: {min: 3}}").find("learning/epsilon/min = 3"));
   EXPECT_NE(std::string::npos, errorOf("learning: {actions: [-20, 20]}").find("physics/force_mag"));
   EXPECT_NE(std::string::npos, errorOf("training: {max_episodes: 0}").find("training/max_episodes = 0"));
+  EXPECT_NE(std::string::npos, errorOf("training: {until: forever}").find("training/until = 'forever'"));
+  EXPECT_NE(std::string::npos, errorOf("training: {until: suite_passes}").find("needs training/suite_every > 0"));
+  EXPECT_NE(std::string::npos,
+            errorOf("training: {until: suite_passes, suite_every: 5, suite: none}").find("needs training/suite_every"));
 }
 
 TEST(Config, TileCodingKeys)

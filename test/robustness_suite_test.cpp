@@ -72,6 +72,37 @@ TEST(RobustnessSuite, BadSuitesAreRefusedNamingTheCaseAndTheKey)
   EXPECT_NE(suiteError("cases: [{name: a, physics: {mass_cart: -1}}]").find("physics/mass_cart = -1"),
             std::string::npos);
   EXPECT_NE(suiteError("cases: [{name: a, colour: red}]").find("case a: unknown key colour"), std::string::npos);
+  EXPECT_NE(suiteError("max_episode_steps: 0\ncases: [{name: a}]").find("max_episode_steps = 0"), std::string::npos);
+  EXPECT_NE(suiteError("start_state_bound: -1\ncases: [{name: a}]").find("start_state_bound = '-1'"),
+            std::string::npos);
+}
+
+TEST(RobustnessSuite, TheCriterionIsTheSuitesWhateverTheTrainingConfigUses)
+{
+  // A table trained on 200-step episodes from starts in +-0.1 is still judged at 500 steps from
+  // starts in +-0.05 (the suite's defaults), or at what the suite file says.
+  TrainingConfig short_wide;
+  short_wide.task.max_episode_steps = 200;
+  short_wide.start_state_bound = 0.1;
+  const RobustnessSuite suite = parseRobustnessSuite("cases: [{name: a}, {name: b, physics: {start_state_bound: 0.2}}]",
+                                                     "suite.yaml", short_wide);
+  EXPECT_EQ(suite.max_episode_steps, 500u);
+  EXPECT_EQ(suite.cases[0].start_state_bound, 0.05);
+  EXPECT_EQ(suite.cases[1].start_state_bound, 0.2);
+  const RobustnessSuite own = parseRobustnessSuite("max_episode_steps: 50\nstart_state_bound: 0.02\ncases: [{name: a}]",
+                                                   "suite.yaml", short_wide);
+  EXPECT_EQ(own.max_episode_steps, 50u);
+  EXPECT_EQ(own.cases[0].start_state_bound, 0.02);
+
+  RobustnessSuite one = loadRobustnessSuite(kSuite, short_wide);
+  one.episodes = 20;
+  one.cases.resize(1);
+  const QTable table = trainedTable(1);
+  const SuiteResult at_500 = evaluateSuite(table, short_wide, one);
+  EXPECT_GE(at_500.cases[0].balanced, 18u);
+  EXPECT_GT(at_500.cases[0].mean_return, 450.0);  // gymnasium reward: the steps, up to 500, not 200
+  one.max_episode_steps = 50;
+  EXPECT_LE(evaluateSuite(table, short_wide, one).cases[0].mean_return, 50.0);
 }
 
 TEST(RobustnessSuite, ATableOfZerosFallsAndATrainedOneBalancesTheNominalCase)

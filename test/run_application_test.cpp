@@ -2,7 +2,9 @@
 // the resume of a respawned controller, the learning curve's file, which save replaces the
 // default table, the save on shutdown, the evaluation verdict, progress lines and rates, and
 // the services' paths. Clocks are injected; tables go to a temporary folder.
+#include "cartpole_qlearning/headless_trainer.h"
 #include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/robustness_suite.h"
 #include "cartpole_qlearning/run_application.h"
 
 #include "test_support.h"
@@ -35,6 +37,7 @@ protected:
     fs::create_directories(dir_);
     settings_.q_table_dir = dir_.string();
     settings_.run_id = "run_host_1_2";
+    settings_.suite_folders = {CARTPOLE_CONFIG_DIR};
     // Episodes of 5 steps; solved when the last 2 episodes balanced (return 5 each).
     config_.task.max_episode_steps = 5;
     config_.task.solved_mean_return = 5.0;
@@ -136,6 +139,43 @@ protected:
     for (const Said& s : saying)
       text += s.text + "\n";
     return text;
+  }
+
+  // Trains on the simulation (HeadlessTrainer) with the application deciding, as train_headless
+  // does; returns every episode's end.
+  std::vector<EpisodeEnd> train(const TrainingConfig& config, Saying* started = nullptr)
+  {
+    HeadlessTrainer trainer(config, settings_.seed);
+    RunApplication app(settings_, config, trainer.session(), clocks_);
+    const Saying said = app.start();
+    if (started)
+      *started = said;
+    std::vector<EpisodeEnd> ends;
+    trainer.runUntil(
+        [&](const EpisodeSummary& s) {
+          const bool reached = config.limits.reached(s.episode, s.solved);
+          ends.push_back(app.endEpisode("", reached));
+          return ends.back().finished || reached;
+        },
+        nullptr);
+    EXPECT_TRUE(app.finished());
+    return ends;
+  }
+  // The lines said at every episode's end that hold `part`, in order.
+  static std::vector<std::string> lines(const std::vector<EpisodeEnd>& ends, const std::string& part)
+  {
+    std::vector<std::string> found;
+    for (const EpisodeEnd& end : ends)
+      for (const Said& s : end.said)
+        if (s.text.find(part) != std::string::npos)
+          found.push_back(s.text);
+    return found;
+  }
+  std::string writeSuite(const std::string& yaml)
+  {
+    const fs::path path = dir_ / "suite.yaml";
+    std::ofstream(path) << yaml;
+    return path.string();
   }
 
   fs::path dir_;
@@ -825,3 +865,120 @@ TEST_F(RunApplicationTest, ResumeGoesOnFromARunFolderOrRefuses)
 }
 
 }  // namespace
+
+TEST_F(RunApplicationTest, EveryRunSaysWhatItsSavedTableIsWorthAndTheDefaultOneTrainsAsBefore)
+{
+  // The default configuration (until solved, no suite during training): the suite runs once, on
+  // the saved table, which is the table training without the application makes, byte for byte.
+  const TrainingConfig config;
+  const std::vector<EpisodeEnd> ends = train(config);
+  HeadlessTrainer alone(config, settings_.seed);
+  alone.run();
+  saveQTableFile(alone.session().table(), (dir_ / "alone.yaml").string());
+  EXPECT_EQ(text(dir_ / "alone.yaml"), text(dir_ / "q_table.yaml"));
+  EXPECT_TRUE(lines(ends, "robustness at episode").empty());
+  for (std::size_t i = 0; i + 1 < ends.size(); ++i)
+    ASSERT_EQ("", ends[i].robustness) << "episode " << i + 1;
+  const SuiteResult verdict =
+      evaluateSuite(alone.session().table(), config,
+                    loadRobustnessSuite(std::string(CARTPOLE_CONFIG_DIR) + "/robust_suite.yaml", config));
+  EXPECT_EQ(verdict.summary(), ends.back().robustness);
+  EXPECT_NE(std::string::npos, ends.back().robustness.find("one_step_late "));
+  EXPECT_EQ(1u, lines(ends, "robustness of the saved table").size());
+  EXPECT_NE(std::string::npos, lines(ends, "robustness of the saved table").at(0).find(verdict.table()));
+  const RunRecord record = parseRunRecord(text(dir_ / folderName() / "run.yaml"));
+  EXPECT_EQ("solved", record.finished);
+  EXPECT_EQ(verdict.summary(), record.robustness);
+}
+
+TEST_F(RunApplicationTest, UntilTheSuitePassesItIsEvaluatedAtItsCadenceAndEndsTrainingWhenItPasses)
+{
+  // A suite the default learner passes some way past solved.
+  TrainingConfig config;
+  config.limits.suite = writeSuite(
+      "episodes: 20\ncases: [{name: nominal, pass: 20}, {name: pushes, pass: 19, "
+      "perturbations: {push_probability: 0.2, push_force: 2.0}}]");
+  config.limits.suite_every = 10;
+  config.limits.until = TrainUntil::SuitePasses;
+  Saying started;
+  const std::vector<EpisodeEnd> ends = train(config, &started);
+  EXPECT_TRUE(says(started, "runs on the table every 10 episodes, and training ends when it passes"));
+  const std::vector<std::string> judged = lines(ends, "robustness at episode");
+  ASSERT_FALSE(judged.empty());
+  EXPECT_EQ(ends.size() / 10, judged.size());
+  EXPECT_EQ(0u, ends.size() % 10);
+  for (std::size_t i = 0; i < judged.size(); ++i)
+  {
+    EXPECT_EQ(0u, judged[i].rfind("robustness at episode " + std::to_string(10 * (i + 1)) + " (", 0)) << judged[i];
+    // Only the last one passes: training ends there.
+    EXPECT_EQ(i + 1 == judged.size(), judged[i].find(": PASSED") != std::string::npos) << judged[i];
+  }
+  EXPECT_TRUE(ends.back().finished);
+  EXPECT_NE(std::string::npos, ends.back().robustness.find(": PASSED"));
+  EXPECT_EQ(1u, lines(ends, "SUITE PASSED after " + std::to_string(ends.size()) + " episodes").size());
+  const RunRecord record = parseRunRecord(text(dir_ / folderName() / "run.yaml"));
+  EXPECT_EQ("suite_passed", record.finished);
+  EXPECT_EQ(ends.back().robustness, record.robustness);
+  // The default table is the passing one, and it does pass.
+  const QTable saved = loadQTableFile((dir_ / "q_table.yaml").string());
+  EXPECT_EQ(ends.size(), saved.episodes);
+  EXPECT_TRUE(evaluateSuite(saved, config, loadRobustnessSuite(config.limits.suite, config)).passed());
+}
+
+TEST_F(RunApplicationTest, AtMaxEpisodesTheBestTableSeenIsSavedAndTheDefaultTableLeftAlone)
+{
+  // A suite no table passes here: training goes to max_episodes and keeps the table with the
+  // most balanced episodes in its worst case, the first of equals.
+  TrainingConfig config;
+  config.limits.suite = writeSuite(
+      "episodes: 20\ncases: [{name: pushed_hard, pass: 20, perturbations: "
+      "{delay_steps: 1, push_probability: 0.3, push_force: 8.0}}]");
+  config.limits.suite_every = 25;
+  config.limits.until = TrainUntil::SuitePasses;
+  config.limits.max_episodes = 400;
+  const std::vector<EpisodeEnd> ends = train(config);
+  ASSERT_EQ(400u, ends.size()) << lines(ends, "robustness").back();
+  const std::vector<std::string> judged = lines(ends, "robustness at episode");
+  ASSERT_EQ(16u, judged.size());
+  std::uint64_t best = 0;
+  std::size_t best_at = 0;
+  for (std::size_t i = 0; i < judged.size(); ++i)
+  {
+    const std::size_t at = judged[i].find("pushed_hard ") + 12;
+    const std::uint64_t balanced = std::stoull(judged[i].substr(at, judged[i].find('/', at) - at));
+    if (balanced > best || i == 0)
+    {
+      best = balanced;
+      best_at = 25 * (i + 1);
+    }
+  }
+  const QTable saved = loadQTableFile((dir_ / folderName() / "q_table.yaml").string());
+  EXPECT_EQ(best_at, saved.episodes);
+  EXPECT_NE(std::string::npos, ends.back().robustness.find("pushed_hard " + std::to_string(best) + "/20: FAILED"));
+  // Here the best is not the last, so the run says which it kept.
+  ASSERT_LT(best_at, 400u);
+  EXPECT_EQ(1u, lines(ends, "keeping the table of episode " + std::to_string(best_at)).size());
+  EXPECT_EQ(1u, lines(ends, "suite NOT passed, max_episodes reached").size());
+  EXPECT_FALSE(fs::exists(dir_ / "q_table.yaml"));
+  EXPECT_EQ("max_episodes", parseRunRecord(text(dir_ / folderName() / "run.yaml")).finished);
+}
+
+TEST_F(RunApplicationTest, ASuiteThatCannotBeReadStopsARunThatNeedsItAndIsOnlySaidOtherwise)
+{
+  config_.limits.suite = (dir_ / "no_such_suite.yaml").string();
+  config_.limits.suite_every = 10;
+  EXPECT_THROW(startRun(), ConfigError);
+  config_.limits.suite_every = 0;
+  config_.limits.max_episodes = 1;
+  Run run = startRun();
+  EXPECT_EQ(Said::Level::Warn, said(run.started, "this run will end without a robustness verdict").level);
+  const EpisodeEnd end = episode(run, false, true);
+  EXPECT_TRUE(end.finished);
+  EXPECT_EQ("", end.robustness);
+  // A relative suite is looked for in the folders given, in order.
+  config_.limits.suite = "robust_suite.yaml";
+  settings_.suite_folders = {dir_.string()};
+  EXPECT_TRUE(says(startRun().started, "no such file in " + dir_.string()));
+  settings_.suite_folders = {dir_.string(), CARTPOLE_CONFIG_DIR};
+  EXPECT_FALSE(says(startRun().started, "without a robustness verdict"));
+}

@@ -140,6 +140,39 @@ TEST_F(TrainHeadlessTest, SolvesAndEndsWithTheResultLine)
   EXPECT_NE(std::string::npos, run.output.find("mean_return_100")) << run.output;
 }
 
+TEST_F(TrainHeadlessTest, EveryRunSaysWhatItsTableIsWorthOnTheRobustnessSuite)
+{
+  const CommandRun run = trainHeadless(config() + " --seed 0 --no-run-folder");
+  EXPECT_EQ(0, run.status) << run.output;
+  // The default table of seed 0 does not hold a command one step late: the run says so.
+  EXPECT_NE(std::string::npos, run.output.find("robustness of the saved table (" CARTPOLE_CONFIG_DIR
+                                               "/robust_suite.yaml, greedy, 100 episodes per case):"))
+      << run.output;
+  EXPECT_NE(std::string::npos, run.output.find("one_step_late ")) << run.output;
+  EXPECT_NE(std::string::npos, run.output.find(": FAILED")) << run.output;
+}
+
+TEST_F(TrainHeadlessTest, TheRobustConfigTrainsOnUntilItsTablePassesTheSuite)
+{
+  const std::string table = file("robust.yaml");
+  const CommandRun run = trainHeadless(std::string("--config ") +
+                                       CARTPOLE_CONFIG_DIR
+                                       "/robust.yaml --seed 0 "
+                                       "--no-run-folder --save " +
+                                       table);
+  EXPECT_EQ(0, run.status) << run.output;
+  EXPECT_NE(std::string::npos, run.output.find("robustness at episode 10 (")) << run.output;
+  EXPECT_NE(std::string::npos, run.output.find("SUITE PASSED after ")) << run.output;
+  // The table saved passes: judged again, apart from the run.
+  const cartpole_qlearning::TrainingConfig robust = cartpole_qlearning::readTrainingConfig(
+      *cartpole_qlearning::loadYamlParameters(CARTPOLE_CONFIG_DIR "/robust.yaml"));
+  const cartpole_qlearning::SuiteResult verdict = cartpole_qlearning::evaluateSuite(
+      cartpole_qlearning::loadQTableFile(table), robust,
+      cartpole_qlearning::loadRobustnessSuite(CARTPOLE_CONFIG_DIR "/robust_suite.yaml", robust));
+  EXPECT_TRUE(verdict.passed()) << verdict.table();
+  EXPECT_NE(std::string::npos, run.output.find(verdict.summary())) << run.output;
+}
+
 TEST_F(TrainHeadlessTest, TheSameSeedWritesTheSameBytesWhereverTheTableGoes)
 {
   // --save to a path of one's own, with and without a run folder, and the default table.

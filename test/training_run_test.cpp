@@ -21,7 +21,8 @@ TEST(RunRecord, RoundTripsExactly)
   record.episodes = 300;
   record.steps = 40000;
   record.recent_returns = {500.0, 12.0, 0.1 + 0.2, 475.5};
-  record.finished = "solved";
+  record.finished = "suite_passed";
+  record.robustness = "nominal 100/100, one_step_late 97/100: PASSED";
   const RunRecord back = parseRunRecord(formatRunRecord(record));
   EXPECT_EQ(record.run_id, back.run_id);
   EXPECT_EQ(record.name_space, back.name_space);
@@ -31,6 +32,7 @@ TEST(RunRecord, RoundTripsExactly)
   EXPECT_EQ(record.steps, back.steps);
   EXPECT_EQ(record.recent_returns, back.recent_returns);
   EXPECT_EQ(record.finished, back.finished);
+  EXPECT_EQ(record.robustness, back.robustness);
 }
 
 TEST(RunRecord, BadRecordsAreRefusedWithTheReason)

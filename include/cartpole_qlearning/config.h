@@ -207,23 +207,37 @@ std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, co
 // file that holds only those; the parameter server holds other names beside them).
 void refuseUnknownSections(const ParameterSource& source);
 
+// What ends training: the first solved episode, or the first greedy evaluation of the robustness
+// suite that passes (the run application evaluates it; training/until).
+enum class TrainUntil
+{
+  Solved,
+  SuitePasses
+};
+
 struct TrainingLimits
 {
   std::uint64_t max_episodes = 1000;  // stop after this many episodes, solved or not
-  bool stop_when_solved = true;       // stop at the first solved episode
+  bool stop_when_solved = true;       // stop at the first solved episode (until solved)
   std::uint64_t progress_every = 50;  // a progress line every this many episodes (0: none)
+  // The robustness suite a run's final table is judged on (robustness_suite.h): a file, relative
+  // to the folders RunSettings::suite_folders lists; "none": no suite.
+  std::string suite = "robust_suite.yaml";
+  std::uint64_t suite_every = 0;  // [episodes] also evaluate it during training, keeping the best table (0: never)
+  TrainUntil until = TrainUntil::Solved;
 
-  // Whether training ends after the episode that made `episodes` in all, `solved` or not.
+  // Whether training ends after the episode that made `episodes` in all, `solved` or not (a
+  // suite that passes ends it too: the run application decides that).
   bool reached(std::uint64_t episodes, bool solved) const
   {
-    return (solved && stop_when_solved) || episodes >= max_episodes;
+    return (solved && stop_when_solved && until == TrainUntil::Solved) || episodes >= max_episodes;
   }
 };
 
 struct TrainingConfig
 {
   CartPoleParams physics;
-  double start_state_bound = 0.05;  // [m, m/s, rad, rad/s] random starts are uniform in +-this
+  double start_state_bound = 0.05;   // [m, m/s, rad, rad/s] random starts are uniform in +-this
   PerturbationParams perturbations;  // what a real cart-pole does (none by default)
   TaskParams task;
   AgentParams agent;

@@ -43,6 +43,9 @@ struct RunSettings
   // its own or save on shutdown); a solved run's only save is the default table.
   bool run_folder = true;
   bool trace = false;  // log every update and the table at each episode end
+  // Where a relative training/suite is looked for, in order (the package's config/; for
+  // train_headless first its --config's folder). None: a relative suite is not found.
+  std::vector<std::string> suite_folders;
 };
 
 struct ControllerSettings
@@ -68,6 +71,7 @@ struct ControllerContext
   std::function<std::string(const std::string&)> name_error;
   // Private keys read by other means (dynamic_reconfigure's fields, ~run/...): not unknown.
   std::vector<std::string> other_keys;
+  std::vector<std::string> suite_folders;  // RunSettings::suite_folders (the package's config/)
 };
 
 // Reads the shared sections from `shared` and the private parameters from `priv`. Throws

@@ -26,14 +26,19 @@ struct SuiteCase
 
 struct RobustnessSuite
 {
-  std::string origin;           // the file, for messages
+  std::string origin;            // the file, for messages
   std::uint64_t episodes = 100;  // per case
   std::uint64_t seed = 1000;     // the evaluation's own seed: start states, noise, draws, pushes
+  // The suite's own criterion, whatever the training used: balanced means reaching this many
+  // steps, from starts in +-start_state_bound (a case's physics/start_state_bound overrides it).
+  unsigned max_episode_steps = 500;
+  double start_state_bound = 0.05;
   std::vector<SuiteCase> cases;
 };
 
-// Reads a suite file (see config/robust_suite.yaml). base: the physics and start region that the
-// cases' keys override (the configuration the table was trained with). Throws ConfigError naming
+// Reads a suite file (see config/robust_suite.yaml). base: the physics that the cases' keys
+// override (the configuration the table was trained with; its step limit and start region play
+// no part: the suite's own do). Throws ConfigError naming
 // the case and key on a bad value or an unknown key.
 RobustnessSuite parseRobustnessSuite(const std::string& yaml, const std::string& origin, const TrainingConfig& base);
 RobustnessSuite loadRobustnessSuite(const std::string& path, const TrainingConfig& base);
@@ -64,7 +69,8 @@ struct SuiteResult
 };
 
 // Runs the table greedily (no learning, no exploration) on one case. config: the task (step
-// limit, thresholds, reward) and the agent's features and actions the table was made for.
+// limit, thresholds, reward) and the agent's features and actions the table was made for;
+// evaluateSuite runs each case with the suite's step limit in place of the task's.
 // Throws ConfigError when the table does not fit the configuration.
 CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
                         std::uint64_t episodes, std::uint64_t seed);

@@ -1,6 +1,9 @@
 // The application around the learner: one training or evaluation run. It owns what a run
 // writes and decides: the table folder and the default table, the run's folder and record,
-// checkpoints and their cadence, the resume of a respawned controller (or of `train_headless
+// checkpoints and their cadence, the robustness suite (training/suite: run greedily on a copy of
+// the table every training/suite_every episodes, keeping the best table seen, ending training
+// when it passes under training/until suite_passes, and always on the table a run saves), the resume of a respawned
+// controller (or of `train_headless
 // --resume`), the per-episode CSV, which save replaces the default table, the save on shutdown,
 // the evaluation verdict, progress lines and their rates. It returns what to say as values (as
 // ControllerProtocol returns a Reaction), with its clocks injected, so that the controller node
@@ -71,6 +74,9 @@ struct EpisodeEnd
   bool finished = false;
   // The run's folder was made or renamed now: the node stores it (~run/folder) for a respawn.
   std::optional<std::string> run_folder;
+  // Training ended here: the robustness suite's summary of the table it saved (episode_stats'
+  // robustness); "" otherwise, or when there is no suite (training/suite none).
+  std::string robustness;
 };
 
 // A service's answer (SaveQTable, LoadQTable): success and message, and what to log.
@@ -104,12 +110,14 @@ public:
   RunApplication(const RunApplication&) = delete;
   RunApplication& operator=(const RunApplication&) = delete;
 
-  // Starts the run: the table of load_on_start, the CSV, and (training) this run's folder, or,
+  // Starts the run: the table of load_on_start, the CSV, the suite (training), and (training) this run's folder, or,
   // when `previous` names this very run (same id and launcher: a respawn), goes on from its
   // checkpoint. launcher: this process's roslaunch (else parent) pid, 0 when not applicable
   // (train_headless). Throws ConfigError naming the parameter for what must stop the node: a
   // ~load_on_start table that cannot be used, a ~stats_csv that cannot be written (a
-  // RunSettingError), a checkpoint that does not fit the configuration.
+  // RunSettingError), a checkpoint that does not fit the configuration, a training/suite that
+  // cannot be read when training evaluates it (suite_every > 0; else a warning says that the run
+  // ends without a verdict).
   Saying start(const RunIdentity& previous = {}, int launcher = 0);
   // train_headless --resume FOLDER: goes on from that run folder's checkpoint (relative: under
   // the table folder), instead of start(): ~load_on_start plays no part, the curve keeps the rows
@@ -119,7 +127,9 @@ public:
 
   // An episode has just ended on robot `robot` (its namespace, "" for the learner's own): the
   // session's lastEpisode(). training_finished: the protocol (or the headless loop) says
-  // training reached its limits with this episode.
+  // training reached its limits with this episode. Training also ends here when the suite,
+  // evaluated at this episode, passes under training/until suite_passes (EpisodeEnd::finished,
+  // finished()): the caller then serves no more states.
   EpisodeEnd endEpisode(const std::string& robot, bool training_finished);
 
   // The services: paths relative to the table folder (empty: the default table); a path that

@@ -30,7 +30,10 @@ struct RunRecord
   std::uint64_t episodes = 0;
   std::uint64_t steps = 0;
   std::vector<double> recent_returns;  // the solved window at the checkpoint, oldest first
-  std::string finished;                // "" while the run goes on; "solved" or "max_episodes"
+  std::string finished;                // "" while the run goes on; "solved", "suite_passed" or "max_episodes"
+  // What the final table is worth: the robustness suite's one-line summary (robustness_suite.h),
+  // written when training ends ("": not judged).
+  std::string robustness;
 };
 
 // The record as YAML, and back. parseRunRecord throws FileError saying what is wrong.

@@ -505,6 +505,11 @@ int run(int argc, char** argv)
   settings.run_folder = !no_run_folder;
   settings.trace = trace;
   settings.own_absolute_paths = true;
+  // A relative training/suite: beside the config first, then the package's config/.
+  const std::string config_folder = config_path.substr(0, config_path.find_last_of('/') + 1);
+  settings.suite_folders = {config_folder.empty() ? "." : config_folder.substr(0, config_folder.size() - 1)};
+  if (!ros::package::getPath("cartpole_qlearning").empty())
+    settings.suite_folders.push_back(ros::package::getPath("cartpole_qlearning") + "/config");
 
   HeadlessTrainer trainer(config, seed, robots, !evaluating);
   const std::vector<std::string> robot_names = robotNamespaces(robots);

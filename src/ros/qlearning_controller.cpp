@@ -6,6 +6,7 @@
 #include "cartpole_qlearning/ros/parameter_source.h"
 
 #include <ros/names.h>
+#include <ros/package.h>
 
 #include <algorithm>
 #include <cstdarg>
@@ -148,6 +149,7 @@ void QLearningControllerNode::readParameters(bool shutdown_by_default)
   // Live tuning's values, which the controller's own dynamic_reconfigure server keeps there.
   for (const auto& param : LearningConfig::__getParamDescriptions__())
     context.other_keys.push_back(param->name);
+  context.suite_folders = {ros::package::getPath("cartpole_qlearning") + "/config"};
   settings_ = readControllerSettings(RosParameterSource(nh_), RosParameterSource(pnh_), context);
 }
 
@@ -266,7 +268,9 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
     pnh_.setParam("run/folder", *end.run_folder);
   const EpisodeSummary& s = session_->lastEpisode();
 
-  stats_pub_.publish(learnerEpisodeStats(s, robot.name, stamp, end.steps_per_second));
+  EpisodeStats stats = learnerEpisodeStats(s, robot.name, stamp, end.steps_per_second);
+  stats.robustness = end.robustness;
+  stats_pub_.publish(stats);
   if (robot.stats_pub)
     robot.stats_pub.publish(robotEpisodeStats(s, robot.name, stamp, end.robot_steps_per_second));
 

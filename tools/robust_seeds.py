@@ -1,0 +1,63 @@
+#!/usr/bin/env python3
+"""Trains one table per seed with train_headless and a config that runs the robustness suite
+(e.g. config/robust.yaml), and prints a Markdown table: per seed, the episodes and steps to the
+table it saved, the wall time, and the suite's per-case counts; then the median and worst seed
+of each column. The figures of docs/robust_tables.md come from one run of it:
+
+  python3 tools/robust_seeds.py --config config/robust.yaml --seeds 0-19
+
+train_headless is found on PATH (source devel/setup.bash) or given with --train-headless.
+Nothing is written (--no-run-folder).
+"""
+import argparse
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+
+
+def seeds(text):
+    low, _, high = text.partition('-')
+    return range(int(low), int(high or low) + 1)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('--config', required=True)
+    parser.add_argument('--seeds', type=seeds, default=seeds('0-19'))
+    parser.add_argument('--train-headless', default=shutil.which('train_headless') or 'train_headless')
+    args = parser.parse_args()
+    rows = []
+    for seed in args.seeds:
+        start = time.time()
+        out = subprocess.run([args.train_headless, '--config', args.config, '--seed', str(seed), '--no-run-folder'],
+                             capture_output=True, text=True).stdout
+        wall = time.time() - start
+        end = re.search(r'^(SUITE PASSED|suite NOT passed|SOLVED|NOT solved)\S* .*?after (\d+) episodes, (\d+) steps',
+                        out, re.M)
+        verdict = [l for l in out.splitlines() if re.search(r': (PASSED|FAILED)$', l) and ' at episode ' not in l]
+        if not end or not verdict:
+            sys.exit('seed %d: no verdict in the output:\n%s' % (seed, out))
+        cases = re.findall(r'(\w+) (\d+)/(\d+)', verdict[-1])
+        rows.append(dict(seed=seed, passed=verdict[-1].endswith('PASSED'), episodes=int(end.group(2)),
+                         steps=int(end.group(3)), wall=wall, cases=[(n, int(b)) for n, b, _ in cases]))
+        print('seed %d: %s' % (seed, verdict[-1]), file=sys.stderr, flush=True)
+    names = [n for n, _ in rows[0]['cases']]
+    print('| seed | passes | episodes | steps | wall s | ' + ' | '.join(names) + ' |')
+    print('| --- ' * (5 + len(names)) + '|')
+    for r in rows:
+        print('| %d | %s | %d | %d | %.1f | %s |' % (r['seed'], 'yes' if r['passed'] else '**no**', r['episodes'],
+                                                    r['steps'], r['wall'], ' | '.join(str(b) for _, b in r['cases'])))
+    median = lambda key: statistics.median(r[key] for r in rows)
+    print('| median | %d of %d | %g | %g | %.1f | %s |' % (
+        sum(r['passed'] for r in rows), len(rows), median('episodes'), median('steps'), median('wall'),
+        ' | '.join('%g' % statistics.median(r['cases'][i][1] for r in rows) for i in range(len(names)))))
+    print('| worst | | %d | %d | %.1f | %s |' % (
+        max(r['episodes'] for r in rows), max(r['steps'] for r in rows), max(r['wall'] for r in rows),
+        ' | '.join(str(min(r['cases'][i][1] for r in rows)) for i in range(len(names)))))
+
+
+if __name__ == '__main__':
+    main()
