@@ -421,3 +421,44 @@ TEST(SimSettings, RefusesAnInfiniteTrackOrAnEmptyFrame)
   EXPECT_SAYS(simError("pole_frame: ''"), "pole_frame = '' is not allowed (frame names must not be empty)");
   EXPECT_SAYS(simError("world_frame: ''"), "world_frame = '' is not allowed (frame names must not be empty)");
 }
+
+TEST(ControllerSettings, ReadsAnotherRobotsJointsOffsetsAndCommand)
+{
+  const ControllerSettings d = readController("");
+  EXPECT_EQ("cart_joint", d.robot.cart_joint);
+  EXPECT_EQ("pole_joint", d.robot.pole_joint);
+  EXPECT_EQ("cart_joint", d.robot.command_joint);
+  EXPECT_EQ(CommandType::JointState, d.robot.command_type);
+  EXPECT_EQ(0.02, d.robot.decision_period);  // physics/tau
+  EXPECT_EQ("cartpole_qlearning/Reset", d.reset_service_type);
+  EXPECT_EQ(0.04, readController("", "physics: {tau: 0.04}").robot.decision_period);
+  const ControllerSettings s = readController(
+      "{cart_joint: slider_to_cart, pole_joint: cart_to_pole, pole_upright: -0.25, pole_angle_sign: -1, "
+      "cart_sign: -1, cart_zero: 0.5, command_type: float64_array, command_index: 1, command_size: 2, "
+      "effort_sign: -1, decision_period: 0, velocity_smoothing: 0.3, reset_service_type: std_srvs/Empty}");
+  EXPECT_EQ("slider_to_cart", s.robot.cart_joint);
+  EXPECT_EQ("cart_to_pole", s.robot.pole_joint);
+  EXPECT_EQ("slider_to_cart", s.robot.command_joint);
+  EXPECT_EQ(-0.25, s.robot.pole_upright);
+  EXPECT_EQ(-1.0, s.robot.pole_angle_sign);
+  EXPECT_EQ(-1.0, s.robot.cart_sign);
+  EXPECT_EQ(0.5, s.robot.cart_zero);
+  EXPECT_EQ(CommandType::Float64Array, s.robot.command_type);
+  EXPECT_EQ(1u, s.robot.command_index);
+  EXPECT_EQ(2u, s.robot.command_size);
+  EXPECT_EQ(-1.0, s.robot.effort_sign);
+  EXPECT_EQ(0.0, s.robot.decision_period);
+  EXPECT_EQ(0.3, s.robot.velocity_smoothing);
+  EXPECT_EQ("std_srvs/Empty", s.reset_service_type);
+}
+
+TEST(ControllerSettings, RefusesABadRobotInterface)
+{
+  EXPECT_SAYS(controllerError("pole_angle_sign: 2"), "pole_angle_sign = 2 is not allowed (must be 1 or -1)");
+  EXPECT_SAYS(controllerError("command_type: twist"), "command_type = 'twist' is not allowed");
+  EXPECT_SAYS(controllerError("{command_index: 2, command_size: 2}"), "command_index = 2 is not allowed");
+  EXPECT_SAYS(controllerError("pole_joint: cart_joint"), "pole_joint = 'cart_joint' is not allowed");
+  EXPECT_SAYS(controllerError("decision_period: -0.1"), "decision_period = -0.1 is not allowed");
+  EXPECT_SAYS(controllerError("velocity_smoothing: 1"), "velocity_smoothing = 1 is not allowed");
+  EXPECT_SAYS(controllerError("reset_service_type: std_srvs/SetBool"), "reset_service_type = 'std_srvs/SetBool'");
+}

@@ -33,9 +33,11 @@
 //   - A state with the last stamp is a repeat: answered again with the same effort and stamp
 //     while the episode runs (its first answer may have been lost), ignored otherwise.
 //   - A state older than the last one is dropped (a replayed or reordered message), unless the
-//     same older stamp comes again: a sim that restarted publishes its first state, and
-//     repeats it while nobody answers. Then the running episode is abandoned without learning
-//     from its unfinished end, and the state is taken as a start.
+//     same older stamp comes again (a sim that restarted publishes its first state, and
+//     repeats it while nobody answers), or when three older states in a row each come newer
+//     than the one before (time set back and going on: Gazebo's reset_simulation). Then the
+//     running episode is abandoned without learning from its unfinished end, and the state is
+//     taken as a start.
 //   - Stamp 0 means "no stamp". A robot whose states all carry 0 is served, each message taken
 //     as a new state (it cannot repeat or reorder anything); a 0 amid stamped states is a stray
 //     and is dropped.
@@ -53,11 +55,14 @@
 
 #include "cartpole_qlearning/cartpole_dynamics.h"
 #include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/said.h"
 #include "cartpole_qlearning/training_session.h"
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <optional>
+#include <string>
 
 namespace cartpole_qlearning
 {
@@ -241,8 +246,17 @@ private:
   bool unstamped_stream_ = false;
   Stamp last_ = 0;
   std::optional<Stamp> older_seen_;  // an older stamp seen once: a restart if it comes again
+  static constexpr int kTimeSetBack = 3;
+  int older_run_ = 0;  // older states in a row, each newer than the one before
   double last_effort_ = 0.0;
   Counts counts_;
 };
+
+// What the controller says about a state that was not simply answered: robot names the robot
+// (its joint_states topic), stamp_s is the state's stamp [s]. A dropped state and a restart are
+// said only when dropped_ready() and restart_ready() (the node's throttles) allow it.
+Saying reactionSaid(const Reaction& reaction, const ControllerProtocol::Counts& counts, const std::string& robot,
+                    double stamp_s, const std::function<bool()>& dropped_ready,
+                    const std::function<bool()>& restart_ready);
 
 }  // namespace cartpole_qlearning

@@ -5,6 +5,7 @@
 
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
+#include "cartpole_qlearning/robot_interface.h"
 
 #include <cstdint>
 #include <functional>
@@ -51,6 +52,9 @@ struct ControllerSettings
   std::vector<std::string> robots{""};               // namespaces relative to the learner's
   bool sync = true;                                  // several robots: served in lockstep rounds
   ControllerProtocolParams protocol;                 // reset_service, start_region, limits
+  RobotInterfaceParams robot;                        // joints, offsets, command type, decision period
+  // ~reset_service_type: what ~reset_service is
+  std::string reset_service_type = "cartpole_qlearning/Reset";
 };
 
 // What only ROS knows, handed in by the node.

@@ -120,6 +120,10 @@ void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
       ROS_DEBUG_NAMED("cartpole_sim", "cartpole_sim: dropped a joint_command older than the one held");
     return;
   }
+  // An unstamped zero is a controller stopping (an episode's end, its shutdown): it answers no
+  // state, so it is dropped without a warning.
+  if (msg->header.stamp.isZero() && effort == 0.0)
+    return;
   apply(lockstep_->onCommand(msg->header.stamp.toNSec(), now), effort, msg->header.stamp);
 }
 
