@@ -229,8 +229,10 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
       break;
     case Phase::AwaitingReset:
       // States that come before the reset is served (realtime) are past the fall.
-      if (!terminal)
+      if (!terminal && (!params_.reset_starts_in_region || inStartRegion(state)))
         begin(reaction, state);
+      else if (params_.reset_starts_in_region)
+        answer(reaction, 0.0);
       break;
     case Phase::WaitingForStart:
     case Phase::WaitingForPerson:

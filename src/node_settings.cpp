@@ -260,6 +260,7 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   readRobotInterface(priv, settings.training.physics.tau, settings.robot);
   priv.readChoice("reset_service_type", settings.reset_service_type,
                   {"cartpole_qlearning/Reset", "std_srvs/Empty", "std_srvs/Trigger"});
+  protocol.reset_starts_in_region = settings.reset_service_type != "cartpole_qlearning/Reset";
   readRobots(source, priv, context, settings.robots);
   priv.read("sync", settings.sync);
   priv.read("trace", run.trace);

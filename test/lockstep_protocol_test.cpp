@@ -628,6 +628,25 @@ TEST_F(ControllerProtocolTest, AControllerRestartedMidRunAnswersTheSimsPendingSt
   EXPECT_EQ(SimProtocol::Verdict::Step, sim.onCommand(next.stamp, kT0));
 }
 
+TEST_F(ControllerProtocolTest, AfterAResetThatSaysNothingTheEpisodeStartsInsideTheStartRegion)
+{
+  // std_srvs/Empty (Gazebo): the state after the reset may still move; it is answered with 0
+  // until it is inside the start region.
+  params_.reset_starts_in_region = true;
+  params_.start_region = CartPoleState::Constant(0.05);
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(1), kUpright);
+  ASSERT_TRUE(controller.onState(tick(2), kFallen).request_reset);
+  const Reaction moving = controller.onState(tick(3), CartPoleState(0.0, 0.5, 0.0, 0.0));
+  EXPECT_FALSE(moving.episode_began);
+  EXPECT_TRUE(moving.answer);
+  EXPECT_EQ(0.0, moving.effort);
+  EXPECT_FALSE(controller.onState(tick(4), kFallen).episode_began);
+  const Reaction still = controller.onState(tick(5), CartPoleState(0.0, 0.01, 0.0, 0.0));
+  EXPECT_TRUE(still.episode_began);
+  EXPECT_EQ(ControllerProtocol::Phase::InEpisode, controller.phase());
+}
+
 TEST_F(ControllerProtocolTest, AFirstStateThatIsTerminalRequestsAResetWithoutLearning)
 {
   ControllerProtocol controller(session_, params_);

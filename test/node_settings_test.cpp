@@ -450,6 +450,8 @@ TEST(ControllerSettings, ReadsAnotherRobotsJointsOffsetsAndCommand)
   EXPECT_EQ(0.0, s.robot.decision_period);
   EXPECT_EQ(0.3, s.robot.velocity_smoothing);
   EXPECT_EQ("std_srvs/Empty", s.reset_service_type);
+  EXPECT_TRUE(s.protocol.reset_starts_in_region);
+  EXPECT_FALSE(d.protocol.reset_starts_in_region);
 }
 
 TEST(ControllerSettings, RefusesABadRobotInterface)

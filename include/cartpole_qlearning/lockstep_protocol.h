@@ -184,7 +184,11 @@ struct Reaction
 struct ControllerProtocolParams
 {
   bool reset_service = true;  // false: a robot that cannot be reset on command
-  // Without a reset service, an episode starts only when every |state[i]| <= start_region[i].
+  // A reset that does not say where it put the robot (std_srvs/Empty, Trigger): after it, the
+  // episode starts only inside start_region, and until then states are answered with 0.
+  bool reset_starts_in_region = false;
+  // Without a reset service (or with one as above), an episode starts only when every
+  // |state[i]| <= start_region[i].
   CartPoleState start_region = CartPoleState::Constant(0.05);
   // Training ends after the episode that reaches these (when learning).
   TrainingLimits limits;
