@@ -131,12 +131,14 @@ void readFinite(SectionReader& priv, const std::string& name, double& value)
 // The robot's joints, offsets and command (robot_interface.h; README: "Your own cart-pole").
 void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& robot)
 {
-  for (const auto& [name, joint] :
-       {std::pair<const char*, std::string*>{"cart_joint", &robot.cart_joint}, {"pole_joint", &robot.pole_joint}})
+  for (const auto& [name, text] : {std::pair<const char*, std::string*>{"cart_joint", &robot.cart_joint},
+                                   {"pole_joint", &robot.pole_joint},
+                                   {"state_topic", &robot.state_topic},
+                                   {"command_topic", &robot.command_topic}})
   {
-    priv.read(name, *joint);
-    if (joint->empty())
-      priv.fail(name, "''", "must name a joint of joint_states");
+    priv.read(name, *text);
+    if (text->empty())
+      priv.fail(name, "''", "must not be empty");
   }
   if (robot.cart_joint == robot.pole_joint)
     priv.fail("pole_joint", "'" + robot.pole_joint + "'", "must differ from ~cart_joint");
@@ -296,6 +298,26 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
   priv.readAtLeast("position_noise_std", settings.position_noise_std, 0.0, false);
   priv.readAtLeast("velocity_noise_std", settings.velocity_noise_std, 0.0, false);
   priv.readAtLeast("effort_noise_std", settings.effort_noise_std, 0.0, false);
+  RobotInterfaceParams& pose = settings.pose;
+  for (const auto& [name, joint] :
+       {std::pair<const char*, std::string*>{"cart_joint", &pose.cart_joint}, {"pole_joint", &pose.pole_joint}})
+  {
+    priv.read(name, *joint);
+    if (joint->empty())
+      priv.fail(name, "''", "must not be empty");
+  }
+  readFinite(priv, "cart_zero", pose.cart_zero);
+  readFinite(priv, "pole_upright", pose.pole_upright);
+  readSign(priv, "cart_sign", pose.cart_sign);
+  readSign(priv, "pole_angle_sign", pose.pole_angle_sign);
+  std::int64_t turns = 0;
+  priv.read("pole_turns", turns);
+  if (turns < -1000 || turns > 1000)
+    priv.fail("pole_turns", std::to_string(turns), "must be a whole number in [-1000, 1000]");
+  settings.pole_turns = static_cast<int>(turns);
+  priv.read("publish_velocities", settings.publish_velocities);
+  if (!settings.publish_velocities && settings.velocity_noise_std > 0.0)
+    priv.fail("publish_velocities", "false", "velocity_noise_std needs velocities to publish");
   priv.read("publish_clock", settings.publish_clock);
   priv.read("publish_tf", settings.publish_tf);
   priv.read("track_y", settings.track_y);

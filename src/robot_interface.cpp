@@ -15,6 +15,19 @@ double wrapAngle(double angle)
   return wrapped;
 }
 
+JointReadings robotReadings(const RobotInterfaceParams& p, const CartPoleState& s, int pole_turns, bool velocities)
+{
+  JointReadings r;
+  r.cart_position = p.cart_sign * s[0] + p.cart_zero;
+  r.pole_position = p.pole_angle_sign * s[2] + p.pole_upright + 2.0 * M_PI * pole_turns;
+  if (velocities)
+  {
+    r.cart_velocity = p.cart_sign * s[1];
+    r.pole_velocity = p.pole_angle_sign * s[3];
+  }
+  return r;
+}
+
 StateMapping::StateMapping(const RobotInterfaceParams& params) : params_(params) {}
 
 CartPoleState StateMapping::map(Stamp stamp, const JointReadings& r)

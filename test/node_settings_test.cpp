@@ -428,6 +428,8 @@ TEST(ControllerSettings, ReadsAnotherRobotsJointsOffsetsAndCommand)
   EXPECT_EQ("cart_joint", d.robot.cart_joint);
   EXPECT_EQ("pole_joint", d.robot.pole_joint);
   EXPECT_EQ("cart_joint", d.robot.command_joint);
+  EXPECT_EQ("joint_states", d.robot.state_topic);
+  EXPECT_EQ("joint_command", d.robot.command_topic);
   EXPECT_EQ(CommandType::JointState, d.robot.command_type);
   EXPECT_EQ(0.02, d.robot.decision_period);  // physics/tau
   EXPECT_EQ("cartpole_qlearning/Reset", d.reset_service_type);
@@ -460,7 +462,27 @@ TEST(ControllerSettings, RefusesABadRobotInterface)
   EXPECT_SAYS(controllerError("command_type: twist"), "command_type = 'twist' is not allowed");
   EXPECT_SAYS(controllerError("{command_index: 2, command_size: 2}"), "command_index = 2 is not allowed");
   EXPECT_SAYS(controllerError("pole_joint: cart_joint"), "pole_joint = 'cart_joint' is not allowed");
+  EXPECT_SAYS(controllerError("state_topic: ''"), "state_topic = '' is not allowed (must not be empty)");
   EXPECT_SAYS(controllerError("decision_period: -0.1"), "decision_period = -0.1 is not allowed");
   EXPECT_SAYS(controllerError("velocity_smoothing: 1"), "velocity_smoothing = 1 is not allowed");
   EXPECT_SAYS(controllerError("reset_service_type: std_srvs/SetBool"), "reset_service_type = 'std_srvs/SetBool'");
+}
+
+TEST(SimSettings, PosesAsAnotherCartPole)
+{
+  const SimSettings d = readSim("");
+  EXPECT_EQ("cart_joint", d.pose.cart_joint);
+  EXPECT_EQ(0, d.pole_turns);
+  EXPECT_TRUE(d.publish_velocities);
+  const SimSettings s = readSim(
+      "{cart_joint: slider_to_cart, pole_joint: cart_to_pole, pole_upright: -0.25, pole_angle_sign: -1, "
+      "pole_turns: 2, publish_velocities: false}");
+  EXPECT_EQ("slider_to_cart", s.pose.cart_joint);
+  EXPECT_EQ("cart_to_pole", s.pose.pole_joint);
+  EXPECT_EQ(-0.25, s.pose.pole_upright);
+  EXPECT_EQ(-1.0, s.pose.pole_angle_sign);
+  EXPECT_EQ(2, s.pole_turns);
+  EXPECT_FALSE(s.publish_velocities);
+  EXPECT_SAYS(simError("cart_sign: 0"), "cart_sign = 0 is not allowed (must be 1 or -1)");
+  EXPECT_SAYS(simError("{publish_velocities: false, velocity_noise_std: 0.1}"), "publish_velocities = false");
 }

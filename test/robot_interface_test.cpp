@@ -144,3 +144,21 @@ TEST(DecisionClock, TimeSetBackAndUnstampedStatesPassAndAPeriodOfZeroDecidesEver
   EXPECT_TRUE(every.onState(kMs).decide);
   EXPECT_TRUE(every.onState(kMs + 1).decide);
 }
+
+TEST(RobotReadings, WhatTheSimPublishesPosingAsARobotMapsBackToItsState)
+{
+  RobotInterfaceParams params;
+  params.cart_zero = 0.5;
+  params.cart_sign = -1.0;
+  params.pole_upright = -0.25;
+  params.pole_angle_sign = -1.0;
+  const CartPoleState state(0.3, -0.2, 0.05, 0.4);
+  const JointReadings r = robotReadings(params, state, 3, true);
+  EXPECT_NEAR(0.2, r.cart_position, 1e-12);
+  EXPECT_NEAR(-0.3 + 6.0 * M_PI, r.pole_position, 1e-12);
+  StateMapping mapping(params);
+  const CartPoleState back = mapping.map(kMs, r);
+  for (int i = 0; i < 4; ++i)
+    EXPECT_NEAR(state[i], back[i], 1e-9) << i;
+  EXPECT_FALSE(robotReadings(params, state, 0, false).cart_velocity.has_value());
+}

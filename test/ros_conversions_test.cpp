@@ -191,6 +191,19 @@ TEST(CommandConversion, Float64CommandsCarryTheEffortInTheCartsSlot)
   EXPECT_EQ(std::vector<std::string>{"cartJoint"}, named.name);
 }
 
+TEST(JointStateConversion, ASimPosingAsAPositionOnlyRobotPublishesNoVelocities)
+{
+  const JointReadings r{0.5, 6.4, std::nullopt, std::nullopt};
+  const sensor_msgs::JointState msg =
+      jointStateFromReadings(r, 2.0, stampAt(20000000), "slider_to_cart", "cart_to_pole");
+  EXPECT_EQ((std::vector<std::string>{"slider_to_cart", "cart_to_pole"}), msg.name);
+  EXPECT_EQ((std::vector<double>{0.5, 6.4}), msg.position);
+  EXPECT_TRUE(msg.velocity.empty());
+  const Reading<JointReadings> read = readingsFromJointState(msg, "slider_to_cart", "cart_to_pole");
+  ASSERT_TRUE(read) << read.refusal;
+  EXPECT_FALSE(read.value->cart_velocity.has_value());
+}
+
 TEST(CommandConversion, TheSimReadsTheEffortAndStampTheControllerSent)
 {
   const ros::Time state_stamp = stampAt(5000000020);

@@ -101,6 +101,12 @@ struct SimSettings
   double position_noise_std = 0.0;  // [m, rad] on published positions
   double velocity_noise_std = 0.0;  // [m/s, rad/s] on published velocities
   double effort_noise_std = 0.0;    // [N] on the applied force
+  // Posing as another cart-pole (README: "Your own cart-pole"): its joint names, offsets and signs
+  // (~cart_joint, ~pole_joint, ~cart_zero, ~cart_sign, ~pole_upright, ~pole_angle_sign), whole turns
+  // added to the pole's reading (~pole_turns) and whether velocities are published.
+  RobotInterfaceParams pose;
+  int pole_turns = 0;
+  bool publish_velocities = true;
 };
 
 // Reads the physics section from `shared` and the sim's private parameters from `priv`; throws

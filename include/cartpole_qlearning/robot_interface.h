@@ -23,12 +23,14 @@ enum class CommandType
 
 struct RobotInterfaceParams
 {
-  std::string cart_joint = "cart_joint";  // ~cart_joint: the cart's name in joint_states
-  std::string pole_joint = "pole_joint";  // ~pole_joint
-  double cart_zero = 0.0;                 // ~cart_zero [m]: the cart joint's reading at the track's centre
-  double cart_sign = 1.0;                 // ~cart_sign: -1 when the joint's + points the other way
-  double pole_upright = 0.0;              // ~pole_upright [rad]: the pole joint's reading when upright
-  double pole_angle_sign = 1.0;           // ~pole_angle_sign: -1 when + leans the pole toward -x
+  std::string state_topic = "joint_states";     // ~state_topic: where the robot's joint_states come
+  std::string command_topic = "joint_command";  // ~command_topic: where its commands go
+  std::string cart_joint = "cart_joint";        // ~cart_joint: the cart's name in joint_states
+  std::string pole_joint = "pole_joint";        // ~pole_joint
+  double cart_zero = 0.0;                       // ~cart_zero [m]: the cart joint's reading at the track's centre
+  double cart_sign = 1.0;                       // ~cart_sign: -1 when the joint's + points the other way
+  double pole_upright = 0.0;                    // ~pole_upright [rad]: the pole joint's reading when upright
+  double pole_angle_sign = 1.0;                 // ~pole_angle_sign: -1 when + leans the pole toward -x
   // ~velocity_smoothing in [0, 1): a velocity estimated from successive positions (a driver
   // that sends none) is v = s * v_before + (1 - s) * (difference / stamp gap); 0: the raw
   // difference. Ignored while the messages carry velocities.
@@ -60,6 +62,12 @@ struct JointReadings
   std::optional<double> cart_velocity;  // none: a position-only driver
   std::optional<double> pole_velocity;
 };
+
+// The task's state as such a robot reads it (the inverse of StateMapping, plus whole turns of the
+// pole): what cartpole_sim publishes when it poses as another cart-pole. Without velocities when
+// !velocities (a position-only driver).
+JointReadings robotReadings(const RobotInterfaceParams& params, const CartPoleState& state, int pole_turns,
+                            bool velocities);
 
 // Readings -> the task's state: x = cart_sign * (cart - cart_zero), theta = the wrapped
 // pole_angle_sign * (pole - pole_upright); velocities the message's (times the sign) or, when it

@@ -103,7 +103,7 @@ bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
 void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const Reading<double> requested = effortFromCommand(*msg);
+  const Reading<double> requested = effortFromCommand(*msg, settings_.pose.cart_joint);
   if (!requested)
   {
     if (bad_command_warning_.ready())
@@ -257,7 +257,9 @@ void CartPoleSimNode::republishState()
 void CartPoleSimNode::publishState(const ros::Time& stamp)
 {
   const CartPoleState& s = simulation_->state();
-  auto msg = boost::make_shared<sensor_msgs::JointState>(jointStateFromState(s, simulation_->appliedForce(), stamp));
+  auto msg = boost::make_shared<sensor_msgs::JointState>(
+      jointStateFromReadings(robotReadings(settings_.pose, s, settings_.pole_turns, settings_.publish_velocities),
+                             simulation_->appliedForce(), stamp, settings_.pose.cart_joint, settings_.pose.pole_joint));
   if (settings_.position_noise_std > 0.0)
   {
     msg->position[0] += settings_.position_noise_std * noise_->normal();

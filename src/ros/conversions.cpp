@@ -72,6 +72,19 @@ sensor_msgs::JointState jointStateFromState(const CartPoleState& state, double a
   return msg;
 }
 
+sensor_msgs::JointState jointStateFromReadings(const JointReadings& r, double applied_effort, const ros::Time& stamp,
+                                               const std::string& cart_joint, const std::string& pole_joint)
+{
+  sensor_msgs::JointState msg;
+  msg.header.stamp = stamp;
+  msg.name = {cart_joint, pole_joint};
+  msg.position = {r.cart_position, r.pole_position};
+  if (r.cart_velocity && r.pole_velocity)
+    msg.velocity = {*r.cart_velocity, *r.pole_velocity};
+  msg.effort = {applied_effort, 0.0};
+  return msg;
+}
+
 sensor_msgs::JointState commandMessage(double effort, const ros::Time& stamp, const std::string& cart_joint)
 {
   sensor_msgs::JointState msg;

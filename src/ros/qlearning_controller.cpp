@@ -99,7 +99,7 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
     params.robot = r;
     robot.protocol = std::make_unique<ControllerProtocol>(*session_, params);
     robot.nh = robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name);
-    robot.command = CommandPublisher(robot.nh, "joint_command", settings_.robot);
+    robot.command = CommandPublisher(robot.nh, settings_.robot.command_topic, settings_.robot);
     robot.mapping = std::make_unique<StateMapping>(settings_.robot);
     robot.decisions = std::make_unique<DecisionClock>(settings_.robot.decision_period);
     if (!robot.name.empty())
@@ -110,8 +110,9 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
       state_nh.setCallbackQueue(state_queue);
     // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
     robot.state_sub = state_nh.subscribe<sensor_msgs::JointState>(
-        "joint_states", 10, [this, r](const sensor_msgs::JointStateConstPtr& msg) { onJointState(r, msg); },
-        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+        settings_.robot.state_topic, 10,
+        [this, r](const sensor_msgs::JointStateConstPtr& msg) { onJointState(r, msg); }, ros::VoidConstPtr(),
+        ros::TransportHints().tcpNoDelay());
   }
 }
 

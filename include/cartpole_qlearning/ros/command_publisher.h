@@ -17,10 +17,13 @@ public:
   // The effort [N] (the task's sign: robotEffort turns it into the robot's), stamped with the state
   // it answers when the type has a stamp; it is held for hold().
   void publish(double effort, const ros::Time& stamp);
-  // The held effort again, answering a state between two decisions (~decision_period).
+  // A state between two decisions (~decision_period): a stamped command answers it with the
+  // effort held (a lockstep sim steps only on an answer); Float64 commands go out at decisions
+  // only (the robot's controller holds the last one).
   void hold(const ros::Time& stamp)
   {
-    publish(held_, stamp);
+    if (params_.command_type == CommandType::JointState)
+      publish(held_, stamp);
   }
   // Zero effort, unstamped: it answers no state (a lockstep sim steps on no such command), it
   // stops a robot that holds its last command (ros_control's forward controllers hold it forever).

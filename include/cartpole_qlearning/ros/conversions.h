@@ -51,6 +51,12 @@ sensor_msgs::JointState jointStateFromState(const CartPoleState& state, double a
                                             const std::string& cart_joint = "cart_joint",
                                             const std::string& pole_joint = "pole_joint");
 
+// A robot's readings -> joint_states (the sim posing as another cart-pole, robotReadings): both
+// joints' positions, velocities when the readings have them, efforts as jointStateFromState's.
+sensor_msgs::JointState jointStateFromReadings(const JointReadings& readings, double applied_effort,
+                                               const ros::Time& stamp, const std::string& cart_joint,
+                                               const std::string& pole_joint);
+
 // The controller's joint_command: the cart's effort [N], stamped with the state it answers.
 sensor_msgs::JointState commandMessage(double effort, const ros::Time& stamp,
                                        const std::string& cart_joint = "cart_joint");
