@@ -73,6 +73,12 @@ Stamp SimProtocol::onReset(WallClock::time_point now)
   return advance(now);
 }
 
+Stamp SimProtocol::onResetTimeBack(WallClock::time_point now)
+{
+  ++counts_.resets;
+  return start(now);
+}
+
 bool SimProtocol::repeatDue(WallClock::time_point now)
 {
   if (now - published_at_ < repeat_after_)

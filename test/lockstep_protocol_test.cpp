@@ -267,6 +267,20 @@ TEST(SimProtocol, TimeNeverGoesBackAcrossResets)
 
 // --- CommandHold -----------------------------------------------------------------------------
 
+TEST(SimProtocol, AResetThatSetsTimeBackStartsAtTheFirstTickAndAnAnswerInFlightIsStale)
+{
+  SimProtocol sim(kTick, kRepeatAfter);
+  const WallClock::time_point t0 = WallClock::now();
+  sim.start(t0);
+  for (int i = 0; i < 5; ++i)
+    sim.onCommand(sim.pending(), t0);
+  const Stamp before = sim.pending();
+  EXPECT_EQ(kTick, sim.onResetTimeBack(t0));
+  EXPECT_EQ(1u, sim.counts().resets);
+  EXPECT_EQ(SimProtocol::Verdict::Future, sim.onCommand(before, t0));  // answers a state of the old time
+  EXPECT_EQ(SimProtocol::Verdict::Step, sim.onCommand(kTick, t0));
+}
+
 TEST(CommandHold, ZeroBeforeAnyCommand)
 {
   const CommandHold hold(std::chrono::milliseconds(500));

@@ -109,6 +109,9 @@ public:
   Verdict onUnstampedCommand(WallClock::time_point now);
   // A reset (the service): a new state, one tick later, is pending. Returns its stamp.
   Stamp onReset(WallClock::time_point now);
+  // A reset that sets time back to the first tick, as Gazebo's reset_simulation does (the sim
+  // posing as such a robot; ~reset_simulation). Returns the new pending stamp.
+  Stamp onResetTimeBack(WallClock::time_point now);
   // A timer tick: true when the pending state has waited repeat_after unanswered since it, or
   // its last repeat, was published: publish it again, unchanged.
   bool repeatDue(WallClock::time_point now);

@@ -54,6 +54,7 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
   effort_sub_ =
       command_nh.subscribe("cart_effort", 10, &CartPoleSimNode::onEffort, this, ros::TransportHints().tcpNoDelay());
   reset_srv_ = pnh_.advertiseService("reset", &CartPoleSimNode::onReset, this);
+  reset_simulation_srv_ = pnh_.advertiseService("reset_simulation", &CartPoleSimNode::onResetSimulation, this);
 
   // The first state: a random start, which takes one tick of sim time like every reset.
   simulation_->resetRandom();
@@ -201,6 +202,14 @@ void CartPoleSimNode::onSubscriberConnect(const ros::SingleSubscriberPublisher& 
   // Harmless to anyone: a controller that already has this state takes it as a repeat.
   if (joint_state_)
     subscriber.publish(joint_state_);
+}
+
+bool CartPoleSimNode::onResetSimulation(std_srvs::Empty::Request&, std_srvs::Empty::Response&)
+{
+  const std::lock_guard<std::mutex> lock(mutex_);
+  simulation_->resetRandom();
+  publishState(lockstep_ ? toRosTime(lockstep_->onResetTimeBack(WallClock::now())) : ros::Time::now());
+  return true;
 }
 
 bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response)
