@@ -207,7 +207,10 @@ void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::Joi
     say(Said::Level::Warn,
         "joint_states on %s come further apart than ~decision_period = %g s, the step the table learns",
         describe(robot).c_str(), settings_.robot.decision_period);
-  if (!decision.decide && !session_->task().isTerminal(state))  // a fall is judged whenever it comes
+  // A fall ends the running episode whenever it comes, not a period later.
+  const bool falls =
+      robot.protocol->phase() == ControllerProtocol::Phase::InEpisode && session_->task().isTerminal(state);
+  if (!decision.decide && !falls)
     return robot.command.hold(stamp);
   if (!rounds_->holds() || !robot.protocol->takesAsNew(stamp.toNSec()))
   {
