@@ -73,6 +73,12 @@ Stamp SimProtocol::onReset(WallClock::time_point now)
   return advance(now);
 }
 
+Stamp SimProtocol::onResetTimeBack(WallClock::time_point now)
+{
+  ++counts_.resets;
+  return start(now);
+}
+
 bool SimProtocol::repeatDue(WallClock::time_point now)
 {
   if (now - published_at_ < repeat_after_)
@@ -191,14 +197,17 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
 
   if (have_stamp_ && stamp < last_)
   {
-    if (older_seen_ != stamp)
+    // Time going on from an older stamp for kTimeSetBack states (Gazebo's reset_simulation sets
+    // time back) is a restart too; fewer are replayed or reordered messages.
+    older_run_ = older_seen_ && stamp > *older_seen_ ? older_run_ + 1 : 1;
+    if (older_seen_ != stamp && older_run_ < kTimeSetBack)
     {
       older_seen_ = stamp;
       ++counts_.stale;
       reaction.kind = Reaction::Kind::Stale;
       return reaction;
     }
-    // The same older state twice: a restarted sim repeating its first state.
+    // The same older state twice (a restarted sim repeating its first state), or time set back.
     ++counts_.restarts;
     reaction.sim_restarted = true;
     session_.abortEpisode(params_.robot);
@@ -212,6 +221,7 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
   reaction.kind = Reaction::Kind::New;
   ++counts_.states;
   older_seen_.reset();
+  older_run_ = 0;
   if (reaction.stamp != 0)
   {
     last_ = reaction.stamp;
@@ -225,8 +235,10 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
       break;
     case Phase::AwaitingReset:
       // States that come before the reset is served (realtime) are past the fall.
-      if (!terminal)
+      if (!terminal && (!params_.reset_starts_in_region || inStartRegion(state)))
         begin(reaction, state);
+      else if (params_.reset_starts_in_region)
+        answer(reaction, 0.0);
       break;
     case Phase::WaitingForStart:
     case Phase::WaitingForPerson:
@@ -280,6 +292,38 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
     }
   }
   return reaction;
+}
+
+Saying reactionSaid(const Reaction& reaction, const ControllerProtocol::Counts& c, const std::string& robot,
+                    double stamp_s, const std::function<bool()>& dropped_ready,
+                    const std::function<bool()>& restart_ready)
+{
+  using Level = Said::Level;
+  const auto count = [](std::uint64_t n) { return static_cast<unsigned long long>(n); };
+  Saying said;
+  if (reaction.kind == Reaction::Kind::Stale && dropped_ready())
+    said.push_back(
+        {Level::Warn, formatText("dropped joint_states on %s stamped %.6f, older than the last state (a "
+                                 "replayed or reordered message; a restarted sim is recognised when it "
+                                 "sends its state again, time set back when it goes on). Dropped so far: %llu",
+                                 robot.c_str(), stamp_s, count(c.stale))});
+  if (reaction.kind == Reaction::Kind::Stray && dropped_ready())
+    said.push_back({Level::Warn, formatText("dropped joint_states on %s without a stamp among stamped ones. Dropped so "
+                                            "far: %llu",
+                                            robot.c_str(), count(c.stray))});
+  if (reaction.first_unstamped)
+    said.push_back({Level::Warn, formatText("joint_states on %s carry no stamp (0): every message is taken as a new "
+                                            "state, and commands go out unstamped",
+                                            robot.c_str())});
+  if (reaction.sim_restarted && restart_ready())
+    said.push_back({Level::Warn, formatText("%s: time went back to %.3f s: the sim restarted (or was reset); starting "
+                                            "a new episode. Restarts so far: %llu",
+                                            robot.c_str(), stamp_s, count(c.restarts))});
+  if (reaction.waiting_for_start)
+    said.push_back({Level::Info, formatText("%s: episode over; no reset service, so commanding 0 until the state is "
+                                            "back inside ~start_region (stand the pole up)",
+                                            robot.c_str())});
+  return said;
 }
 
 }  // namespace cartpole_qlearning

@@ -139,6 +139,63 @@ std::optional<std::pair<RobustnessSuite, SuiteCase>> readSuiteCase(SectionReader
   }
   priv.fail("suite_case", "'" + name + "'", "the cases of " + path + ": " + names);
 }
+
+void readSign(SectionReader& priv, const std::string& name, double& sign)
+{
+  priv.read(name, sign);
+  if (sign != 1.0 && sign != -1.0)
+    priv.fail(name, SectionReader::numberText(sign), "must be 1 or -1");
+}
+
+void readFinite(SectionReader& priv, const std::string& name, double& value)
+{
+  priv.read(name, value);
+  if (!std::isfinite(value))
+    priv.fail(name, SectionReader::numberText(value), "must be finite");
+}
+
+// The robot's joints, offsets and command (robot_interface.h; README: "Your own cart-pole").
+void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& robot)
+{
+  for (const auto& [name, text] : {std::pair<const char*, std::string*>{"cart_joint", &robot.cart_joint},
+                                   {"pole_joint", &robot.pole_joint},
+                                   {"state_topic", &robot.state_topic},
+                                   {"command_topic", &robot.command_topic}})
+  {
+    priv.read(name, *text);
+    if (text->empty())
+      priv.fail(name, "''", "must not be empty");
+  }
+  if (robot.cart_joint == robot.pole_joint)
+    priv.fail("pole_joint", "'" + robot.pole_joint + "'", "must differ from ~cart_joint");
+  readFinite(priv, "cart_zero", robot.cart_zero);
+  readFinite(priv, "pole_upright", robot.pole_upright);
+  readSign(priv, "cart_sign", robot.cart_sign);
+  readSign(priv, "pole_angle_sign", robot.pole_angle_sign);
+  readSign(priv, "effort_sign", robot.effort_sign);
+  priv.read("velocity_smoothing", robot.velocity_smoothing);
+  if (!(robot.velocity_smoothing >= 0.0 && robot.velocity_smoothing < 1.0))
+    priv.fail("velocity_smoothing", SectionReader::numberText(robot.velocity_smoothing), "must be in [0, 1)");
+  std::string type = "joint_state";
+  priv.readChoice("command_type", type, {"joint_state", "float64", "float64_array"});
+  robot.command_type = type == "float64"         ? CommandType::Float64
+                       : type == "float64_array" ? CommandType::Float64Array
+                                                 : CommandType::JointState;
+  robot.command_joint = robot.cart_joint;
+  priv.read("command_joint", robot.command_joint);
+  if (robot.command_joint.empty())
+    priv.fail("command_joint", "''", "must name the cart's joint as the robot takes commands for it");
+  std::uint64_t index = 0;
+  std::uint64_t size = 1;
+  priv.read("command_index", index, 0);
+  priv.read("command_size", size, 1);
+  if (index >= size)
+    priv.fail("command_index", std::to_string(index), "must be < ~command_size = " + std::to_string(size));
+  robot.command_index = static_cast<std::size_t>(index);
+  robot.command_size = static_cast<std::size_t>(size);
+  robot.decision_period = tau;
+  priv.readAtLeast("decision_period", robot.decision_period, 0.0, false);
+}
 }  // namespace
 
 ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& source,
@@ -240,6 +297,10 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
                 "must be 4 finite values > 0: |x|, |x_dot|, |theta|, |theta_dot| bounds");
     protocol.start_region[i] = region[i];
   }
+  readRobotInterface(priv, settings.training.physics.tau, settings.robot);
+  priv.readChoice("reset_service_type", settings.reset_service_type,
+                  {"cartpole_qlearning/Reset", "std_srvs/Empty", "std_srvs/Trigger"});
+  protocol.reset_starts_in_region = settings.reset_service_type != "cartpole_qlearning/Reset";
   readRobots(source, priv, context, settings.robots);
   priv.read("sync", settings.sync);
   priv.read("trace", run.trace);
@@ -315,6 +376,24 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
               std::string("replaced by the shared perturbations section, as in config/cartpole.yaml: perturbations/") +
                   instead);
   }
+  RobotInterfaceParams& pose = settings.pose;
+  for (const auto& [name, joint] :
+       {std::pair<const char*, std::string*>{"cart_joint", &pose.cart_joint}, {"pole_joint", &pose.pole_joint}})
+  {
+    priv.read(name, *joint);
+    if (joint->empty())
+      priv.fail(name, "''", "must not be empty");
+  }
+  readFinite(priv, "cart_zero", pose.cart_zero);
+  readFinite(priv, "pole_upright", pose.pole_upright);
+  readSign(priv, "cart_sign", pose.cart_sign);
+  readSign(priv, "pole_angle_sign", pose.pole_angle_sign);
+  std::int64_t turns = 0;
+  priv.read("pole_turns", turns);
+  if (turns < -1000 || turns > 1000)
+    priv.fail("pole_turns", std::to_string(turns), "must be a whole number in [-1000, 1000]");
+  settings.pole_turns = static_cast<int>(turns);
+  priv.read("publish_velocities", settings.publish_velocities);
   priv.read("publish_clock", settings.publish_clock);
   priv.read("publish_tf", settings.publish_tf);
   priv.read("track_y", settings.track_y);
@@ -332,6 +411,23 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
   if (settings.publish_clock && settings.mode != SimMode::Lockstep)
     priv.fail("publish_clock", "true", "only in lockstep mode: in realtime the wall clock is the clock");
   return settings;
+}
+
+std::string controllerStartText(const ControllerSettings& settings, const QTable& table,
+                                const std::string& table_directory, const std::string& served)
+{
+  const FeatureParams& features = table.features();
+  const std::string rows = features.kind == FeatureKind::Tiles ? std::to_string(features.tilings) + " tilings, " +
+                                                                     std::to_string(table.stateCount()) + " tiles"
+                                                               : std::to_string(table.stateCount()) + " states";
+  std::string text = std::string(settings.run.learning ? "training" : "evaluating (greedy, no learning)") + ", seed " +
+                     std::to_string(settings.run.seed) + ", " + rows + " x " + std::to_string(table.actionCount()) +
+                     " actions, tables under " + table_directory + "; serving " + served;
+  if (settings.robots.size() > 1)
+    text += settings.sync ? " in lockstep rounds" : ", each as its states come";
+  return text + "; " +
+         (settings.protocol.reset_service ? "resets by ~" + settings.reset_service
+                                          : "no reset service: episodes start when the state is in ~start_region");
 }
 
 }  // namespace cartpole_qlearning

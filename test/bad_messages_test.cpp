@@ -211,6 +211,9 @@ public:
     if (msg.name != std::vector<std::string>{"cart_joint"} || msg.effort.size() != 1 || !std::isfinite(msg.effort[0]))
       problem("a malformed or non-finite command from the controller");
     const std::uint64_t stamp = msg.header.stamp.toNSec();
+    // An unstamped zero answers no state: the controller stopping the cart (an episode's end).
+    if (stamp == 0 && msg.effort.size() == 1 && msg.effort[0] == 0.0)
+      return;
     if (stamp == 0)
       ++answered_unstamped_;
     else if (stamp % 1000 != 0)
@@ -567,7 +570,8 @@ protected:
         msg->position.resize(slot == 0 ? 1 : 3, 0.0);
         break;
       case kNamesVsVelocities:
-        msg->velocity.resize(slot == 0 ? 0 : 3, 0.0);
+        // (None at all is a position-only driver's valid state: its velocities are estimated.)
+        msg->velocity.resize(slot == 0 ? 1 : 3, 0.0);
         break;
       case kNaNPosition:
         msg->position[slot] = kNaN;

@@ -165,12 +165,15 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
 {
   ros::NodeHandle nh;
   int commands = 0;
+  int stops = 0;  // unstamped zeros: the controller stopping the cart, answering no state
   bool silent_reported = false;
   bool back_reported = false;
-  ros::Subscriber effort =
-      nh.subscribe<sensor_msgs::JointState>("/alone/joint_command", 100,
-                                            boost::function<void(const sensor_msgs::JointStateConstPtr&)>(
-                                                [&](const sensor_msgs::JointStateConstPtr&) { ++commands; }));
+  ros::Subscriber effort = nh.subscribe<sensor_msgs::JointState>(
+      "/alone/joint_command", 100,
+      boost::function<void(const sensor_msgs::JointStateConstPtr&)>([&](const sensor_msgs::JointStateConstPtr& m) {
+        const bool stop = m->header.stamp.isZero() && m->effort.size() == 1 && m->effort[0] == 0.0;
+        ++(stop ? stops : commands);
+      }));
   ros::Subscriber log = nh.subscribe<rosgraph_msgs::Log>(
       "/rosout", 1000,
       boost::function<void(const rosgraph_msgs::LogConstPtr&)>([&](const rosgraph_msgs::LogConstPtr& m) {
@@ -197,7 +200,7 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
       make({"cart_joint"}, {0.0}, {0.0}),                          // pole_joint missing
       make({"cart_joint", "other"}, {0.0, 0.0}, {0.0, 0.0}),       // pole_joint missing
       make({"cart_joint", "pole_joint"}, {0.0}, {0.0, 0.0}),       // lengths differ
-      make({"cart_joint", "pole_joint"}, {0.0, 0.0}, {}),          // no velocities
+      make({"cart_joint", "pole_joint"}, {0.0, 0.0}, {0.0}),       // too few velocities (none: position-only)
       make({"cart_joint", "pole_joint"}, {nan, 0.0}, {0.0, 0.0}),  // NaN
       make({"cart_joint", "pole_joint"}, {0.0, 0.0}, {0.0, inf}),  // Inf
   };
@@ -218,6 +221,8 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
   // No sim in this namespace: after sim_timeout (1 s) of silence the controller says so, once,
   // and says so again when states come back.
   ASSERT_TRUE(spinUntil([&] { return silent_reported; }, 20.0)) << "no report of the silent sim";
+  // ... and stops the cart, which may hold its last command (ros_control's forward controllers).
+  EXPECT_TRUE(spinUntil([&] { return stops == 1; }, 5.0)) << "no zero effort after the states stopped";
   states.publish(make({"cart_joint", "pole_joint"}, {0.0, 0.01}, {0.0, 0.0}));
   EXPECT_TRUE(spinUntil([&] { return back_reported; }, 10.0));
   EXPECT_TRUE(spinUntil([&] { return commands == 2; }, 10.0));

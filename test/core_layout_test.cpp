@@ -95,7 +95,7 @@ TEST(CoreLayoutTest, NoCoreFileIncludesAHeaderFromOutsideTheCore)
 }
 
 // The names in backquotes in the README's Layout row that starts with `first_cell`, leaving out
-// paths and patterns (they name folders, not files).
+// paths and patterns (they name folders, not files). tools/readme_layout.py writes the table.
 std::set<std::string> layoutNames(const std::string& readme, const std::string& first_cell)
 {
   const std::size_t layout = readme.find("## Layout\n");

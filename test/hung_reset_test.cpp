@@ -233,7 +233,7 @@ TEST(HungReset, ResetCallerGivesAHungCallUpOnANewThreadAndDoesNotWaitForItAtTheE
   const std::string answers_again = std::string(kCallerService) + " answers again";
   LogLines log(kCallerService);
   HangingReset service(kCallerService, "");
-  auto caller = std::make_unique<ResetCaller>(kCallerService, std::chrono::seconds(1));
+  auto caller = std::make_unique<ResetCaller>(kCallerService, "cartpole_qlearning/Reset", std::chrono::seconds(1));
 
   // The first call hangs; after 1 s it is given up and made again on a fresh connection.
   caller->request();

@@ -267,6 +267,20 @@ TEST(SimProtocol, TimeNeverGoesBackAcrossResets)
 
 // --- CommandHold -----------------------------------------------------------------------------
 
+TEST(SimProtocol, AResetThatSetsTimeBackStartsAtTheFirstTickAndAnAnswerInFlightIsStale)
+{
+  SimProtocol sim(kTick, kRepeatAfter);
+  const WallClock::time_point t0 = WallClock::now();
+  sim.start(t0);
+  for (int i = 0; i < 5; ++i)
+    sim.onCommand(sim.pending(), t0);
+  const Stamp before = sim.pending();
+  EXPECT_EQ(kTick, sim.onResetTimeBack(t0));
+  EXPECT_EQ(1u, sim.counts().resets);
+  EXPECT_EQ(SimProtocol::Verdict::Future, sim.onCommand(before, t0));  // answers a state of the old time
+  EXPECT_EQ(SimProtocol::Verdict::Step, sim.onCommand(kTick, t0));
+}
+
 TEST(CommandHold, ZeroBeforeAnyCommand)
 {
   const CommandHold hold(std::chrono::milliseconds(500));
@@ -484,6 +498,37 @@ TEST_F(ControllerProtocolTest, TheSameOlderStampTwiceIsASimRestartThatAbandonsTh
   EXPECT_EQ(2u, session_.lastEpisode().steps);
 }
 
+TEST_F(ControllerProtocolTest, TimeSetBackAndGoingOnIsARestartOnItsThirdState)
+{
+  // Gazebo's reset_simulation: the states after it start near 0 and go on from there.
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(100), kUpright);
+  for (std::uint64_t n = 101; n <= 110; ++n)
+    controller.onState(tick(n), kSmall);
+  ASSERT_TRUE(session_.inEpisode());
+  const std::uint64_t before = learntSteps();
+  EXPECT_EQ(Reaction::Kind::Stale, controller.onState(tick(1), kUpright).kind);
+  EXPECT_EQ(Reaction::Kind::Stale, controller.onState(tick(2), kUpright).kind);
+  const Reaction r = controller.onState(tick(3), kUpright);
+  EXPECT_TRUE(r.sim_restarted);
+  EXPECT_TRUE(r.episode_began);
+  EXPECT_TRUE(r.answer);
+  EXPECT_FALSE(r.learned);
+  EXPECT_EQ(before, learntSteps());
+  EXPECT_EQ(0u, session_.episodesEnded());  // the abandoned episode is not counted
+  // Training goes on at the new time.
+  const Reaction next = controller.onState(tick(4), kSmall);
+  EXPECT_EQ(Reaction::Kind::New, next.kind);
+  EXPECT_TRUE(next.learned);
+  EXPECT_EQ(before + 1, learntSteps());
+  // Older states that do not go on in order (replays) stay dropped.
+  controller.onState(tick(10), kSmall);
+  EXPECT_EQ(Reaction::Kind::Stale, controller.onState(tick(6), kSmall).kind);
+  EXPECT_EQ(Reaction::Kind::Stale, controller.onState(tick(5), kSmall).kind);
+  EXPECT_EQ(Reaction::Kind::Stale, controller.onState(tick(7), kSmall).kind);
+  EXPECT_EQ(1u, controller.counts().restarts);
+}
+
 TEST_F(ControllerProtocolTest, AStampZeroAmidStampedStatesIsAStray)
 {
   ControllerProtocol controller(session_, params_);
@@ -595,6 +640,25 @@ TEST_F(ControllerProtocolTest, AControllerRestartedMidRunAnswersTheSimsPendingSt
   const Reaction next = controller.onState(sim.pending(), kSmall);
   EXPECT_TRUE(next.learned);
   EXPECT_EQ(SimProtocol::Verdict::Step, sim.onCommand(next.stamp, kT0));
+}
+
+TEST_F(ControllerProtocolTest, AfterAResetThatSaysNothingTheEpisodeStartsInsideTheStartRegion)
+{
+  // std_srvs/Empty (Gazebo): the state after the reset may still move; it is answered with 0
+  // until it is inside the start region.
+  params_.reset_starts_in_region = true;
+  params_.start_region = CartPoleState::Constant(0.05);
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(1), kUpright);
+  ASSERT_TRUE(controller.onState(tick(2), kFallen).request_reset);
+  const Reaction moving = controller.onState(tick(3), CartPoleState(0.0, 0.5, 0.0, 0.0));
+  EXPECT_FALSE(moving.episode_began);
+  EXPECT_TRUE(moving.answer);
+  EXPECT_EQ(0.0, moving.effort);
+  EXPECT_FALSE(controller.onState(tick(4), kFallen).episode_began);
+  const Reaction still = controller.onState(tick(5), CartPoleState(0.0, 0.01, 0.0, 0.0));
+  EXPECT_TRUE(still.episode_began);
+  EXPECT_EQ(ControllerProtocol::Phase::InEpisode, controller.phase());
 }
 
 TEST_F(ControllerProtocolTest, AFirstStateThatIsTerminalRequestsAResetWithoutLearning)
@@ -1141,4 +1205,32 @@ TEST(LockstepProtocol, ASimRestartedMidEpisodeIsTakenUpOnItsFirstRepeatAndTraini
   EXPECT_EQ(20u, link.session().episodesEnded());
   EXPECT_EQ(1u, link.controller().counts().restarts);
   EXPECT_EQ(0u, link.sim().counts().stale + link.sim().counts().future);
+}
+
+TEST(ReactionSaid, SaysWhatHappenedAndAsksTheThrottleOnlyForWhatItThrottles)
+{
+  int asked = 0;
+  const auto ready = [&] {
+    ++asked;
+    return true;
+  };
+  Reaction answered;
+  answered.answer = true;
+  EXPECT_TRUE(reactionSaid(answered, {}, "/cartpole/joint_states", 1.0, ready, ready).empty());
+  EXPECT_EQ(0, asked);
+  Reaction restarted;
+  restarted.sim_restarted = true;
+  ControllerProtocol::Counts counts;
+  counts.restarts = 2;
+  const Saying said = reactionSaid(restarted, counts, "/cartpole/joint_states", 0.06, ready, [] { return false; });
+  EXPECT_TRUE(said.empty());  // throttled
+  const Saying allowed = reactionSaid(restarted, counts, "/cartpole/joint_states", 0.06, ready, ready);
+  ASSERT_EQ(1u, allowed.size());
+  EXPECT_EQ(Said::Level::Warn, allowed[0].level);
+  EXPECT_NE(std::string::npos, allowed[0].text.find("time went back to 0.060 s")) << allowed[0].text;
+  EXPECT_NE(std::string::npos, allowed[0].text.find("Restarts so far: 2")) << allowed[0].text;
+  Reaction stale;
+  stale.kind = Reaction::Kind::Stale;
+  EXPECT_EQ(1u, reactionSaid(stale, counts, "/cartpole/joint_states", 0.5, ready, ready).size());
+  EXPECT_EQ(2, asked);  // the restart's throttle once, the dropped state's once
 }

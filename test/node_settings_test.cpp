@@ -488,3 +488,82 @@ TEST(ControllerSettings, AnEvaluationOfASuiteCaseSaysTheCaseAndItsPassCount)
   EXPECT_SAYS(controllerError("{mode: evaluate, suite: " + suite + ", suite_case: heavy}"),
               "suite_case = 'heavy' is not allowed (the cases of " + suite + ": nominal");
 }
+
+TEST(ControllerSettings, ReadsAnotherRobotsJointsOffsetsAndCommand)
+{
+  const ControllerSettings d = readController("");
+  EXPECT_EQ("cart_joint", d.robot.cart_joint);
+  EXPECT_EQ("pole_joint", d.robot.pole_joint);
+  EXPECT_EQ("cart_joint", d.robot.command_joint);
+  EXPECT_EQ("joint_states", d.robot.state_topic);
+  EXPECT_EQ("joint_command", d.robot.command_topic);
+  EXPECT_EQ(CommandType::JointState, d.robot.command_type);
+  EXPECT_EQ(0.02, d.robot.decision_period);  // physics/tau
+  EXPECT_EQ("cartpole_qlearning/Reset", d.reset_service_type);
+  EXPECT_EQ(0.04, readController("", "physics: {tau: 0.04}").robot.decision_period);
+  const ControllerSettings s = readController(
+      "{cart_joint: slider_to_cart, pole_joint: cart_to_pole, pole_upright: -0.25, pole_angle_sign: -1, "
+      "cart_sign: -1, cart_zero: 0.5, command_type: float64_array, command_index: 1, command_size: 2, "
+      "effort_sign: -1, decision_period: 0, velocity_smoothing: 0.3, reset_service_type: std_srvs/Empty}");
+  EXPECT_EQ("slider_to_cart", s.robot.cart_joint);
+  EXPECT_EQ("cart_to_pole", s.robot.pole_joint);
+  EXPECT_EQ("slider_to_cart", s.robot.command_joint);
+  EXPECT_EQ(-0.25, s.robot.pole_upright);
+  EXPECT_EQ(-1.0, s.robot.pole_angle_sign);
+  EXPECT_EQ(-1.0, s.robot.cart_sign);
+  EXPECT_EQ(0.5, s.robot.cart_zero);
+  EXPECT_EQ(CommandType::Float64Array, s.robot.command_type);
+  EXPECT_EQ(1u, s.robot.command_index);
+  EXPECT_EQ(2u, s.robot.command_size);
+  EXPECT_EQ(-1.0, s.robot.effort_sign);
+  EXPECT_EQ(0.0, s.robot.decision_period);
+  EXPECT_EQ(0.3, s.robot.velocity_smoothing);
+  EXPECT_EQ("std_srvs/Empty", s.reset_service_type);
+  EXPECT_TRUE(s.protocol.reset_starts_in_region);
+  EXPECT_FALSE(d.protocol.reset_starts_in_region);
+}
+
+TEST(ControllerSettings, RefusesABadRobotInterface)
+{
+  EXPECT_SAYS(controllerError("pole_angle_sign: 2"), "pole_angle_sign = 2 is not allowed (must be 1 or -1)");
+  EXPECT_SAYS(controllerError("command_type: twist"), "command_type = 'twist' is not allowed");
+  EXPECT_SAYS(controllerError("{command_index: 2, command_size: 2}"), "command_index = 2 is not allowed");
+  EXPECT_SAYS(controllerError("pole_joint: cart_joint"), "pole_joint = 'cart_joint' is not allowed");
+  EXPECT_SAYS(controllerError("state_topic: ''"), "state_topic = '' is not allowed (must not be empty)");
+  EXPECT_SAYS(controllerError("decision_period: -0.1"), "decision_period = -0.1 is not allowed");
+  EXPECT_SAYS(controllerError("velocity_smoothing: 1"), "velocity_smoothing = 1 is not allowed");
+  EXPECT_SAYS(controllerError("reset_service_type: std_srvs/SetBool"), "reset_service_type = 'std_srvs/SetBool'");
+}
+
+TEST(SimSettings, PosesAsAnotherCartPole)
+{
+  const SimSettings d = readSim("");
+  EXPECT_EQ("cart_joint", d.pose.cart_joint);
+  EXPECT_EQ(0, d.pole_turns);
+  EXPECT_TRUE(d.publish_velocities);
+  const SimSettings s = readSim(
+      "{cart_joint: slider_to_cart, pole_joint: cart_to_pole, pole_upright: -0.25, pole_angle_sign: -1, "
+      "pole_turns: 2, publish_velocities: false}");
+  EXPECT_EQ("slider_to_cart", s.pose.cart_joint);
+  EXPECT_EQ("cart_to_pole", s.pose.pole_joint);
+  EXPECT_EQ(-0.25, s.pose.pole_upright);
+  EXPECT_EQ(-1.0, s.pose.pole_angle_sign);
+  EXPECT_EQ(2, s.pole_turns);
+  EXPECT_FALSE(s.publish_velocities);
+  EXPECT_SAYS(simError("cart_sign: 0"), "cart_sign = 0 is not allowed (must be 1 or -1)");
+}
+
+TEST(ControllerSettings, TheStartLineSaysWhatTheControllerDoes)
+{
+  const ControllerSettings s = readController("");
+  const QTable table(s.training.agent.featureParams(), s.training.agent.actions);
+  EXPECT_EQ(
+      "training, seed 0, 72 states x 2 actions, tables under /t; serving /cartpole/joint_states; resets by "
+      "~cartpole_sim/reset",
+      controllerStartText(s, table, "/t", "/cartpole/joint_states"));
+  const ControllerSettings e = readController("{mode: evaluate, seed: 3, robots: 2, sync: false, reset_service: ''}");
+  EXPECT_EQ(
+      "evaluating (greedy, no learning), seed 3, 72 states x 2 actions, tables under /t; serving a, b, each as "
+      "its states come; no reset service: episodes start when the state is in ~start_region",
+      controllerStartText(e, table, "/t", "a, b"));
+}

@@ -154,6 +154,56 @@ TEST(JointStateConversion, OtherJointNamesArePublishedAsGiven)
 
 // ---- joint_command: controller -> sim
 
+TEST(JointStateConversion, AnyCartPolesReadingsAreFoundByNameAndVelocitiesMayBeMissing)
+{
+  // gym-gazebo's names among other joints, the pole first.
+  const Reading<JointReadings> read =
+      readingsFromJointState(joints({"wheel", "cart_to_pole", "slider_to_cart"}, {9.0, 6.4, 0.5}, {1.0, 0.2, -0.3}),
+                             "slider_to_cart", "cart_to_pole");
+  ASSERT_TRUE(read) << read.refusal;
+  EXPECT_EQ(0.5, read.value->cart_position);
+  EXPECT_EQ(6.4, read.value->pole_position);  // as read: the core wraps it
+  EXPECT_EQ(-0.3, read.value->cart_velocity);
+  EXPECT_EQ(0.2, read.value->pole_velocity);
+  // A position-only driver: no velocity array at all is taken, a partial one is not.
+  const Reading<JointReadings> positions =
+      readingsFromJointState(joints({"cart_joint", "pole_joint"}, {1.0, 2.0}, {}), "cart_joint", "pole_joint");
+  ASSERT_TRUE(positions) << positions.refusal;
+  EXPECT_FALSE(positions.value->cart_velocity.has_value());
+  EXPECT_FALSE(positions.value->pole_velocity.has_value());
+  EXPECT_EQ("dropped joint_states with 2 names but 2 positions and 1 velocities",
+            readingsFromJointState(joints({"cart_joint", "pole_joint"}, {1.0, 2.0}, {3.0}), "cart_joint", "pole_joint")
+                .refusal);
+  EXPECT_EQ(
+      "dropped joint_states without foot_joint",
+      readingsFromJointState(joints({"cart_joint", "pole_joint"}, {1.0, 2.0}, {}), "foot_joint", "pole_joint").refusal);
+  EXPECT_FALSE(
+      readingsFromJointState(joints({"cart_joint", "pole_joint"}, {kNaN, 2.0}, {}), "cart_joint", "pole_joint"));
+}
+
+TEST(CommandConversion, Float64CommandsCarryTheEffortInTheCartsSlot)
+{
+  EXPECT_EQ(-7.5, float64Command(-7.5).data);
+  const std_msgs::Float64MultiArray group = float64ArrayCommand(3.0, 1, 3);
+  EXPECT_EQ((std::vector<double>{0.0, 3.0, 0.0}), group.data);
+  EXPECT_EQ((std::vector<double>{-2.0}), float64ArrayCommand(-2.0, 0, 1).data);
+  const sensor_msgs::JointState named = commandMessage(4.0, stampAt(20000000), "cartJoint");
+  EXPECT_EQ(std::vector<std::string>{"cartJoint"}, named.name);
+}
+
+TEST(JointStateConversion, ASimPosingAsAPositionOnlyRobotPublishesNoVelocities)
+{
+  const JointReadings r{0.5, 6.4, std::nullopt, std::nullopt};
+  const sensor_msgs::JointState msg =
+      jointStateFromReadings(r, 2.0, stampAt(20000000), "slider_to_cart", "cart_to_pole");
+  EXPECT_EQ((std::vector<std::string>{"slider_to_cart", "cart_to_pole"}), msg.name);
+  EXPECT_EQ((std::vector<double>{0.5, 6.4}), msg.position);
+  EXPECT_TRUE(msg.velocity.empty());
+  const Reading<JointReadings> read = readingsFromJointState(msg, "slider_to_cart", "cart_to_pole");
+  ASSERT_TRUE(read) << read.refusal;
+  EXPECT_FALSE(read.value->cart_velocity.has_value());
+}
+
 TEST(CommandConversion, TheSimReadsTheEffortAndStampTheControllerSent)
 {
   const ros::Time state_stamp = stampAt(5000000020);

@@ -33,9 +33,11 @@
 //   - A state with the last stamp is a repeat: answered again with the same effort and stamp
 //     while the episode runs (its first answer may have been lost), ignored otherwise.
 //   - A state older than the last one is dropped (a replayed or reordered message), unless the
-//     same older stamp comes again: a sim that restarted publishes its first state, and
-//     repeats it while nobody answers. Then the running episode is abandoned without learning
-//     from its unfinished end, and the state is taken as a start.
+//     same older stamp comes again (a sim that restarted publishes its first state, and
+//     repeats it while nobody answers), or when three older states in a row each come newer
+//     than the one before (time set back and going on: Gazebo's reset_simulation). Then the
+//     running episode is abandoned without learning from its unfinished end, and the state is
+//     taken as a start.
 //   - Stamp 0 means "no stamp". A robot whose states all carry 0 is served, each message taken
 //     as a new state (it cannot repeat or reorder anything); a 0 amid stamped states is a stray
 //     and is dropped.
@@ -53,11 +55,14 @@
 
 #include "cartpole_qlearning/cartpole_dynamics.h"
 #include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/said.h"
 #include "cartpole_qlearning/training_session.h"
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <optional>
+#include <string>
 
 namespace cartpole_qlearning
 {
@@ -104,6 +109,9 @@ public:
   Verdict onUnstampedCommand(WallClock::time_point now);
   // A reset (the service): a new state, one tick later, is pending. Returns its stamp.
   Stamp onReset(WallClock::time_point now);
+  // A reset that sets time back to the first tick, as Gazebo's reset_simulation does (the sim
+  // posing as such a robot; ~reset_simulation). Returns the new pending stamp.
+  Stamp onResetTimeBack(WallClock::time_point now);
   // A timer tick: true when the pending state has waited repeat_after unanswered since it, or
   // its last repeat, was published: publish it again, unchanged.
   bool repeatDue(WallClock::time_point now);
@@ -179,7 +187,11 @@ struct Reaction
 struct ControllerProtocolParams
 {
   bool reset_service = true;  // false: a robot that cannot be reset on command
-  // Without a reset service, an episode starts only when every |state[i]| <= start_region[i].
+  // A reset that does not say where it put the robot (std_srvs/Empty, Trigger): after it, the
+  // episode starts only inside start_region, and until then states are answered with 0.
+  bool reset_starts_in_region = false;
+  // Without a reset service (or with one as above), an episode starts only when every
+  // |state[i]| <= start_region[i].
   CartPoleState start_region = CartPoleState::Constant(0.05);
   // Training ends after the episode that reaches these (when learning).
   TrainingLimits limits;
@@ -241,8 +253,17 @@ private:
   bool unstamped_stream_ = false;
   Stamp last_ = 0;
   std::optional<Stamp> older_seen_;  // an older stamp seen once: a restart if it comes again
+  static constexpr int kTimeSetBack = 3;
+  int older_run_ = 0;  // older states in a row, each newer than the one before
   double last_effort_ = 0.0;
   Counts counts_;
 };
+
+// What the controller says about a state that was not simply answered: robot names the robot
+// (its joint_states topic), stamp_s is the state's stamp [s]. A dropped state and a restart are
+// said only when dropped_ready() and restart_ready() (the node's throttles) allow it.
+Saying reactionSaid(const Reaction& reaction, const ControllerProtocol::Counts& counts, const std::string& robot,
+                    double stamp_s, const std::function<bool()>& dropped_ready,
+                    const std::function<bool()>& restart_ready);
 
 }  // namespace cartpole_qlearning

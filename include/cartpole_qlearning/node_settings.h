@@ -5,6 +5,8 @@
 
 #include "cartpole_qlearning/config.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
+#include "cartpole_qlearning/q_table.h"
+#include "cartpole_qlearning/robot_interface.h"
 
 #include <cstdint>
 #include <functional>
@@ -58,6 +60,9 @@ struct ControllerSettings
   std::vector<std::string> robots{""};               // namespaces relative to the learner's
   bool sync = true;                                  // several robots: served in lockstep rounds
   ControllerProtocolParams protocol;                 // reset_service, start_region, limits
+  RobotInterfaceParams robot;                        // joints, offsets, command type, decision period
+  // ~reset_service_type: what ~reset_service is
+  std::string reset_service_type = "cartpole_qlearning/Reset";
 };
 
 // What only ROS knows, handed in by the node.
@@ -109,11 +114,22 @@ struct SimSettings
   // region and perturbations over the shared ones; its seed unless ~seed is given). "": none.
   std::string suite;
   std::string suite_case;
+  // Posing as another cart-pole (README: "Your own cart-pole"): its joint names, offsets and signs
+  // (~cart_joint, ~pole_joint, ~cart_zero, ~cart_sign, ~pole_upright, ~pole_angle_sign), whole turns
+  // added to the pole's reading (~pole_turns) and whether velocities are published.
+  RobotInterfaceParams pose;
+  int pole_turns = 0;
+  bool publish_velocities = true;
 };
 
 // Reads the physics and perturbations sections from `shared` and the sim's private parameters
 // from `priv` (loading ~suite when ~suite_case is set); throws ConfigError as
 // readControllerSettings does.
 SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource& priv);
+
+// The controller's first line: what it does, with which table, serving whom ("training, seed 0,
+// 72 states x 2 actions, tables under DIR; serving ROBOTS; resets by ~cartpole_sim/reset").
+std::string controllerStartText(const ControllerSettings& settings, const QTable& table,
+                                const std::string& table_directory, const std::string& served);
 
 }  // namespace cartpole_qlearning

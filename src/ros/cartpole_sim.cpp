@@ -56,6 +56,7 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
   effort_sub_ =
       command_nh.subscribe("cart_effort", 10, &CartPoleSimNode::onEffort, this, ros::TransportHints().tcpNoDelay());
   reset_srv_ = pnh_.advertiseService("reset", &CartPoleSimNode::onReset, this);
+  reset_simulation_srv_ = pnh_.advertiseService("reset_simulation", &CartPoleSimNode::onResetSimulation, this);
 
   // The first state: a random start, which takes one tick of sim time like every reset.
   simulation_->resetRandom();
@@ -111,7 +112,7 @@ bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
 void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const Reading<double> requested = effortFromCommand(*msg);
+  const Reading<double> requested = effortFromCommand(*msg, settings_.pose.cart_joint);
   if (!requested)
   {
     if (bad_command_warning_.ready())
@@ -128,6 +129,10 @@ void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
       ROS_DEBUG_NAMED("cartpole_sim", "cartpole_sim: dropped a joint_command older than the one held");
     return;
   }
+  // An unstamped zero is a controller stopping (an episode's end, its shutdown): it answers no
+  // state, so it is dropped without a warning.
+  if (msg->header.stamp.isZero() && effort == 0.0)
+    return;
   apply(lockstep_->onCommand(msg->header.stamp.toNSec(), now), effort, msg->header.stamp);
 }
 
@@ -205,6 +210,14 @@ void CartPoleSimNode::onSubscriberConnect(const ros::SingleSubscriberPublisher& 
     subscriber.publish(joint_state_);
 }
 
+bool CartPoleSimNode::onResetSimulation(std_srvs::Empty::Request&, std_srvs::Empty::Response&)
+{
+  const std::lock_guard<std::mutex> lock(mutex_);
+  simulation_->resetRandom();
+  publishState(lockstep_ ? toRosTime(lockstep_->onResetTimeBack(WallClock::now())) : ros::Time::now());
+  return true;
+}
+
 bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
@@ -261,7 +274,9 @@ void CartPoleSimNode::publishState(const ros::Time& stamp)
   // joint_states carry what the sensors read; TF shows the true state.
   const CartPoleState& s = simulation_->state();
   auto msg = boost::make_shared<sensor_msgs::JointState>(
-      jointStateFromState(simulation_->observation(), simulation_->appliedForce(), stamp));
+      jointStateFromReadings(robotReadings(settings_.pose, simulation_->observation(), settings_.pole_turns,
+                                           settings_.publish_velocities),
+                             simulation_->appliedForce(), stamp, settings_.pose.cart_joint, settings_.pose.pole_joint));
   joint_state_ = msg;
   republishState();
 

@@ -36,6 +36,30 @@ Reading<CartPoleState> stateFromJointState(const sensor_msgs::JointState& msg, c
   return {state, ""};
 }
 
+Reading<JointReadings> readingsFromJointState(const sensor_msgs::JointState& msg, const std::string& cart_joint,
+                                              const std::string& pole_joint)
+{
+  const int cart = jointIndex(msg, cart_joint);
+  const int pole = jointIndex(msg, pole_joint);
+  if (cart < 0 || pole < 0)
+    return {std::nullopt, "dropped joint_states without " + (cart < 0 ? cart_joint : pole_joint)};
+  const bool velocities = !msg.velocity.empty();
+  if (msg.position.size() != msg.name.size() || (velocities && msg.velocity.size() != msg.name.size()))
+    return {std::nullopt, "dropped joint_states with " + std::to_string(msg.name.size()) + " names but " +
+                              std::to_string(msg.position.size()) + " positions and " +
+                              std::to_string(msg.velocity.size()) + " velocities"};
+  JointReadings readings{msg.position[cart], msg.position[pole], std::nullopt, std::nullopt};
+  if (velocities)
+  {
+    readings.cart_velocity = msg.velocity[cart];
+    readings.pole_velocity = msg.velocity[pole];
+  }
+  if (!std::isfinite(readings.cart_position) || !std::isfinite(readings.pole_position) ||
+      !std::isfinite(readings.cart_velocity.value_or(0.0)) || !std::isfinite(readings.pole_velocity.value_or(0.0)))
+    return {std::nullopt, "dropped joint_states with a non-finite position or velocity"};
+  return {readings, ""};
+}
+
 sensor_msgs::JointState jointStateFromState(const CartPoleState& state, double applied_effort, const ros::Time& stamp,
                                             const std::string& cart_joint, const std::string& pole_joint)
 {
@@ -48,12 +72,40 @@ sensor_msgs::JointState jointStateFromState(const CartPoleState& state, double a
   return msg;
 }
 
+sensor_msgs::JointState jointStateFromReadings(const JointReadings& r, double applied_effort, const ros::Time& stamp,
+                                               const std::string& cart_joint, const std::string& pole_joint)
+{
+  sensor_msgs::JointState msg;
+  msg.header.stamp = stamp;
+  msg.name = {cart_joint, pole_joint};
+  msg.position = {r.cart_position, r.pole_position};
+  if (r.cart_velocity && r.pole_velocity)
+    msg.velocity = {*r.cart_velocity, *r.pole_velocity};
+  msg.effort = {applied_effort, 0.0};
+  return msg;
+}
+
 sensor_msgs::JointState commandMessage(double effort, const ros::Time& stamp, const std::string& cart_joint)
 {
   sensor_msgs::JointState msg;
   msg.header.stamp = stamp;
   msg.name = {cart_joint};
   msg.effort = {effort};
+  return msg;
+}
+
+std_msgs::Float64 float64Command(double effort)
+{
+  std_msgs::Float64 msg;
+  msg.data = effort;
+  return msg;
+}
+
+std_msgs::Float64MultiArray float64ArrayCommand(double effort, std::size_t index, std::size_t size)
+{
+  std_msgs::Float64MultiArray msg;
+  msg.data.assign(size, 0.0);
+  msg.data.at(index) = effort;
   return msg;
 }
 

@@ -1,6 +1,5 @@
 #include "cartpole_qlearning/ros/qlearning_controller.h"
 
-#include "cartpole_qlearning/Reset.h"
 #include "cartpole_qlearning/ros/conversions.h"
 #include "cartpole_qlearning/ros/launch_control.h"
 #include "cartpole_qlearning/ros/parameter_source.h"
@@ -62,25 +61,16 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
     // README: the ~reset_service row.
     const auto give_up_after = resetGiveUpAfter(settings_.sim_timeout);
     for (Robot& robot : robots_)
-      robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(settings_.reset_service), give_up_after);
+      robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(settings_.reset_service),
+                                                     settings_.reset_service_type, give_up_after);
   }
   watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, settings_.sim_timeout / 2.0)),
                                     &QLearningControllerNode::onWatchdog, this);
   std::string served;
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
-  const FeatureParams& features = session_->table().features();
-  const std::string rows =
-      features.kind == FeatureKind::Tiles
-          ? std::to_string(features.tilings) + " tilings, " + std::to_string(session_->table().stateCount()) + " tiles"
-          : std::to_string(session_->table().stateCount()) + " states";
-  say(Said::Level::Info, "%s, seed %llu, %s x %zu actions, tables under %s; serving %s%s; %s",
-      settings_.run.learning ? "training" : "evaluating (greedy, no learning)",
-      static_cast<unsigned long long>(settings_.run.seed), rows.c_str(), session_->table().actionCount(),
-      app_->tableDirectory().c_str(), served.c_str(),
-      robots_.size() > 1 ? (settings_.sync ? " in lockstep rounds" : ", each as its states come") : "",
-      settings_.protocol.reset_service ? ("resets by ~" + settings_.reset_service).c_str()
-                                       : "no reset service: episodes start when the state is in ~start_region");
+  say(Said::Level::Info, "%s",
+      controllerStartText(settings_, session_->table(), app_->tableDirectory(), served).c_str());
   lock.unlock();
   startLiveTuning();
 }
@@ -100,7 +90,9 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
     params.robot = r;
     robot.protocol = std::make_unique<ControllerProtocol>(*session_, params);
     robot.nh = robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name);
-    robot.command_pub = robot.nh.advertise<sensor_msgs::JointState>("joint_command", 10);
+    robot.command = CommandPublisher(robot.nh, settings_.robot.command_topic, settings_.robot);
+    robot.mapping = std::make_unique<StateMapping>(settings_.robot);
+    robot.decisions = std::make_unique<DecisionClock>(settings_.robot.decision_period);
     if (!robot.name.empty())
       robot.stats_pub = robot.nh.advertise<EpisodeStats>("episode_stats", 100);
     robot.last_state_at = now;
@@ -109,8 +101,9 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
       state_nh.setCallbackQueue(state_queue);
     // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
     robot.state_sub = state_nh.subscribe<sensor_msgs::JointState>(
-        "joint_states", 10, [this, r](const sensor_msgs::JointStateConstPtr& msg) { onJointState(r, msg); },
-        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+        settings_.robot.state_topic, 10,
+        [this, r](const sensor_msgs::JointStateConstPtr& msg) { onJointState(r, msg); }, ros::VoidConstPtr(),
+        ros::TransportHints().tcpNoDelay());
   }
 }
 
@@ -153,16 +146,17 @@ void QLearningControllerNode::readParameters(bool shutdown_by_default)
   settings_ = readControllerSettings(RosParameterSource(nh_), RosParameterSource(pnh_), context);
 }
 
-bool QLearningControllerNode::extractState(const sensor_msgs::JointState& msg, CartPoleState& state) const
+bool QLearningControllerNode::extractState(Robot& robot, const sensor_msgs::JointState& msg, CartPoleState& state) const
 {
-  const Reading<CartPoleState> reading = stateFromJointState(msg);
+  const Reading<JointReadings> reading =
+      readingsFromJointState(msg, settings_.robot.cart_joint, settings_.robot.pole_joint);
   if (!reading)
   {
     if (bad_state_warning_.ready())
       say(Said::Level::Warn, "%s", reading.refusal.c_str());
     return false;
   }
-  state = *reading.value;
+  state = robot.mapping->map(msg.header.stamp.toNSec(), *reading.value);
   return true;
 }
 
@@ -173,17 +167,23 @@ std::string QLearningControllerNode::describe(const Robot& robot) const
 
 void QLearningControllerNode::command(Robot& robot, double effort, const ros::Time& stamp)
 {
-  // A new message each time: in a nodelet manager the sim receives this very pointer.
-  robot.command_pub.publish(boost::make_shared<sensor_msgs::JointState>(commandMessage(effort, stamp)));
+  robot.command.publish(effort, stamp);
+}
+
+void QLearningControllerNode::stop()
+{
+  const std::lock_guard<std::mutex> lock(mutex_);
+  for (Robot& robot : robots_)
+    robot.command.stop();
 }
 
 void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::JointStateConstPtr& msg)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
   CartPoleState state;
-  if (app_->finished() || !extractState(*msg, state))
-    return;
   Robot& robot = robots_[r];
+  if (app_->finished() || !extractState(robot, *msg, state))
+    return;
   robot.last_state_at = std::chrono::steady_clock::now();
   if (robot.silent_reported)
   {
@@ -194,6 +194,16 @@ void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::Joi
     say(Said::Level::Info, "%s takes part in the rounds again", describe(robot).c_str());
 
   const ros::Time stamp = msg->header.stamp;
+  const DecisionClock::Verdict decision = robot.decisions->onState(stamp.toNSec());
+  if (decision.slow && slow_states_warning_.ready())
+    say(Said::Level::Warn,
+        "joint_states on %s come further apart than ~decision_period = %g s, the step the table learns",
+        describe(robot).c_str(), settings_.robot.decision_period);
+  // A fall ends the running episode whenever it comes, not a period later.
+  const bool falls =
+      robot.protocol->phase() == ControllerProtocol::Phase::InEpisode && session_->task().isTerminal(state);
+  if (!decision.decide && !falls)
+    return robot.command.hold(stamp);
   if (!rounds_->holds() || !robot.protocol->takesAsNew(stamp.toNSec()))
   {
     serve(r, stamp, state);
@@ -226,6 +236,8 @@ void QLearningControllerNode::serve(std::size_t r, const ros::Time& stamp, const
   report(robot, reaction, stamp);
   if (reaction.answer)
     command(robot, reaction.effort, stamp);
+  if (reaction.episode_ended && !reaction.answer)
+    robot.command.stop();
   if (reaction.episode_ended)
     endEpisode(robot, stamp, reaction.training_finished);
   if (reaction.request_reset && !app_->finished())
@@ -234,29 +246,9 @@ void QLearningControllerNode::serve(std::size_t r, const ros::Time& stamp, const
 
 void QLearningControllerNode::report(const Robot& robot, const Reaction& reaction, const ros::Time& stamp)
 {
-  const ControllerProtocol::Counts& c = robot.protocol->counts();
-  if (reaction.kind == Reaction::Kind::Stale && dropped_state_warning_.ready())
-    say(Said::Level::Warn,
-        "dropped joint_states on %s stamped %.6f, older than the last state (a replayed or reordered message; a "
-        "restarted sim is recognised when it sends its state again). Dropped so far: %llu",
-        describe(robot).c_str(), stamp.toSec(), static_cast<unsigned long long>(c.stale));
-  if (reaction.kind == Reaction::Kind::Stray && dropped_state_warning_.ready())
-    say(Said::Level::Warn, "dropped joint_states on %s without a stamp among stamped ones. Dropped so far: %llu",
-        describe(robot).c_str(), static_cast<unsigned long long>(c.stray));
-  if (reaction.first_unstamped)
-    say(Said::Level::Warn,
-        "joint_states on %s carry no stamp (0): every message is taken as a new state, and commands go out "
-        "unstamped",
-        describe(robot).c_str());
-  if (reaction.sim_restarted && restart_warning_.ready())
-    say(Said::Level::Warn,
-        "%s: time went back to %.3f s: the sim restarted; starting a new episode. Restarts so far: %llu",
-        describe(robot).c_str(), stamp.toSec(), static_cast<unsigned long long>(c.restarts));
-  if (reaction.waiting_for_start)
-    say(Said::Level::Info,
-        "%s: episode over; no reset service, so commanding 0 until the state is back inside ~start_region (stand "
-        "the pole up)",
-        describe(robot).c_str());
+  say(reactionSaid(
+      reaction, robot.protocol->counts(), describe(robot), stamp.toSec(),
+      [this] { return dropped_state_warning_.ready(); }, [this] { return restart_warning_.ready(); }));
 }
 
 void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, bool training_finished)
@@ -353,6 +345,7 @@ void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
     if (robot.silent_reported || secondsSince(robot.last_state_at) < settings_.sim_timeout)
       continue;
     robot.silent_reported = true;
+    robot.command.stop();
     say(Said::Level::Warn, "no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting for it",
         describe(robot).c_str(), settings_.sim_timeout);
   }

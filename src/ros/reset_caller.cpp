@@ -3,6 +3,8 @@
 #include "cartpole_qlearning/Reset.h"
 
 #include <ros/ros.h>
+#include <std_srvs/Empty.h>
+#include <std_srvs/Trigger.h>
 
 #include <condition_variable>
 #include <mutex>
@@ -12,6 +14,41 @@
 
 namespace cartpole_qlearning
 {
+namespace
+{
+bool succeeded(const Reset::Response& response, std::string& message)
+{
+  message = response.message;
+  return response.success;
+}
+bool succeeded(const std_srvs::Trigger::Response& response, std::string& message)
+{
+  message = response.message;
+  return response.success;
+}
+bool succeeded(const std_srvs::Empty::Response&, std::string&)
+{
+  return true;  // Gazebo's reset_simulation and many drivers' reset: an answer is a reset
+}
+
+// One call of a reset service of type Srv (ours with an empty state: a random start). Persistent:
+// on persistent_client, connected when first needed (the sim may come up after this node; a new
+// connection per episode would cost a master lookup and a TCP set-up); else on a connection of
+// its own (see ResetCalls), and the persistent link is made again once the sim answers.
+template <typename Srv>
+bool callReset(ros::ServiceClient& persistent_client, const std::string& service, bool persistent, std::string& message)
+{
+  Srv srv;
+  ros::ServiceClient once;
+  if (!persistent)
+    persistent_client = ros::ServiceClient();
+  ros::ServiceClient& client = persistent ? persistent_client : once;
+  if (!client.isValid())
+    client = ros::ServiceClient(service, persistent, ros::M_string(), ros::service_traits::md5sum<Srv>());
+  return client.call(srv) && succeeded(srv.response, message);
+}
+}  // namespace
+
 // What a ResetCaller and its calling threads share. A calling thread that was given up holds it
 // after the ResetCaller is gone, so it is all the thread may touch.
 struct ResetCaller::Shared
@@ -36,8 +73,11 @@ struct ResetCaller::Shared
   std::optional<bool> handed;
 };
 
-ResetCaller::ResetCaller(std::string service, std::chrono::steady_clock::duration give_up_after)
-  : service_(std::move(service)), calls_(service_, give_up_after), shared_(std::make_shared<Shared>())
+ResetCaller::ResetCaller(std::string service, std::string type, std::chrono::steady_clock::duration give_up_after)
+  : service_(std::move(service)),
+    type_(std::move(type)),
+    calls_(service_, give_up_after),
+    shared_(std::make_shared<Shared>())
 {
   thread_ = std::thread(&ResetCaller::run, this);
 }
@@ -61,7 +101,8 @@ void ResetCaller::request()
   shared_->changed.notify_all();
 }
 
-void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t generation, const std::string& service)
+void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t generation, const std::string& service,
+                           const std::string& type)
 {
   // Made by name (resolved already), not through a NodeHandle: a thread given up may outlive the
   // node and its handles.
@@ -85,28 +126,14 @@ void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t 
       persistent = *shared->handed;
       shared->handed.reset();
     }
-    Reset reset;  // empty state: a random start
-    bool answered = false;
-    if (persistent)
-    {
-      // Connected when first needed (the sim may come up after this node). Persistent: a new
-      // connection per episode would cost a master lookup and a TCP set-up.
-      if (!persistent_client.isValid())
-        persistent_client = ros::ServiceClient(service, true, ros::M_string(), ros::service_traits::md5sum<Reset>());
-      answered = persistent_client.call(reset) && reset.response.success;
-    }
-    else
-    {
-      // A connection of its own (see ResetCalls): the persistent link is made again once the sim
-      // answers.
-      persistent_client = ros::ServiceClient();
-      answered =
-          ros::ServiceClient(service, false, ros::M_string(), ros::service_traits::md5sum<Reset>()).call(reset) &&
-          reset.response.success;
-    }
+    std::string message;
+    const bool answered =
+        type == "std_srvs/Empty"     ? callReset<std_srvs::Empty>(persistent_client, service, persistent, message)
+        : type == "std_srvs/Trigger" ? callReset<std_srvs::Trigger>(persistent_client, service, persistent, message)
+                                     : callReset<Reset>(persistent_client, service, persistent, message);
     {
       std::lock_guard<std::mutex> lock(shared->mutex);
-      shared->returned.push_back({generation, true, answered, reset.response.message});
+      shared->returned.push_back({generation, true, answered, message});
       shared->changed.notify_all();
       if (shared->generation != generation || shared->stopping)
         return;
@@ -156,7 +183,7 @@ void ResetCaller::carryOut(const ResetCalls::Orders& orders)
   if (orders.call)
   {
     if (!caller_.joinable())
-      caller_ = std::thread(&ResetCaller::callLoop, shared_, orders.call->generation, service_);
+      caller_ = std::thread(&ResetCaller::callLoop, shared_, orders.call->generation, service_, type_);
     shared_->handed = orders.call->persistent;
   }
   if (orders.give_up || orders.call)

@@ -14,6 +14,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <std_msgs/Float64.h>
+#include <std_srvs/Empty.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <memory>
@@ -36,6 +37,9 @@ private:
   void onJointCommand(const sensor_msgs::JointStateConstPtr& msg);
   void onEffort(const std_msgs::Float64ConstPtr& msg);
   bool onReset(Reset::Request& request, Reset::Response& response);
+  // ~reset_simulation (std_srvs/Empty), posing as Gazebo: a random start; in lockstep, time set
+  // back to the first tick.
+  bool onResetSimulation(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void onRealtimeTick(const ros::SteadyTimerEvent& event);
   void onLockstepTimer(const ros::SteadyTimerEvent& event);
   // Lockstep: a controller that subscribes gets the pending state at once (instead of after
@@ -81,6 +85,7 @@ private:
   ros::Subscriber command_sub_;
   ros::Subscriber effort_sub_;
   ros::ServiceServer reset_srv_;
+  ros::ServiceServer reset_simulation_srv_;
   ros::SteadyTimer timer_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
 };

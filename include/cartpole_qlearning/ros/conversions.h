@@ -7,11 +7,14 @@
 #include "cartpole_qlearning/LearningConfig.h"
 #include "cartpole_qlearning/cartpole_dynamics.h"
 #include "cartpole_qlearning/learning_settings.h"
+#include "cartpole_qlearning/robot_interface.h"
 #include "cartpole_qlearning/training_session.h"
 
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/time.h>
 #include <sensor_msgs/JointState.h>
+#include <std_msgs/Float64.h>
+#include <std_msgs/Float64MultiArray.h>
 
 #include <optional>
 #include <string>
@@ -37,15 +40,30 @@ struct Reading
 Reading<CartPoleState> stateFromJointState(const sensor_msgs::JointState& msg,
                                            const std::string& cart_joint = "cart_joint",
                                            const std::string& pole_joint = "pole_joint");
+// joint_states from any cart-pole -> the two joints' readings, found by name in any order among
+// others. Positions one per name; velocities one per name or none at all (a position-only
+// driver: the core's StateMapping estimates them); finite.
+Reading<JointReadings> readingsFromJointState(const sensor_msgs::JointState& msg, const std::string& cart_joint,
+                                              const std::string& pole_joint);
 // The state -> joint_states as the sim publishes it: both joints' positions, velocities and
 // efforts (the cart's the force applied in the last step, the pole's 0: it is not actuated).
 sensor_msgs::JointState jointStateFromState(const CartPoleState& state, double applied_effort, const ros::Time& stamp,
                                             const std::string& cart_joint = "cart_joint",
                                             const std::string& pole_joint = "pole_joint");
 
+// A robot's readings -> joint_states (the sim posing as another cart-pole, robotReadings): both
+// joints' positions, velocities when the readings have them, efforts as jointStateFromState's.
+sensor_msgs::JointState jointStateFromReadings(const JointReadings& readings, double applied_effort,
+                                               const ros::Time& stamp, const std::string& cart_joint,
+                                               const std::string& pole_joint);
+
 // The controller's joint_command: the cart's effort [N], stamped with the state it answers.
 sensor_msgs::JointState commandMessage(double effort, const ros::Time& stamp,
                                        const std::string& cart_joint = "cart_joint");
+// The effort as ros_control's JointEffortController takes it.
+std_msgs::Float64 float64Command(double effort);
+// The effort in slot `index` of `size` (JointGroupEffortController), the other slots 0.
+std_msgs::Float64MultiArray float64ArrayCommand(double effort, std::size_t index, std::size_t size);
 // joint_command -> the effort of the cart joint (as sent: the sim checks and clamps it).
 Reading<double> effortFromCommand(const sensor_msgs::JointState& msg, const std::string& cart_joint = "cart_joint");
 

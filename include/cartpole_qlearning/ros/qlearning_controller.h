@@ -16,6 +16,7 @@
 #include "cartpole_qlearning/LoadQTable.h"
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/ros/command_publisher.h"
 #include "cartpole_qlearning/ros/reset_caller.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
 #include "cartpole_qlearning/node_settings.h"
@@ -36,7 +37,6 @@
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace cartpole_qlearning
@@ -44,19 +44,21 @@ namespace cartpole_qlearning
 class QLearningControllerNode
 {
 public:
-  // nh: the learner's namespace (topics of its own robot; physics, task, learning and training
-  // parameters); pnh: the node's private namespace (controller parameters and services).
-  // When training ends (solved or max_episodes) and ~shutdown_when_finished (default:
-  // shutdown_by_default), the controller ends the roslaunch that started it, as Ctrl-C would
-  // (launch_control.h); when no roslaunch started it, it calls shutdown: the executable ends
-  // there; a nodelet ends its manager only when asked. state_queue: where the joint_states callbacks queue (nullptr:
-  // nh's queue); a nodelet passes the queue its lockstep thread serves. Throws ConfigError naming a bad parameter
-  // (a ~load_on_start table or ~stats_csv that cannot be used included).
+  // nh: the learner's namespace (topics of its own robot; physics, task, learning and training parameters); pnh:
+  // the node's private namespace (controller parameters and services). When training ends (solved or max_episodes)
+  // and ~shutdown_when_finished (default: shutdown_by_default), the controller ends the roslaunch that started it,
+  // as Ctrl-C would (launch_control.h); when no roslaunch started it, it calls shutdown: the executable ends there;
+  // a nodelet ends its manager only when asked. state_queue: where the joint_states callbacks queue (nullptr: nh's
+  // queue); a nodelet passes the queue its lockstep thread serves. Throws ConfigError naming a bad parameter (a
+  // ~load_on_start table or ~stats_csv that cannot be used included).
   QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::function<void()> shutdown,
                           bool shutdown_by_default, ros::CallbackQueue* state_queue = nullptr);
   // Saves the table when ~save_on_shutdown (training, RunApplication::shutdown), after giving up
   // any reset call under way.
   ~QLearningControllerNode();
+
+  // Zero effort to every robot, before ROS shuts down (Ctrl-C, roslaunch's kill): a robot may hold its last command.
+  void stop();
 
   QLearningControllerNode(const QLearningControllerNode&) = delete;
   QLearningControllerNode& operator=(const QLearningControllerNode&) = delete;
@@ -69,7 +71,9 @@ private:
     ros::NodeHandle nh;  // in that namespace
     std::unique_ptr<ControllerProtocol> protocol;
     ros::Subscriber state_sub;
-    ros::Publisher command_pub;
+    CommandPublisher command;  // ~command_type on joint_command
+    std::unique_ptr<StateMapping> mapping;
+    std::unique_ptr<DecisionClock> decisions;
     ros::Publisher stats_pub;               // only for a robot in a namespace of its own
     std::unique_ptr<ResetCaller> resetter;  // none without a reset service
     ros::Time held_stamp;                   // a new state waiting for its round
@@ -97,7 +101,7 @@ private:
   void onWatchdog(const ros::SteadyTimerEvent& event);
 
   // The state in a message, or false (with a throttled warning) when it cannot be used.
-  bool extractState(const sensor_msgs::JointState& msg, CartPoleState& state) const;
+  bool extractState(Robot& robot, const sensor_msgs::JointState& msg, CartPoleState& state) const;
   // Hands one state to the robot's protocol and carries out its reaction.
   void serve(std::size_t robot, const ros::Time& stamp, const CartPoleState& state);
   // Serves every complete round of held states, in robot order.
@@ -139,6 +143,7 @@ private:
 
   mutable WallThrottle bad_state_warning_{1.0};
   WallThrottle dropped_state_warning_{1.0};
+  WallThrottle slow_states_warning_{10.0};
   // A replayed older stamp, sent twice, looks like a restarted sim: said at most once a second.
   WallThrottle restart_warning_{1.0};
 

@@ -22,8 +22,9 @@ namespace cartpole_qlearning
 class ResetCaller
 {
 public:
-  // service: the service's resolved name; give_up_after: resetGiveUpAfter(~sim_timeout).
-  ResetCaller(std::string service, std::chrono::steady_clock::duration give_up_after);
+  // service: the service's resolved name; type: ~reset_service_type (cartpole_qlearning/Reset,
+  // std_srvs/Empty or std_srvs/Trigger); give_up_after: resetGiveUpAfter(~sim_timeout).
+  ResetCaller(std::string service, std::string type, std::chrono::steady_clock::duration give_up_after);
   // Never waits for a call under way: gives it up as a hung one.
   ~ResetCaller();
 
@@ -40,9 +41,11 @@ private:
   // Under shared_->mutex, on run()'s thread.
   void carryOut(const ResetCalls::Orders& orders);
   // A calling thread: makes the calls handed to its generation while it is the current one.
-  static void callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t generation, const std::string& service);
+  static void callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t generation, const std::string& service,
+                       const std::string& type);
 
   const std::string service_;
+  const std::string type_;
   ResetCalls calls_;  // run()'s only (a given-up thread must not touch this object)
   std::shared_ptr<Shared> shared_;
   std::thread caller_;  // the current calling thread, if any; run()'s only

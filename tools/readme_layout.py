@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""Writes the README's Layout table from the tree: the core's modules, the ROS layer's files, the
+command line, the configuration files, the launch files, users' scripts and developers' tools,
+each listed as it is in its folder. test/core_layout_test.cpp fails when the table and the tree
+differ, so a new file means running this again:
+
+  tools/readme_layout.py          # rewrites README.md's Layout table in place
+"""
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def stems(*folders):
+    names = set()
+    for folder in folders:
+        path = os.path.join(ROOT, folder)
+        names |= {os.path.splitext(f)[0] for f in os.listdir(path) if os.path.isfile(os.path.join(path, f))}
+    return sorted(names)
+
+
+def files(folder):
+    path = os.path.join(ROOT, folder)
+    return sorted(f for f in os.listdir(path) if os.path.isfile(os.path.join(path, f)))
+
+
+def quoted(names):
+    return ", ".join("`%s`" % n for n in names)
+
+
+def table():
+    rows = [
+        ("`include/cartpole_qlearning/`, `src/`",
+         "the ROS-free core, one module a file pair, named for what it models: "
+         + quoted(stems("include/cartpole_qlearning", "src"))),
+        ("`include/cartpole_qlearning/ros/`, `src/ros/`",
+         "the ROS layer: the node classes and their mains (`*_node.cpp`), the nodelets, message conversions, "
+         "the parameter server reader, the reset caller, start-up and launch control: "
+         + quoted(stems("include/cartpole_qlearning/ros", "src/ros"))),
+        ("`src/cli/`", "the command line: " + quoted(stems("src/cli"))),
+        ("`msg/`, `srv/`", "`EpisodeStats`, `Reset`, `SaveQTable`, `LoadQTable`"),
+        ("`cfg/`", "`Learning.cfg`: the controller's live-tuning fields (dynamic_reconfigure)"),
+        ("`config/`", "commented YAML parameters: " + quoted(files("config"))
+         + "; `config/robots/`: one profile per public cart-pole, for robot.launch's robot argument"),
+        ("`launch/`", "the launch files users type: " + quoted(files("launch")) + "; `launch/include/` holds their parts"),
+        ("`urdf/`, `rviz/`", "`cartpole.urdf` (links match the TF frames), `cartpole.rviz`"),
+        ("`docs/`", "pages and pictures (`docs/images/`), each picture made by the command beside it"),
+        ("`test/`", "gtest unit tests of the core (`core_tests`), of the ROS layer's message conversions "
+         "(`ros_conversions_test`, no master) and of `train_headless`; rostest tests of the nodes' wiring "
+         "(`*.test`), of `plot_learning_curve` and of RViz's picture; fuzzers (`test/fuzz/`); sanitizer "
+         "suppressions (`test/sanitizer/`)"),
+        ("`bench/`", "benchmarks (Google Benchmark for the core; the lockstep loops against raw TCPROS and "
+         "intra-process round trips; the Python anchor)"),
+        ("`scripts/`", "what users run: " + quoted(files("scripts"))),
+        ("`tools/`", "what developers run (CI, fuzzing, sanitizers, pictures, figures, reference trajectories): "
+         + quoted(files("tools"))),
+        ("`.ci/`", "`run`: what CI runs (the README's test command in a workspace of its own)"),
+    ]
+    return "| folder | what is inside |\n| --- | --- |\n" + "".join("| %s | %s |\n" % row for row in rows)
+
+
+def main():
+    readme = os.path.join(ROOT, "README.md")
+    text = open(readme).read()
+    start = text.index("| folder | what is inside |", text.index("## Layout\n"))
+    end = text.find("\n## ", start)
+    end = len(text) if end < 0 else end + 1
+    new = text[:start] + table() + ("\n" if end < len(text) else "") + text[end:]
+    open(readme, "w").write(new)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
