@@ -126,6 +126,10 @@ QLearningControllerNode::~QLearningControllerNode()
   // ROS may be shut down already: said on the console.
   for (const Said& said : app_ ? app_->shutdown() : Saying())
     std::printf("%s\n", prefixed(said).c_str());
+  // Out now: under roslaunch stdout is a pipe, and a process killed after its slow exit (a
+  // loaded machine) would lose what is still buffered (seen in a new Debian 12 root: the line
+  // cut after the path).
+  std::fflush(stdout);
 }
 
 void QLearningControllerNode::readParameters(bool shutdown_by_default)
