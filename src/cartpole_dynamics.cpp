@@ -42,8 +42,8 @@ std::string CartPoleParams::validate() const
     out << name << " = " << value << " is not allowed (must be finite and > 0)";
     return out.str();
   };
-  for (const auto& [name, value] : {std::pair<const char*, double>{"cart_friction", cart_friction},
-                                    {"pole_friction", pole_friction}})
+  for (const auto& [name, value] :
+       {std::pair<const char*, double>{"cart_friction", cart_friction}, {"pole_friction", pole_friction}})
   {
     if (!(std::isfinite(value) && value >= 0.0))
     {

@@ -8,14 +8,14 @@ namespace cartpole_qlearning
 {
 CartPoleSimulation::CartPoleSimulation(const CartPoleParams& params, double start_state_bound, std::uint64_t seed,
                                        const PerturbationParams& perturbations)
-  : nominal_(params)
-  , dynamics_(params)
-  , start_state_bound_(start_state_bound)
-  , perturbations_(perturbations)
-  , rng_(seed, kEnvironmentStream)
-  , noise_rng_(seed, kNoiseStream)
-  , perturbation_rng_(seed, kPerturbationStream)
-  , delay_(perturbations.delay_steps)
+  : nominal_(params),
+    dynamics_(params),
+    start_state_bound_(start_state_bound),
+    perturbations_(perturbations),
+    rng_(seed, kEnvironmentStream),
+    noise_rng_(seed, kNoiseStream),
+    perturbation_rng_(seed, kPerturbationStream),
+    delay_(perturbations.delay_steps)
 {
   if (!(std::isfinite(start_state_bound) && start_state_bound >= 0.0))
     throw std::invalid_argument("start_state_bound = " + std::to_string(start_state_bound) +
@@ -30,9 +30,8 @@ void CartPoleSimulation::beginEpisode()
   applied_force_ = 0.0;
   last_push_ = 0.0;
   unsigned delay = perturbations_.delay_steps;
-  if (perturbations_.mass_cart.varies() || perturbations_.mass_pole.varies() ||
-      perturbations_.half_length.varies() || perturbations_.motor.varies() ||
-      perturbations_.delay_steps_max != perturbations_.delay_steps)
+  if (perturbations_.mass_cart.varies() || perturbations_.mass_pole.varies() || perturbations_.half_length.varies() ||
+      perturbations_.motor.varies() || perturbations_.delay_steps_max != perturbations_.delay_steps)
     dynamics_ = CartPoleDynamics(drawEpisodePhysics(nominal_, perturbations_, perturbation_rng_, motor_factor_, delay));
   delay_.reset(delay);
   observation_ = perturbations_.noisy() ? addSensorNoise(state_, perturbations_, noise_rng_) : state_;

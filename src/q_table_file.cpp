@@ -200,8 +200,7 @@ std::string formatQTable(const QTable& table)
     out << "# The rows repeat once per previous action: first for none (an episode's first state), then\n"
         << "# for each action in order; the learner sees the action it took last.\n"
         << "previous_action: true\n";
-  out
-      << "# The effort [N] of each action: one column of values per action.\n"
+  out << "# The effort [N] of each action: one column of values per action.\n"
       << "actions: " << flowList(table.actions()) << "\n"
       << "# Training that produced this table.\n"
       << "episodes: " << table.episodes << "\n"

@@ -273,10 +273,9 @@ void CartPoleSimNode::publishState(const ros::Time& stamp)
 {
   // joint_states carry what the sensors read; TF shows the true state.
   const CartPoleState& s = simulation_->state();
-  auto msg = boost::make_shared<sensor_msgs::JointState>(
-      jointStateFromReadings(robotReadings(settings_.pose, simulation_->observation(), settings_.pole_turns,
-                                           settings_.publish_velocities),
-                             simulation_->appliedForce(), stamp, settings_.pose.cart_joint, settings_.pose.pole_joint));
+  auto msg = boost::make_shared<sensor_msgs::JointState>(jointStateFromReadings(
+      robotReadings(settings_.pose, simulation_->observation(), settings_.pole_turns, settings_.publish_velocities),
+      simulation_->appliedForce(), stamp, settings_.pose.cart_joint, settings_.pose.pole_joint));
   joint_state_ = msg;
   republishState();
 

@@ -86,10 +86,13 @@ private:
     // Its loader would respawn into the same error: startNode ends the launch that started the
     // manager instead (as for the executables), and the manager is told it failed.
     std::string reason;
-    if (!startNode("cartpole_sim", [&] {
-          lockstep_ = LockstepThread::acquire();
-          node_ = std::make_unique<CartPoleSimNode>(getNodeHandle(), getPrivateNodeHandle(), lockstep_->queue());
-        }, &reason))
+    if (!startNode(
+            "cartpole_sim",
+            [&] {
+              lockstep_ = LockstepThread::acquire();
+              node_ = std::make_unique<CartPoleSimNode>(getNodeHandle(), getPrivateNodeHandle(), lockstep_->queue());
+            },
+            &reason))
       throw std::runtime_error(reason);
   }
 
@@ -112,11 +115,14 @@ private:
     // other nodelets keep running unless ~shutdown_when_finished asks to end the manager
     // (train.launch nodelet:=true, where the manager is the run's own).
     std::string reason;
-    if (!startNode("qlearning_controller", [&] {
-          lockstep_ = LockstepThread::acquire();
-          node_ = std::make_unique<QLearningControllerNode>(
-              getNodeHandle(), getPrivateNodeHandle(), [] { ros::requestShutdown(); }, false, lockstep_->queue());
-        }, &reason))
+    if (!startNode(
+            "qlearning_controller",
+            [&] {
+              lockstep_ = LockstepThread::acquire();
+              node_ = std::make_unique<QLearningControllerNode>(
+                  getNodeHandle(), getPrivateNodeHandle(), [] { ros::requestShutdown(); }, false, lockstep_->queue());
+            },
+            &reason))
       throw std::runtime_error(reason);
   }
 
