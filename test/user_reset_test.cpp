@@ -80,6 +80,15 @@ TEST(UserReset, EveryStepIsThePhysicsOfTheStateItsCommandWasStampedWith)
           ++bad_messages;
           return;
         }
+        // An unstamped zero is the controller stopping the cart at an episode's end; it answers
+        // no state (the sim steps on none), and kept here at stamp 0 it would hide that the
+        // recording of commands began after that of states.
+        if (m->header.stamp.isZero())
+        {
+          if (m->effort[0] != 0.0)
+            ++bad_messages;
+          return;
+        }
         commands[m->header.stamp.toNSec()].push_back(m->effort[0]);
       }),
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
