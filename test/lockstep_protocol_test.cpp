@@ -1,5 +1,6 @@
 // The rules of lockstep_protocol.h, each driven through a scripted order of messages, and the
 // whole loop wired by hand with faults injected, which must train exactly as without them.
+#include "test_support.h"
 #include "cartpole_qlearning/headless_trainer.h"
 #include "cartpole_qlearning/lockstep_loopback.h"
 #include "cartpole_qlearning/lockstep_protocol.h"
@@ -18,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+using cartpole_qlearning::test::bitIdentical;
 using namespace cartpole_qlearning;
 
 namespace
@@ -45,11 +47,6 @@ TrainingConfig shortConfig(std::uint64_t episodes)
   config.limits.max_episodes = episodes;
   config.limits.stop_when_solved = false;
   return config;
-}
-
-bool bitIdentical(const std::vector<double>& a, const std::vector<double>& b)
-{
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
 }
 
 CartPoleState leaning(double theta)

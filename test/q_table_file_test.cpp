@@ -15,6 +15,7 @@
 
 #include <unistd.h>
 
+using cartpole_qlearning::test::bitIdentical;
 using namespace cartpole_qlearning;
 namespace fs = std::filesystem;
 
@@ -78,10 +79,6 @@ protected:
   fs::path dir_;
 };
 
-bool bitIdentical(const std::vector<double>& a, const std::vector<double>& b)
-{
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
 }  // namespace
 
 TEST_F(QTableFileTest, RoundTripIsBitExact)

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <cstdio>
 #include <fstream>
@@ -35,6 +36,13 @@ struct CommandRun
     return text.substr(text.find_last_of('\n') + 1);
   }
 };
+
+// The same doubles to the bit (NaN payloads and the sign of zero included), as a saved table
+// and a replayed run must be.
+inline bool bitIdentical(const std::vector<double>& a, const std::vector<double>& b)
+{
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
 
 // Runs a shell command, its stderr joined to its stdout, and waits for it.
 inline CommandRun runCommand(const std::string& command)

@@ -1,3 +1,4 @@
+#include "test_support.h"
 #include "cartpole_qlearning/headless_trainer.h"
 
 #include <gtest/gtest.h>
@@ -5,6 +6,7 @@
 #include <algorithm>
 #include <cstring>
 
+using cartpole_qlearning::test::bitIdentical;
 using namespace cartpole_qlearning;
 
 namespace
@@ -14,10 +16,6 @@ TrainingConfig shippedConfig()
   return readTrainingConfig(*loadYamlParameters(CARTPOLE_CONFIG_DIR "/cartpole.yaml"));
 }
 
-bool bitIdentical(const std::vector<double>& a, const std::vector<double>& b)
-{
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
 }  // namespace
 
 TEST(HeadlessTrainer, DefaultConfigSolvesCartPoleOnSeedsZeroToNineInAMedianOfAtMost300Episodes)

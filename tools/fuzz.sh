@@ -7,7 +7,8 @@
 # usage: bash tools/fuzz.sh [SECONDS_EACH (default 60)] [RESULTS_DIR]
 #   RESULTS_DIR: also write one JUnit file per target there (for catkin_test_results).
 #   FUZZ_TARGETS: which targets (default "q_table config"); FUZZ_WORK: the work directory.
-# Prints per target: runs, seconds, corpus size and coverage, and exits 1 if any target found a
+# The core is compiled once for all targets and the targets run side by side. Prints per
+# target: runs, seconds, corpus size and coverage, and exits 1 if any target found a
 # crash (its reproducer is kept under the work directory it names).
 set -euo pipefail
 SECONDS_EACH=${1:-60}
@@ -21,21 +22,56 @@ mkdir -p "$WORK"
 
 # The core's sources, as CMakeLists.txt lists them for the core library.
 mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_core/,/^)/p' "$SRC/CMakeLists.txt" | grep -o 'src/[a-z_]*\.cpp')
-FLAGS=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
+COMPILE=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
   -I "$SRC/include" -isystem /usr/include/eigen3)
-status=0
-for target in ${FUZZ_TARGETS:-q_table config}; do
-  exe="$WORK/${target}_fuzzer"
-  echo "[fuzz] building $target (${#CORE[@]} core sources, ASan + UBSan)"
-  "$CXX" "${FLAGS[@]}" "$SRC/test/fuzz/${target}_fuzzer.cpp" "${CORE[@]/#/$SRC/}" -lyaml-cpp -o "$exe"
+# The core is compiled once, for every target (with coverage hooks: fuzzer-no-link), two sources at
+# a time; each target then compiles its own file and links with libFuzzer's main.
+OBJECTS="$WORK/core_objects"
+mkdir -p "$OBJECTS"
+echo "[fuzz] compiling ${#CORE[@]} core sources once (ASan + UBSan, coverage for libFuzzer)"
+SECONDS=0
+compile_one() { "$CXX" "${COMPILE[@]}" -fsanitize=fuzzer-no-link -c "$SRC/$1" -o "$OBJECTS/$(basename "$1" .cpp).o"; }
+running=0
+failed=0
+for source in "${CORE[@]}"; do
+  compile_one "$source" &
+  if ((++running >= $(nproc))); then
+    wait -n || failed=1
+    running=$((running - 1))
+  fi
+done
+while ((running > 0)); do
+  wait -n || failed=1
+  running=$((running - 1))
+done
+((failed == 0)) || { echo "fuzz.sh: the core does not compile with $CXX" >&2; exit 2; }
+echo "[fuzz] compiled in $SECONDS s"
+TARGETS=(${FUZZ_TARGETS:-q_table config})
+for target in "${TARGETS[@]}"; do
+  echo "[fuzz] building $target"
+  "$CXX" "${COMPILE[@]}" -fsanitize=fuzzer "$SRC/test/fuzz/${target}_fuzzer.cpp" "$OBJECTS"/*.o -lyaml-cpp \
+    -o "$WORK/${target}_fuzzer"
+done
+# The targets run side by side (each on one core, for the same bounded time); their exit statuses
+# are kept in files and read afterwards.
+echo "[fuzz] running ${TARGETS[*]} side by side for $SECONDS_EACH s (logs in $WORK)"
+for target in "${TARGETS[@]}"; do
   corpus="$WORK/corpus_$target"
   mkdir -p "$corpus"
   cp -n "$SRC/test/fuzz/corpus/$target/"* "$corpus/" 2>/dev/null || true
+  (
+    rc=0
+    cd "$WORK" && ASAN_OPTIONS=detect_leaks=1 "$WORK/${target}_fuzzer" -max_total_time="$SECONDS_EACH" \
+      -max_len=65536 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 "$corpus" >"$WORK/$target.log" 2>&1 || rc=$?
+    echo "$rc" >"$WORK/$target.status"
+  ) &
+done
+wait
+status=0
+for target in "${TARGETS[@]}"; do
+  corpus="$WORK/corpus_$target"
   log="$WORK/$target.log"
-  echo "[fuzz] running $target for $SECONDS_EACH s (log $log)"
-  rc=0
-  (cd "$WORK" && ASAN_OPTIONS=detect_leaks=1 "$exe" -max_total_time="$SECONDS_EACH" -max_len=65536 -timeout=10 \
-    -rss_limit_mb=2048 -print_final_stats=1 "$corpus" >"$log" 2>&1) || rc=$?
+  rc=$(cat "$WORK/$target.status" 2>/dev/null || echo 1)
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1 | grep -o '[0-9]*' || echo 0)
   files=$(find "$corpus" -type f | wc -l)
