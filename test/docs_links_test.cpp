@@ -102,7 +102,7 @@ std::vector<std::string> linksOf(const std::string& text)
   for (const std::string& raw : proseLines(text))
   {
     const std::string line = std::regex_replace(raw, code_span, "``");
-    for (const std::regex* pattern : { &inline_link, &html })
+    for (const std::regex* pattern : {&inline_link, &html})
       for (std::sregex_iterator it(line.begin(), line.end(), *pattern), end; it != end; ++it)
         links.push_back((*it)[1]);
     std::smatch m;
@@ -136,7 +136,7 @@ std::string brokenBecause(const fs::path& page, const std::string& target)
 
 std::vector<fs::path> pages()
 {
-  std::vector<fs::path> found{ kSource / "README.md" };
+  std::vector<fs::path> found{kSource / "README.md"};
   for (const fs::directory_entry& entry : fs::directory_iterator(kSource / "docs"))
     if (entry.is_regular_file() && entry.path().extension() == ".md")
       found.push_back(entry.path());
@@ -151,15 +151,15 @@ TEST(DocsLinksTest, AnchorsAreGitHubs)
   EXPECT_EQ(anchorOf("Robust tables: `config/robust.yaml`"), "robust-tables-configrobustyaml");
   EXPECT_EQ(anchorOf("See [Nodes](nodes.md) and snake_case"), "see-nodes-and-snake_case");
   const std::set<std::string> twice = anchorsOf("# Usage\n```\n# not a heading\n```\n## Usage\n### Usage ##\n");
-  EXPECT_EQ(twice, (std::set<std::string>{ "usage", "usage-1", "usage-2" }));
+  EXPECT_EQ(twice, (std::set<std::string>{"usage", "usage-1", "usage-2"}));
 }
 
 TEST(DocsLinksTest, LinksAreFoundWhereMarkdownHasThem)
 {
-  const std::vector<std::string> links =
-      linksOf("[a](a.md) and ![b](images/b.png \"title\") and `[c](c.md)`\n"
-              "```\n[d](d.md)\n```\n[e]: e.md\n<img src=\"f.png\" width=\"49%\"> [g](https://example.org)\n");
-  EXPECT_EQ(links, (std::vector<std::string>{ "a.md", "images/b.png", "e.md", "https://example.org", "f.png" }));
+  const std::vector<std::string> links = linksOf(
+      "[a](a.md) and ![b](images/b.png \"title\") and `[c](c.md)`\n"
+      "```\n[d](d.md)\n```\n[e]: e.md\n<img src=\"f.png\" width=\"49%\"> [g](https://example.org)\n");
+  EXPECT_EQ(links, (std::vector<std::string>{"a.md", "images/b.png", "e.md", "https://example.org", "f.png"}));
 }
 
 TEST(DocsLinksTest, ABrokenLinkIsCaught)
@@ -195,8 +195,8 @@ TEST(DocsLinksTest, EveryDocsPageLinksBackToTheReadme)
     if (page.filename() == "README.md")
       continue;
     const std::vector<std::string> links = linksOf(readText(page));
-    const bool back = std::any_of(links.begin(), links.end(),
-                                  [](const std::string& l) { return l.rfind("../README.md", 0) == 0; });
+    const bool back =
+        std::any_of(links.begin(), links.end(), [](const std::string& l) { return l.rfind("../README.md", 0) == 0; });
     EXPECT_TRUE(back) << fs::relative(page, kSource).string() << " has no link back to ../README.md";
   }
 }
