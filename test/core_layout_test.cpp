@@ -94,16 +94,17 @@ TEST(CoreLayoutTest, NoCoreFileIncludesAHeaderFromOutsideTheCore)
   EXPECT_GT(files, 40u) << "the core's files were not found under " << kSource;
 }
 
-// The names in backquotes in the README's Layout row that starts with `first_cell`, leaving out
-// paths and patterns (they name folders, not files). tools/readme_layout.py writes the table.
-std::set<std::string> layoutNames(const std::string& readme, const std::string& first_cell)
+// The names in backquotes in the Layout row (of docs/design.md) that starts with `first_cell`,
+// leaving out paths and patterns (they name folders, not files). tools/readme_layout.py writes
+// the table.
+std::set<std::string> layoutNames(const std::string& page, const std::string& first_cell)
 {
-  const std::size_t layout = readme.find("## Layout\n");
-  const std::size_t row = readme.find("\n| " + first_cell + " |", layout);
+  const std::size_t layout = page.find("## Layout\n");
+  const std::size_t row = page.find("\n| " + first_cell + " |", layout);
   std::set<std::string> names;
   if (layout == std::string::npos || row == std::string::npos)
     return names;
-  const std::string line = readme.substr(row + 1, readme.find('\n', row + 1) - row - 1);
+  const std::string line = page.substr(row + 1, page.find('\n', row + 1) - row - 1);
   const std::string cells = line.substr(first_cell.size() + 4);
   static const std::regex quoted("`([^`]+)`");
   for (std::sregex_iterator it(cells.begin(), cells.end(), quoted), end; it != end; ++it)
@@ -130,9 +131,9 @@ std::set<std::string> filesIn(const std::vector<fs::path>& folders, bool stems)
   return names;
 }
 
-TEST(CoreLayoutTest, TheReadmesLayoutListsTheTreeAsItIs)
+TEST(CoreLayoutTest, TheLayoutTableListsTheTreeAsItIs)
 {
-  const std::string readme = readText(kSource / "README.md");
+  const std::string design = readText(kSource / "docs" / "design.md");
   const fs::path include = kSource / "include" / "cartpole_qlearning";
   struct Row
   {
@@ -151,13 +152,13 @@ TEST(CoreLayoutTest, TheReadmesLayoutListsTheTreeAsItIs)
   };
   for (const Row& row : rows)
   {
-    const std::set<std::string> listed = layoutNames(readme, row.first_cell);
+    const std::set<std::string> listed = layoutNames(design, row.first_cell);
     const std::set<std::string> present = filesIn(row.folders, row.stems);
     for (const std::string& name : present)
-      EXPECT_EQ(listed.count(name), 1u) << name << " is in the tree but not in the README's Layout row "
+      EXPECT_EQ(listed.count(name), 1u) << name << " is in the tree but not in docs/design.md's Layout row "
                                         << row.first_cell;
     for (const std::string& name : listed)
-      EXPECT_EQ(present.count(name), 1u) << name << " is in the README's Layout row " << row.first_cell
+      EXPECT_EQ(present.count(name), 1u) << name << " is in docs/design.md's Layout row " << row.first_cell
                                          << " but not in the tree";
   }
 }

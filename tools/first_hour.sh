@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
-# A newcomer's first hour, as the README's own check: a fresh copy of this repository in a
-# fresh home (so ~/cartpole_ws and ~/.ros are new), a master of its own on a free port, and the
-# README's commands in the README's order, each checked for what the README says it does.
-# Every command is looked up verbatim in README.md before it runs: a README change that alters
-# a command fails here until the command is tried again. Commands not run are listed with why.
+# A newcomer's first hour, as the documentation's own check: a fresh copy of this repository in
+# a fresh home (so ~/cartpole_ws and ~/.ros are new), a master of its own on a free port, and the
+# commands of the README and the docs pages in the order a newcomer meets them, each checked for
+# what the text says it does. Every command is looked up verbatim before it runs, first in
+# README.md, then in docs/*.md in name order (docs/benchmarks.md, docs/configuration.md, ...);
+# found in any of them, it runs. A change to the README or a docs page that alters or drops a
+# command fails here until the command is tried again. Commands not run are listed with why.
 #
 # usage: bash tools/first_hour.sh [RESULTS_DIR]   (one JUnit case per command goes there)
 # Needs what scripts/setup.sh installs (the first command, scripts/train.sh, runs it).
 set -o pipefail
 SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-README="$SRC/README.md"
+# Where commands are looked up, in this order (see above).
+PAGES=("$SRC/README.md" "$SRC"/docs/*.md)
 RESULTS=${1:+$(realpath -m "$1")}
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/cartpole_first_hour.XXXXXX")
 LOGS="$WORK/logs"
@@ -60,9 +63,16 @@ record() {
   printf '[first-hour] %8.1f s  %s  %s\n' "$seconds" "${failure:+FAIL}${failure:+: $failure}${failure:-ok}" "$name"
 }
 
-in_readme() { grep -qF -- "$1" "$README"; }
+# in_docs TEXT: whether README.md or a docs page says TEXT word for word.
+in_docs() {
+  local page
+  for page in "${PAGES[@]}"; do
+    grep -qF -- "$1" "$page" && return 0
+  done
+  return 1
+}
 
-# run NAME TIMEOUT EXPECTED_STATUS COMMAND [PATTERN...]: COMMAND (as the README has it) must
+# run NAME TIMEOUT EXPECTED_STATUS COMMAND [PATTERN...]: COMMAND (as the pages have it) must
 # end with EXPECTED_STATUS (124: still running at TIMEOUT, for commands that never end) and
 # print every PATTERN (extended regex). Its output stays in $LOGS/NAME.log (shown on failure).
 LAST_LOG=""
@@ -71,8 +81,8 @@ run() {
   shift 4
   local log="$LOGS/$(printf '%s' "$name" | tr -c 'a-zA-Z0-9_.-' '_').log"
   LAST_LOG=$log
-  if ! in_readme "$command"; then
-    record "$name" 0 "the README no longer says: $command"
+  if ! in_docs "$command"; then
+    record "$name" 0 "the README and docs no longer say: $command"
     return 1
   fi
   local start end status
@@ -99,7 +109,7 @@ run() {
   return 0
 }
 
-# check NAME CONDITION_COMMAND: a claim of the README about the result of the commands before.
+# check NAME CONDITION_COMMAND: a claim of the pages about the result of the commands before.
 check() {
   local name=$1 condition=$2
   if bash -c "$condition" >/dev/null 2>&1; then
@@ -109,13 +119,13 @@ check() {
   fi
 }
 
-# start NAME COMMAND: a README command that runs until stopped (a launch), in the background.
+# start NAME COMMAND: a documented command that runs until stopped (a launch), in the background.
 start() {
   local name=$1 command=$2
   local log="$LOGS/$(printf '%s' "$name" | tr -c 'a-zA-Z0-9_.-' '_').log"
   LAST_LOG=$log
-  if ! in_readme "$command"; then
-    record "$name" 0 "the README no longer says: $command"
+  if ! in_docs "$command"; then
+    record "$name" 0 "the README and docs no longer say: $command"
     return 1
   fi
   setsid bash -c "exec $command" >"$log" 2>&1 </dev/null &
@@ -177,7 +187,7 @@ TABLES="$HOME/.ros/cartpole_qlearning/cartpole"
 run "scripts/train.sh" 1200 0 "bash scripts/train.sh" "ready: source" "SOLVED after" "ending the launch"
 check "train.sh saved ~/.ros/cartpole_qlearning/cartpole/q_table.yaml" "test -s '$TABLES/q_table.yaml'"
 check "train.sh ended without 'REQUIRED process has died'" "! grep -q 'REQUIRED process' '$LAST_LOG'"
-in_readme "source ~/cartpole_ws/devel/setup.bash" || record "source the workspace" 0 "the README no longer says it"
+in_docs "source ~/cartpole_ws/devel/setup.bash" || record "source the workspace" 0 "the README and docs no longer say it"
 # shellcheck disable=SC1090
 source "$HOME/cartpole_ws/devel/setup.bash"
 # Debian's python3 for the ROS tools, as the README's advice has it.
@@ -215,7 +225,7 @@ if start "train.launch stop_when_solved:=false" "roslaunch cartpole_qlearning tr
 fi
 cp "$WORK/solved.yaml" "$TABLES/q_table.yaml"
 
-# The README says the test executables come from catkin_make tests (test.sh runs every test).
+# docs/testing.md says the test executables come from catkin_make tests (test.sh runs every test).
 run "catkin_make tests" 1200 0 "cd ~/cartpole_ws && catkin_make tests -DCMAKE_BUILD_TYPE=Release" "Built target"
 run "rostest controller_train.test" 400 0 "rostest cartpole_qlearning controller_train.test" "RESULT: SUCCESS"
 run "rostest sim_lockstep.test" 400 0 "rostest cartpole_qlearning sim_lockstep.test" "RESULT: SUCCESS"
@@ -250,7 +260,7 @@ if start "sim.launch" "roslaunch cartpole_qlearning sim.launch"; then
   stop_launch "sim.launch ends on Ctrl-C" "$sim" "$sim_log"
 fi
 
-# RViz, by its picture: the README's picture made again here (Xvfb of its own: no display needed).
+# RViz, by its picture: the tutorial's picture made again here (Xvfb of its own: no display needed).
 run "rviz_screenshot" 120 0 "tools/rviz_screenshot --x 0.5 --theta 0.2 --out docs/images/rviz.png" \
   "wrote docs/images/rviz.png"
 

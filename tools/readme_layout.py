@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""Writes the README's Layout table from the tree: the core's modules, the ROS layer's files, the
-command line, the configuration files, the launch files, users' scripts and developers' tools,
-each listed as it is in its folder. test/core_layout_test.cpp fails when the table and the tree
-differ, so a new file means running this again:
+"""Writes the Layout table of docs/design.md (the README's docs index links it) from the tree: the
+core's modules, the ROS layer's files, the command line, the configuration files, the launch
+files, users' scripts and developers' tools, each listed as it is in its folder.
+test/core_layout_test.cpp fails when the table and the tree differ, so a new file means running
+this again:
 
-  tools/readme_layout.py          # rewrites README.md's Layout table in place
+  tools/readme_layout.py          # rewrites docs/design.md's Layout table in place
 """
 import os
 import sys
@@ -61,13 +62,13 @@ def table():
 
 
 def main():
-    readme = os.path.join(ROOT, "README.md")
-    text = open(readme).read()
+    page = os.path.join(ROOT, "docs", "design.md")
+    text = open(page).read()
     start = text.index("| folder | what is inside |", text.index("## Layout\n"))
     end = text.find("\n## ", start)
     end = len(text) if end < 0 else end + 1
     new = text[:start] + table() + ("\n" if end < len(text) else "") + text[end:]
-    open(readme, "w").write(new)
+    open(page, "w").write(new)
     return 0
 
 

@@ -1,0 +1,204 @@
+// Every relative link in README.md and docs/*.md leads somewhere: the file or folder exists and,
+// for a link with #anchor into a Markdown page, that page has a heading with that anchor. The
+// pages move text between one another; a link left pointing at where the text was fails here.
+// Anchors are made the way GitHub makes them, since that is where users read the pages.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+namespace fs = std::filesystem;
+
+const fs::path kSource = CARTPOLE_SOURCE_DIR;
+
+std::string readText(const fs::path& path)
+{
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The lines of a page outside fenced code blocks: a "[x](y)" or "# x" inside a block of
+// commands or output is not Markdown.
+std::vector<std::string> proseLines(const std::string& text)
+{
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  std::string line;
+  bool fenced = false;
+  while (std::getline(in, line))
+  {
+    const std::size_t first = line.find_first_not_of(' ');
+    if (first != std::string::npos && line.compare(first, 3, "```") == 0)
+    {
+      fenced = !fenced;
+      continue;
+    }
+    lines.push_back(fenced ? std::string() : line);
+  }
+  return lines;
+}
+
+// A heading's anchor as GitHub derives it: the text as rendered (code spans and link targets
+// dropped, their text kept), lower case, anything but letters, digits, '-', '_' and spaces
+// removed, spaces made '-'. Non-ASCII characters are dropped too: GitHub keeps non-ASCII
+// letters, which no heading here has; should one come, its links fail here rather than pass.
+std::string anchorOf(std::string heading)
+{
+  static const std::regex link(R"(!?\[([^\]]*)\]\([^)]*\))");
+  heading = std::regex_replace(heading, link, "$1");
+  std::string anchor;
+  for (const char c : heading)
+  {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x80)
+      continue;
+    if (std::isalnum(u) || c == '-' || c == '_')
+      anchor += static_cast<char>(std::tolower(u));
+    else if (c == ' ')
+      anchor += '-';
+  }
+  return anchor;
+}
+
+// Every anchor a page's headings give, with GitHub's -1, -2, ... for repeated headings.
+std::set<std::string> anchorsOf(const std::string& text)
+{
+  static const std::regex heading(R"(^#{1,6}\s+(.*?)\s*#*\s*$)");
+  std::set<std::string> anchors;
+  std::map<std::string, int> seen;
+  for (const std::string& line : proseLines(text))
+  {
+    std::smatch m;
+    if (!std::regex_match(line, m, heading))
+      continue;
+    const std::string anchor = anchorOf(m[1]);
+    const int n = seen[anchor]++;
+    anchors.insert(n == 0 ? anchor : anchor + "-" + std::to_string(n));
+  }
+  return anchors;
+}
+
+// The link targets of a page: Markdown links and images, reference definitions, and the src and
+// href of HTML tags. Code spans are left out first: `[a](b)` there is an example, not a link.
+std::vector<std::string> linksOf(const std::string& text)
+{
+  static const std::regex code_span("`[^`]*`");
+  static const std::regex inline_link(R"re(\]\(\s*<?([^)\s>]+)>?(?:\s+"[^"]*")?\s*\))re");
+  static const std::regex reference(R"(^\s*\[[^\]]+\]:\s*(\S+))");
+  static const std::regex html(R"re(\b(?:src|href)\s*=\s*"([^"]+)")re");
+  std::vector<std::string> links;
+  for (const std::string& raw : proseLines(text))
+  {
+    const std::string line = std::regex_replace(raw, code_span, "``");
+    for (const std::regex* pattern : {&inline_link, &html})
+      for (std::sregex_iterator it(line.begin(), line.end(), *pattern), end; it != end; ++it)
+        links.push_back((*it)[1]);
+    std::smatch m;
+    if (std::regex_search(line, m, reference))
+      links.push_back(m[1]);
+  }
+  return links;
+}
+
+bool isExternal(const std::string& target)
+{
+  static const std::regex scheme("^[a-zA-Z][a-zA-Z0-9+.-]*:");
+  return std::regex_search(target, scheme);
+}
+
+// What is wrong with one relative link of `page`, or "" when it leads somewhere.
+std::string brokenBecause(const fs::path& page, const std::string& target)
+{
+  const std::size_t hash = target.find('#');
+  const std::string path = target.substr(0, hash);
+  const std::string anchor = hash == std::string::npos ? "" : target.substr(hash + 1);
+  const fs::path file = path.empty() ? page : page.parent_path() / path;
+  if (!fs::exists(file))
+    return "no such file: " + fs::relative(file.lexically_normal(), kSource).string();
+  if (anchor.empty() || file.extension() != ".md")
+    return "";
+  if (anchorsOf(readText(file)).count(anchor) == 0)
+    return "no heading in " + fs::relative(file.lexically_normal(), kSource).string() + " gives #" + anchor;
+  return "";
+}
+
+std::vector<fs::path> pages()
+{
+  std::vector<fs::path> found{kSource / "README.md"};
+  for (const fs::directory_entry& entry : fs::directory_iterator(kSource / "docs"))
+    if (entry.is_regular_file() && entry.path().extension() == ".md")
+      found.push_back(entry.path());
+  std::sort(found.begin() + 1, found.end());
+  return found;
+}
+
+TEST(DocsLinksTest, AnchorsAreGitHubs)
+{
+  EXPECT_EQ(anchorOf("Tile coding: `learning/features: tiles`"), "tile-coding-learningfeatures-tiles");
+  EXPECT_EQ(anchorOf("The Q-learning tutorial's worked example"), "the-q-learning-tutorials-worked-example");
+  EXPECT_EQ(anchorOf("Robust tables: `config/robust.yaml`"), "robust-tables-configrobustyaml");
+  EXPECT_EQ(anchorOf("See [Nodes](nodes.md) and snake_case"), "see-nodes-and-snake_case");
+  const std::set<std::string> twice = anchorsOf("# Usage\n```\n# not a heading\n```\n## Usage\n### Usage ##\n");
+  EXPECT_EQ(twice, (std::set<std::string>{"usage", "usage-1", "usage-2"}));
+}
+
+TEST(DocsLinksTest, LinksAreFoundWhereMarkdownHasThem)
+{
+  const std::vector<std::string> links = linksOf(
+      "[a](a.md) and ![b](images/b.png \"title\") and `[c](c.md)`\n"
+      "```\n[d](d.md)\n```\n[e]: e.md\n<img src=\"f.png\" width=\"49%\"> [g](https://example.org)\n");
+  EXPECT_EQ(links, (std::vector<std::string>{"a.md", "images/b.png", "e.md", "https://example.org", "f.png"}));
+}
+
+TEST(DocsLinksTest, ABrokenLinkIsCaught)
+{
+  const fs::path readme = kSource / "README.md";
+  EXPECT_EQ(brokenBecause(readme, "docs/no_such_page.md"), "no such file: docs/no_such_page.md");
+  EXPECT_EQ(brokenBecause(readme, "#no-such-heading"), "no heading in README.md gives #no-such-heading");
+  EXPECT_EQ(brokenBecause(readme, "#documentation"), "");
+}
+
+TEST(DocsLinksTest, EveryRelativeLinkInTheReadmeAndDocsLeadsSomewhere)
+{
+  std::size_t checked = 0;
+  for (const fs::path& page : pages())
+  {
+    for (const std::string& target : linksOf(readText(page)))
+    {
+      if (isExternal(target))
+        continue;
+      ++checked;
+      const std::string why = brokenBecause(page, target);
+      EXPECT_EQ(why, "") << fs::relative(page, kSource).string() << " links to " << target;
+    }
+  }
+  // The README's index alone links to every page: far fewer means the links were not read.
+  EXPECT_GT(checked, 30u) << "links found in README.md and docs/*.md";
+}
+
+TEST(DocsLinksTest, EveryDocsPageLinksBackToTheReadme)
+{
+  for (const fs::path& page : pages())
+  {
+    if (page.filename() == "README.md")
+      continue;
+    const std::vector<std::string> links = linksOf(readText(page));
+    const bool back =
+        std::any_of(links.begin(), links.end(), [](const std::string& l) { return l.rfind("../README.md", 0) == 0; });
+    EXPECT_TRUE(back) << fs::relative(page, kSource).string() << " has no link back to ../README.md";
+  }
+}
+
+}  // namespace
