@@ -173,6 +173,8 @@ class NodesDiagramTest(unittest.TestCase):
         self.assertTrue({"~reset", "~reset_simulation"} <= set(services["cartpole_sim"]), services)
         self.assertTrue({"~save_q_table", "~load_q_table", "~set_parameters"} <= set(services["qlearning_controller"]),
                         services)
+        # The master knows no service clients: the reset call comes from the controller's parameter.
+        self.assertEqual([("qlearning_controller", "~reset", "cartpole_sim")], self.graph.calls)
 
     def test_every_topic_and_service_of_the_run_is_on_the_nodes_page(self):
         with open(os.path.join(PACKAGE_DIR, "docs", "nodes.md")) as f:
@@ -188,6 +190,9 @@ class NodesDiagramTest(unittest.TestCase):
                     # dynamic_reconfigure's own topics go with ~set_parameters, said once there.
                     if node in nodes and "`%s`" % topic not in documented and not topic.startswith(node + "/parameter_"):
                         missing.append("%s: %s %s" % (node, heading.lower(), topic))
+        for caller, service, server in self.graph.calls:
+            if "`%s/%s`" % (server, service.lstrip("~")) not in page_section(text, caller, "Services Called"):
+                missing.append("%s: services called %s/%s" % (caller, server, service.lstrip("~")))
         self.assertEqual([], missing, "docs/nodes.md lacks what the running graph has")
 
     def test_the_diagram_is_drawn(self):
