@@ -223,6 +223,8 @@ int printPolicy(const std::string& table_path, const std::string& table_dir, std
       throw std::invalid_argument("give two dimensions, e.g. theta,theta_dot");
     params.x_dimension = stateDimension(axes.substr(0, comma));
     params.y_dimension = stateDimension(axes.substr(comma + 1));
+    if (params.x_dimension == params.y_dimension)
+      throw std::invalid_argument("the two axes must be two different dimensions");
   }
   catch (const std::invalid_argument& e)
   {
