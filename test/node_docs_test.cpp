@@ -5,7 +5,6 @@
 // is gone, fails here with the names.
 #include "cartpole_qlearning/node_settings.h"
 
-
 #include <gtest/gtest.h>
 
 #include <fstream>
