@@ -6,8 +6,8 @@ plot_policy draws each; both actions' colours fill the share of the policy panel
 train_headless --policy says they hold, the value panel is a ramp of colours, and the same table
 gives the same bytes: those of docs/images/ on the matplotlib that made them. The nodes diagram:
 tools/nodes_diagram reads train.launch's graph from its master; the sim and the controller are
-wired as DESIGN.md says, every topic and service of the running graph is on docs/nodes.md, and
-the PNG shows boxes for them.
+wired as DESIGN.md says; every topic and service of the running graph, and every private
+parameter the nodes have on the master, is on docs/nodes.md; and the PNG shows boxes for them.
 """
 import os
 import re
@@ -208,6 +208,17 @@ class NodesDiagramTest(unittest.TestCase):
             if "`%s/%s`" % (server, service.lstrip("~")) not in page_section(text, caller, "Services Called"):
                 missing.append("%s: services called %s/%s" % (caller, server, service.lstrip("~")))
         self.assertEqual([], missing, "docs/nodes.md lacks what the running graph has")
+
+    def test_every_private_parameter_on_the_master_is_on_the_nodes_page(self):
+        # What train.launch and the nodes themselves (dynamic_reconfigure, ~run/...) put there.
+        with open(os.path.join(PACKAGE_DIR, "docs", "nodes.md")) as f:
+            text = f.read()
+        self.assertIn("gamma", self.graph.parameters["qlearning_controller"], "the live-tuning fields were not read")
+        missing = []
+        for node, names in self.graph.parameters.items():
+            documented = page_section(text, node, "Parameters") + page_section(text, node, "Dynamic reconfigure")
+            missing += ["%s: ~%s" % (node, name) for name in names if "- `~%s` (" % name not in documented]
+        self.assertEqual([], missing, "docs/nodes.md lacks parameters the running nodes have")
 
     def test_the_diagram_is_drawn(self):
         out = os.path.join(self.work, "nodes.png")
