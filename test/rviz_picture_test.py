@@ -5,7 +5,9 @@ show a drawn 3D view, the pole's colour, and the pole leaning the way theta says
 lean comes from the geometry alone: the URDF's pole joint axis and pole length, and the Orbit
 view of rviz/cartpole.rviz, projected; and, apart from them, the package's convention (theta > 0
 toward +x, +x drawn to the right), so a sim whose TF turns the pole the wrong way, a URDF axis
-flipped, or a camera looking from behind all fail here."""
+flipped, or a camera looking from behind all fail here. The pictures written are cropped to the
+cart-pole and marked (+x, theta), as docs/images/rviz.png is: the robot must fill a good share
+of them, with both marks drawn."""
 import math
 import os
 import sys
@@ -14,8 +16,10 @@ import xml.etree.ElementTree as ElementTree
 from importlib.machinery import SourceFileLoader
 from importlib.util import module_from_spec, spec_from_loader
 
+import numpy
 import rospkg
 import rostest
+from PIL import Image
 
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -72,6 +76,25 @@ class RvizPictureTest(unittest.TestCase):
                          "theta %+.1f should lean the pole's top to the %s" % (theta, "right" if theta > 0 else "left")
                          + where)
         self.assertTrue(complete, "RViz's picture was not steady with the pole in it" + where)
+        self.check_crop(out, where)
+
+    def check_crop(self, out, where):
+        # The written picture: the cart-pole, enlarged, not a window with a small robot in it.
+        with Image.open(out) as image:
+            picture = image.convert("RGB")
+        found = screenshot.robot_box(picture, self.config, self.urdf)
+        self.assertIsNotNone(found, "no pole in the cropped picture" + where)
+        (left, top, right, bottom), _ = found
+        width, height = picture.size
+        # The whole window has the robot in about 5 % of its rows x 4 %; cropped, the pole and cart
+        # span more than half the height and a tenth of the area.
+        self.assertGreater((bottom - top) / height, 0.5, "the cart-pole spans too little of the picture" + where)
+        self.assertGreater((right - left) * (bottom - top) / (width * height), 0.08,
+                           "the cart-pole fills too little of the picture" + where)
+        pixels = numpy.asarray(picture)
+        for colour, mark in ((screenshot.THETA_COLOUR, "theta"), (screenshot.MARK_COLOUR, "+x")):
+            count = int(numpy.all(pixels == numpy.array(colour), axis=2).sum())
+            self.assertGreater(count, 100, "the %s mark is not drawn" % mark + where)
 
     def test_the_model_and_the_view_keep_the_packages_convention(self):
         # DESIGN: theta > 0 leans the pole toward +x; the README's view shows +x to the right.

@@ -2,6 +2,7 @@
 // and what it writes (run folders, checkpoints, the default table) under $ROS_HOME, which every
 // test points to a folder of its own.
 #include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/policy_grid.h"
 #include "cartpole_qlearning/q_table_file.h"
 #include "cartpole_qlearning/robustness_suite.h"
 #include "cartpole_qlearning/training_run.h"
@@ -786,4 +787,44 @@ TEST_F(TrainHeadlessTest, TraceWhileTrainingHoldsItsArithmeticWithATableAtEachEp
   // Without --trace, no trace.
   const CommandRun quiet = trainHeadless(tutorialConfig() + " --seed 3 --max-episodes 6");
   EXPECT_TRUE(TraceReading(quiet.output, kTutorialNames).updates.empty()) << quiet.output;
+}
+
+TEST_F(TrainHeadlessTest, PolicyPrintsTheTablesGreedyActionOnAGridAsTheCoreComputesIt)
+{
+  ASSERT_EQ(0, trainHeadless(config() + " --seed 0 --quiet --no-run-folder --save trained.yaml").status);
+  const std::string table_path = (tables() / "trained.yaml").string();
+  const auto before = written();
+  // A relative table is under the table folder, as for --evaluate; the other dimensions at a slice.
+  const CommandRun run = trainHeadless("--policy trained.yaml --grid 11 --axes theta,theta_dot --at x=0.5,x_dot=-1");
+  ASSERT_EQ(0, run.status) << run.output;
+  cartpole_qlearning::PolicyGridParams params;
+  params.points = 11;
+  params.slice = cartpole_qlearning::CartPoleState(0.5, -1.0, 0.0, 0.0);
+  const cartpole_qlearning::QTable table = cartpole_qlearning::loadQTableFile(table_path);
+  EXPECT_EQ(cartpole_qlearning::policyGridCsv(cartpole_qlearning::policyGrid(table, params), table), run.output);
+  EXPECT_NE(std::string::npos, run.output.find("# slice: x=0.5 x_dot=-1\n")) << run.output;
+  EXPECT_EQ(before, written()) << "a policy writes nothing";
+  // The default grid: 101 x 101 points after the header.
+  const CommandRun by_default = trainHeadless("--policy " + table_path);
+  ASSERT_EQ(0, by_default.status);
+  EXPECT_EQ(7 + 101 * 101, std::count(by_default.output.begin(), by_default.output.end(), '\n'));
+
+  const std::vector<std::pair<std::string, std::string>> refused{
+      {"--policy trained.yaml --grid 1", "--grid 1 is not allowed"},
+      {"--policy trained.yaml --axes theta", "--axes theta is not allowed"},
+      {"--policy trained.yaml --axes theta,theta", "--axes theta,theta is not allowed"},
+      {"--policy trained.yaml --at omega=1", "--at omega=1 is not allowed"},
+      {"--policy trained.yaml --at theta=0.1", "--at theta=0.1 is not allowed (theta is an axis)"},
+      {"--policy trained.yaml --at x=fast", "--at x=fast is not allowed"},
+      {"--policy trained.yaml --previous 5", "--previous 5 is not allowed"},
+      {"--policy trained.yaml --seed 3", "--seed with --policy"},
+      {"--grid 11", "--grid, --axes, --at and --previous: draw a table's policy"},
+      {"--policy missing.yaml", "--policy missing.yaml: "},
+  };
+  for (const auto& c : refused)
+  {
+    const CommandRun bad = trainHeadless(c.first);
+    EXPECT_EQ(2, bad.status) << c.first << ": " << bad.output;
+    EXPECT_NE(std::string::npos, bad.output.find("train_headless: " + c.second)) << c.first << ": " << bad.output;
+  }
 }

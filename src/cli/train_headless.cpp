@@ -4,8 +4,10 @@
 // Training ends with one line "solved=true|false episodes=N steps=M wall_s=T", an evaluation
 // with "evaluated=N balanced=M mean_return=R", a robustness suite (--evaluate TABLE --suite FILE)
 // with "suite=PASSED|FAILED cases=N passed=K worst=M/E". With --replay it learns from the transitions of a
-// file instead (the tutorial's worked example), tracing each update.
+// file instead (the tutorial's worked example), tracing each update. --policy TABLE prints the
+// table's greedy policy over a grid of states as CSV (scripts/plot_policy draws it).
 #include "cartpole_qlearning/headless_trainer.h"
+#include "cartpole_qlearning/policy_grid.h"
 #include "cartpole_qlearning/q_table_file.h"
 #include "cartpole_qlearning/robustness_suite.h"
 #include "cartpole_qlearning/run_application.h"
@@ -44,6 +46,8 @@ void usage(std::ostream& out)
          "       train_headless --evaluate TABLE [--episodes N] [--config FILE] [--seed N] [--robots N] [--ns NS]\n"
          "       train_headless --evaluate TABLE --suite FILE [--config FILE] [--seed N] [--ns NS] [--quiet]\n"
          "       train_headless --replay FILE [--config FILE] [--seed N] [--save PATH]\n"
+         "       train_headless --policy TABLE [--grid N] [--axes X,Y] [--at NAME=V,...] [--previous none|A] [--ns "
+         "NS]\n"
          "Trains as train.launch's controller does, with the core alone (no ROS master), writes what it writes and\n"
          "prints what it logs. Training ends with \"solved=true|false episodes=N steps=M wall_s=T\" (N and M count\n"
          "a loaded or resumed table's own), an evaluation with \"evaluated=N balanced=M mean_return=R\".\n"
@@ -93,6 +97,16 @@ void usage(std::ostream& out)
          "                       reward, next state], states named as the config's learning/state_names), traced\n"
          "                       as --trace does; --save writes its table; e.g. --config\n"
          "                       config/tutorial_4_states.yaml --replay config/tutorial_10_steps.yaml\n"
+         "  --policy TABLE       print TABLE's greedy policy as CSV: on an N x N grid over two state dimensions\n"
+         "                       (the table's bounds), the action the controller takes and max_a Q, found by the\n"
+         "                       table's own features (for rosrun cartpole_qlearning plot_policy); learns and\n"
+         "                       writes nothing\n"
+         "  --grid N             with --policy: points per axis, in [2, 1000] (default 101)\n"
+         "  --axes X,Y           with --policy: the two dimensions among x, x_dot, theta, theta_dot (default\n"
+         "                       theta,theta_dot)\n"
+         "  --at NAME=V,...      with --policy: the values of the other dimensions (default 0)\n"
+         "  --previous none|A    with --policy, for a table that sees its previous action: none (an episode's\n"
+         "                       first state, the default) or the index of the action taken last\n"
          "Ctrl-C (SIGINT) or SIGTERM saves the table into the run's folder, as the controller does when stopped,\n"
          "and exits with 128 + the signal's number. Exit 1: a table could not be saved; 2: a bad argument, config,\n"
          "table or folder (the message names it).\n";
@@ -194,6 +208,87 @@ int runSuite(const cartpole_qlearning::TrainingConfig& config, const std::string
               static_cast<unsigned long long>(suite.episodes));
   return 0;
 }
+// --policy TABLE: the table's greedy policy over a grid, as CSV on stdout. Exit 2 on a table that
+// cannot be read or a bad grid, the message naming what.
+int printPolicy(const std::string& table_path, const std::string& table_dir, std::uint64_t points,
+                const std::string& axes, const std::string& at, const std::string& previous)
+{
+  using namespace cartpole_qlearning;
+  PolicyGridParams params;
+  params.points = points;
+  try
+  {
+    const std::size_t comma = axes.find(',');
+    if (comma == std::string::npos)
+      throw std::invalid_argument("give two dimensions, e.g. theta,theta_dot");
+    params.x_dimension = stateDimension(axes.substr(0, comma));
+    params.y_dimension = stateDimension(axes.substr(comma + 1));
+    if (params.x_dimension == params.y_dimension)
+      throw std::invalid_argument("the two axes must be two different dimensions");
+  }
+  catch (const std::invalid_argument& e)
+  {
+    std::cerr << "train_headless: --axes " << axes << " is not allowed (" << e.what() << ")\n";
+    return 2;
+  }
+  std::string rest = at;
+  while (!rest.empty())
+  {
+    const std::string item = rest.substr(0, rest.find(','));
+    rest = item.size() < rest.size() ? rest.substr(item.size() + 1) : std::string();
+    const std::size_t equals = item.find('=');
+    try
+    {
+      if (equals == std::string::npos)
+        throw std::invalid_argument("give NAME=VALUE, e.g. x=0.5");
+      const std::size_t d = stateDimension(item.substr(0, equals));
+      if (d == params.x_dimension || d == params.y_dimension)
+        throw std::invalid_argument(item.substr(0, equals) + " is an axis");
+      std::size_t used = 0;
+      const std::string value = item.substr(equals + 1);
+      params.slice[d] = std::stod(value, &used);
+      if (used != value.size())
+        throw std::invalid_argument("not a number: " + value);
+    }
+    catch (const std::logic_error& e)  // invalid_argument, out_of_range
+    {
+      std::cerr << "train_headless: --at " << at << " is not allowed (" << e.what() << ")\n";
+      return 2;
+    }
+  }
+  QTable table;
+  try
+  {
+    table = table_path.front() == '/' ? loadQTableFile(table_path) : loadQTableUnder(table_dir, table_path);
+  }
+  catch (const FileError& e)
+  {
+    std::cerr << "train_headless: --policy " << table_path << ": " << e.what() << "\n";
+    return 2;
+  }
+  if (previous != "none")
+  {
+    std::uint64_t index = 0;
+    if (!parseCount(previous, index) || index >= table.actionCount())
+    {
+      std::cerr << "train_headless: --previous " << previous << " is not allowed (none, or an action index below "
+                << table.actionCount() << ")\n";
+      return 2;
+    }
+    params.previous = index + 1;
+  }
+  try
+  {
+    const PolicyGrid grid = policyGrid(table, params);
+    std::fputs(policyGridCsv(grid, table).c_str(), stdout);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    std::cerr << "train_headless: --policy " << table_path << ": " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}
 }  // namespace
 
 int run(int argc, char** argv)
@@ -220,6 +315,12 @@ int run(int argc, char** argv)
   bool print_returns = false;
   bool trace = false;
   std::string replay_path;
+  std::string policy_path;
+  std::uint64_t grid_points = cartpole_qlearning::PolicyGridParams().points;
+  std::string axes = "theta,theta_dot";
+  std::string policy_at;
+  std::string previous = "none";
+  bool policy_options = false;
   // A value argument: its text, or a refusal that names it.
   const auto refuse = [](const std::string& arg, const std::string& value, const std::string& allowed) {
     std::cerr << "train_headless: " << arg << " " << value << " is not allowed (" << allowed << ")\n";
@@ -244,6 +345,30 @@ int run(int argc, char** argv)
       no_run_folder = true;
     else if (arg == "--replay" && has_value)
       replay_path = argv[++i];
+    else if (arg == "--policy" && has_value)
+      policy_path = argv[++i];
+    else if (arg == "--axes" && has_value)
+    {
+      policy_options = true;
+      axes = argv[++i];
+    }
+    else if (arg == "--at" && has_value)
+    {
+      policy_options = true;
+      policy_at = argv[++i];
+    }
+    else if (arg == "--previous" && has_value)
+    {
+      policy_options = true;
+      previous = argv[++i];
+    }
+    else if (arg == "--grid" && has_value)
+    {
+      policy_options = true;
+      if (!parseCount(argv[++i], grid_points) || grid_points < 2 ||
+          grid_points > cartpole_qlearning::kMaxPolicyGridPoints)
+        return refuse(arg, argv[i], "must be a whole number in [2, 1000]");
+    }
     else if (arg == "--config" && has_value)
       config_path = argv[++i];
     else if (arg == "--save" && has_value)
@@ -308,6 +433,23 @@ int run(int argc, char** argv)
     std::cerr << "train_headless: " << what << ": " << why << "\n";
     return 2;
   };
+  if (policy_options && policy_path.empty())
+    return conflict("--grid, --axes, --at and --previous", "draw a table's policy: give them with --policy TABLE");
+  if (!policy_path.empty())
+  {
+    // A policy is read from the table alone (the file says its features and actions): nothing to
+    // train, evaluate or configure.
+    for (int i = 1; i < argc; ++i)
+    {
+      const std::string arg = argv[i];
+      if (arg == "--policy" || arg == "--grid" || arg == "--axes" || arg == "--at" || arg == "--previous" ||
+          arg == "--ns")
+        ++i;
+      else
+        return conflict(arg + " with --policy", "a policy is drawn from the table alone (its file says its features)");
+    }
+    return printPolicy(policy_path, defaultTableDirectory(name_space), grid_points, axes, policy_at, previous);
+  }
   if (!load_path.empty() && !resume_folder.empty())
     return conflict("--load and --resume", "give one: --resume goes on from a run's own checkpoint");
   if (episodes_given && !evaluating)
