@@ -395,6 +395,7 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
   if (!source.keysUnder("publish_period").empty() &&
       !(settings.publish_period >= 1e-6 && settings.publish_period <= 1.0))
     priv.fail("publish_period", SectionReader::numberText(settings.publish_period), "must be in [1e-06, 1] s");
+  priv.read("group_effort_index", settings.group_effort_index, 0);
   std::int64_t turns = 0;
   priv.read("pole_turns", turns);
   if (turns < -1000 || turns > 1000)

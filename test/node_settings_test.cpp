@@ -566,6 +566,10 @@ TEST(SimSettings, PosesAtAnotherStateRateAndEffortSign)
   EXPECT_SAYS(simError("publish_period: 2"), "publish_period = 2 is not allowed (must be in [1e-06, 1] s)");
   EXPECT_SAYS(simError("publish_period: .nan"), "publish_period = nan is not allowed");
   EXPECT_SAYS(simError("effort_sign: 2"), "effort_sign = 2 is not allowed (must be 1 or -1)");
+  EXPECT_EQ(0u, d.group_effort_index);
+  EXPECT_EQ(2u, readSim("group_effort_index: 2").group_effort_index);
+  EXPECT_SAYS(simError("group_effort_index: -1"),
+              "group_effort_index = -1 is not allowed (must be a whole number >= 0)");
 }
 
 TEST(ControllerSettings, TheStartLineSaysWhatTheControllerDoes)

@@ -122,6 +122,9 @@ struct SimSettings
   // [s] ~publish_period: joint_states every this much sim time (physics/tau by default); the physics
   // still steps every tau (SampledPhysics).
   double publish_period = 0.02;
+  // ~group_effort_index: the cart's slot in the std_msgs/Float64MultiArray commands on group_effort
+  // (a JointGroupEffortController's).
+  std::uint64_t group_effort_index = 0;
   int pole_turns = 0;
   bool publish_velocities = true;
 };

@@ -55,6 +55,8 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
                                       ros::TransportHints().tcpNoDelay());
   effort_sub_ =
       command_nh.subscribe("cart_effort", 10, &CartPoleSimNode::onEffort, this, ros::TransportHints().tcpNoDelay());
+  group_effort_sub_ = command_nh.subscribe("group_effort", 10, &CartPoleSimNode::onGroupEffort, this,
+                                           ros::TransportHints().tcpNoDelay());
   reset_srv_ = pnh_.advertiseService("reset", &CartPoleSimNode::onReset, this);
   reset_simulation_srv_ = pnh_.advertiseService("reset_simulation", &CartPoleSimNode::onResetSimulation, this);
 
@@ -153,8 +155,26 @@ void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
 void CartPoleSimNode::onEffort(const std_msgs::Float64ConstPtr& msg)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
+  onUnstampedEffort(msg->data);
+}
+
+void CartPoleSimNode::onGroupEffort(const std_msgs::Float64MultiArrayConstPtr& msg)
+{
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (msg->data.size() <= settings_.group_effort_index)
+  {
+    if (bad_command_warning_.ready())
+      ROS_WARN_NAMED("cartpole_sim", "cartpole_sim: dropped a group_effort of %zu values: the cart's is at index %llu",
+                     msg->data.size(), static_cast<unsigned long long>(settings_.group_effort_index));
+    return;
+  }
+  onUnstampedEffort(msg->data[settings_.group_effort_index]);
+}
+
+void CartPoleSimNode::onUnstampedEffort(double requested)
+{
   double effort = 0.0;
-  if (!acceptEffort(msg->data, effort))
+  if (!acceptEffort(requested, effort))
     return;
   const WallClock::time_point now = WallClock::now();
   if (settings_.mode == SimMode::Realtime)

@@ -15,6 +15,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <std_msgs/Float64.h>
+#include <std_msgs/Float64MultiArray.h>
 #include <std_srvs/Empty.h>
 #include <tf2_ros/transform_broadcaster.h>
 
@@ -37,6 +38,10 @@ private:
   void readParameters();
   void onJointCommand(const sensor_msgs::JointStateConstPtr& msg);
   void onEffort(const std_msgs::Float64ConstPtr& msg);
+  // group_effort (std_msgs/Float64MultiArray, unstamped, as a JointGroupEffortController takes it): the slot
+  // ~group_effort_index is the cart's.
+  void onGroupEffort(const std_msgs::Float64MultiArrayConstPtr& msg);
+  void onUnstampedEffort(double requested);
   bool onReset(Reset::Request& request, Reset::Response& response);
   // ~reset_simulation (std_srvs/Empty), posing as Gazebo: a random start; in lockstep, time set
   // back to the first tick.
@@ -98,6 +103,7 @@ private:
   ros::Publisher clock_pub_;
   ros::Subscriber command_sub_;
   ros::Subscriber effort_sub_;
+  ros::Subscriber group_effort_sub_;
   ros::ServiceServer reset_srv_;
   ros::ServiceServer reset_simulation_srv_;
   ros::SteadyTimer timer_;
