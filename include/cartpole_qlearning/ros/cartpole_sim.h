@@ -1,8 +1,9 @@
 // cartpole_sim: the core's cart-pole as a ROS robot. Publishes joint_states and TF, takes
 // joint_command (stamped), cart_effort and group_effort (unstamped), serves ~reset and
 // ~reset_simulation, and in lockstep mode can drive /clock. It can pose as another cart-pole
-// (SimSettings::pose: names, offsets, signs, another joint_states rate). What a command means in lockstep is the core's SimProtocol's decision;
-// this class translates messages and services into its calls.
+// (SimSettings::pose: names, offsets, signs, another joint_states rate). What a command means in
+// lockstep is the core's SimProtocol's decision; this class translates messages and services
+// into its calls.
 #pragma once
 
 #include "cartpole_qlearning/Reset.h"
