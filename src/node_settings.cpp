@@ -388,6 +388,14 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
   readFinite(priv, "pole_upright", pose.pole_upright);
   readSign(priv, "cart_sign", pose.cart_sign);
   readSign(priv, "pole_angle_sign", pose.pole_angle_sign);
+  readSign(priv, "effort_sign", pose.effort_sign);
+  settings.publish_period = settings.physics.tau;
+  priv.read("publish_period", settings.publish_period);
+  // A stamp step of at least a microsecond; a second apart is no joint_states stream to pose as.
+  if (!source.keysUnder("publish_period").empty() &&
+      !(settings.publish_period >= 1e-6 && settings.publish_period <= 1.0))
+    priv.fail("publish_period", SectionReader::numberText(settings.publish_period), "must be in [1e-06, 1] s");
+  priv.read("group_effort_index", settings.group_effort_index, 0);
   std::int64_t turns = 0;
   priv.read("pole_turns", turns);
   if (turns < -1000 || turns > 1000)

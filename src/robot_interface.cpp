@@ -85,4 +85,19 @@ DecisionClock::Verdict DecisionClock::onState(Stamp stamp)
   return verdict;
 }
 
+SampledPhysics::SampledPhysics(Stamp tau, Stamp period) : tau_(tau), period_(period) {}
+
+void SampledPhysics::restart(Stamp stamp)
+{
+  next_step_ = stamp;
+}
+
+std::uint64_t SampledPhysics::stepsAfter(Stamp stamp)
+{
+  std::uint64_t steps = 0;
+  for (; next_step_ < stamp + period_; next_step_ += tau_)
+    ++steps;
+  return steps;
+}
+
 }  // namespace cartpole_qlearning

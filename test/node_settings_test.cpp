@@ -553,6 +553,25 @@ TEST(SimSettings, PosesAsAnotherCartPole)
   EXPECT_SAYS(simError("cart_sign: 0"), "cart_sign = 0 is not allowed (must be 1 or -1)");
 }
 
+TEST(SimSettings, PosesAtAnotherStateRateAndEffortSign)
+{
+  const SimSettings d = readSim("", "physics: {tau: 0.01}");
+  EXPECT_EQ(0.01, d.publish_period);  // physics/tau
+  EXPECT_EQ(1.0, d.pose.effort_sign);
+  const SimSettings s = readSim("{publish_period: 0.0333333333, effort_sign: -1}");
+  EXPECT_EQ(0.0333333333, s.publish_period);
+  EXPECT_EQ(0.02, s.physics.tau);
+  EXPECT_EQ(-1.0, s.pose.effort_sign);
+  EXPECT_SAYS(simError("publish_period: 0"), "publish_period = 0 is not allowed (must be in [1e-06, 1] s)");
+  EXPECT_SAYS(simError("publish_period: 2"), "publish_period = 2 is not allowed (must be in [1e-06, 1] s)");
+  EXPECT_SAYS(simError("publish_period: .nan"), "publish_period = nan is not allowed");
+  EXPECT_SAYS(simError("effort_sign: 2"), "effort_sign = 2 is not allowed (must be 1 or -1)");
+  EXPECT_EQ(0u, d.group_effort_index);
+  EXPECT_EQ(2u, readSim("group_effort_index: 2").group_effort_index);
+  EXPECT_SAYS(simError("group_effort_index: -1"),
+              "group_effort_index = -1 is not allowed (must be a whole number >= 0)");
+}
+
 TEST(ControllerSettings, TheStartLineSaysWhatTheControllerDoes)
 {
   const ControllerSettings s = readController("");

@@ -162,3 +162,55 @@ TEST(RobotReadings, WhatTheSimPublishesPosingAsARobotMapsBackToItsState)
     EXPECT_NEAR(state[i], back[i], 1e-9) << i;
   EXPECT_FALSE(robotReadings(params, state, 0, false).cart_velocity.has_value());
 }
+
+// The sim posing at another joint_states rate: 100 Hz samples of 50 Hz physics (gym-gazebo's rate).
+TEST(SampledPhysics, SamplesTwiceAsFastAsTheStepsWaitOnlyForTheStatesWhoseAnswerDrivesAStep)
+{
+  SampledPhysics physics(20 * kMs, 10 * kMs);
+  physics.restart(10 * kMs);  // a start state at 10 ms
+  EXPECT_TRUE(physics.answerDrivesAStep(10 * kMs));
+  EXPECT_EQ(1u, physics.stepsAfter(10 * kMs));
+  // The state at 20 ms still shows the start: the step ends at 30 ms.
+  EXPECT_TRUE(physics.showsBeforeLastStep(20 * kMs));
+  EXPECT_FALSE(physics.answerDrivesAStep(20 * kMs));
+  EXPECT_EQ(0u, physics.stepsAfter(20 * kMs));
+  EXPECT_FALSE(physics.showsBeforeLastStep(30 * kMs));
+  EXPECT_TRUE(physics.answerDrivesAStep(30 * kMs));
+  EXPECT_EQ(1u, physics.stepsAfter(30 * kMs));
+  // A reset between two steps starts the physics anew at its stamp.
+  physics.restart(40 * kMs);
+  EXPECT_FALSE(physics.showsBeforeLastStep(40 * kMs));
+  EXPECT_TRUE(physics.answerDrivesAStep(40 * kMs));
+}
+
+TEST(SampledPhysics, ThirtyHzSamplesOfFiftyHzPhysicsTakeOneOrTwoStepsAndNeverShowTheFuture)
+{
+  const Stamp period = 33333333;  // 30 Hz (openai_ros' joint_state_controller)
+  SampledPhysics physics(20 * kMs, period);
+  physics.restart(period);
+  std::uint64_t steps = 0;
+  Stamp physics_time = period;  // the time of the physics state after the steps so far
+  for (Stamp stamp = period; stamp < 100 * period; stamp += period)
+  {
+    ASSERT_TRUE(physics.answerDrivesAStep(stamp));  // a step starts in every 33 ms
+    const std::uint64_t n = physics.stepsAfter(stamp);
+    EXPECT_TRUE(n == 1 || n == 2) << n;
+    steps += n;
+    physics_time += n * 20 * kMs;
+    // The next state shows the physics at its last step at or before it.
+    const Stamp shown = physics.showsBeforeLastStep(stamp + period) ? physics_time - 20 * kMs : physics_time;
+    EXPECT_LE(shown, stamp + period);
+    EXPECT_GT(shown + 20 * kMs, stamp + period);
+  }
+  // 99 samples of 33.3 ms: 3.3 s of physics, 165 steps.
+  EXPECT_EQ(165u, steps);
+}
+
+TEST(SampledPhysics, SamplesSlowerThanTheStepsTakeSeveralStepsEach)
+{
+  SampledPhysics physics(20 * kMs, 40 * kMs);  // 25 Hz samples
+  physics.restart(40 * kMs);
+  EXPECT_EQ(2u, physics.stepsAfter(40 * kMs));
+  EXPECT_FALSE(physics.showsBeforeLastStep(80 * kMs));
+  EXPECT_EQ(2u, physics.stepsAfter(80 * kMs));
+}

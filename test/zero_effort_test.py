@@ -2,7 +2,9 @@
 """The controller commands zero effort when it stops pushing (zero_effort.test): the test plays an
 OSKOOO-like robot (Float64 effort on /cart_pole/cart_joint_effort_controller/command, which a
 ros_control forward controller would hold forever), then its joint_states stop (~sim_timeout),
-then the controller's process gets SIGINT (Ctrl-C, roslaunch's kill)."""
+then the controller's process gets ~signal: INT (Ctrl-C, roslaunch's first), TERM (what roslaunch sends when SIGINT
+has not ended a node in time), or INT to a nodelet's loader, which unloads the controller nodelet from its manager
+(zero_effort.test, zero_effort_sigterm.test, zero_effort_nodelet.test)."""
 import os
 import signal
 import threading
@@ -60,7 +62,7 @@ class ZeroEffortTest(unittest.TestCase):
         self.publishing.clear()
         return time.monotonic()
 
-    def test_zero_after_states_stop_and_after_sigint(self):
+    def test_zero_after_states_stop_and_after_the_signal(self):
         stopped = self.pushing_then_stop()
         # ~sim_timeout is 1 s here: zero comes after it, and nothing after the zero.
         self.assertTrue(self.wait_for(lambda c: c[-1][1] == 0.0 and c[-1][0] > stopped + 0.5, 4.0),
@@ -72,9 +74,10 @@ class ZeroEffortTest(unittest.TestCase):
             pushes = len(self.commands)
         api = rosgraph.Master("/zero_effort_test").lookupNode(CONTROLLER)
         pid = xmlrpc.client.ServerProxy(api).getPid("/zero_effort_test")[2]
-        os.kill(pid, signal.SIGINT)
+        sig = getattr(signal, "SIG" + rospy.get_param("~signal", "INT"))
+        os.kill(pid, sig)
         self.assertTrue(self.wait_for(lambda c: len(c) > pushes and c[-1][1] == 0.0 and self.quiet(c, 0.5), 10.0),
-                        "no zero as the last command after SIGINT")
+                        "no zero as the last command after " + sig.name)
 
     @staticmethod
     def quiet(commands, seconds):

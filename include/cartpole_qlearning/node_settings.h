@@ -117,7 +117,14 @@ struct SimSettings
   // Posing as another cart-pole (README: "Your own cart-pole"): its joint names, offsets and signs
   // (~cart_joint, ~pole_joint, ~cart_zero, ~cart_sign, ~pole_upright, ~pole_angle_sign), whole turns
   // added to the pole's reading (~pole_turns) and whether velocities are published.
+  // (~effort_sign too: -1, a robot whose + effort pushes the cart toward -x.)
   RobotInterfaceParams pose;
+  // [s] ~publish_period: joint_states every this much sim time (physics/tau by default); the physics
+  // still steps every tau (SampledPhysics).
+  double publish_period = 0.02;
+  // ~group_effort_index: the cart's slot in the std_msgs/Float64MultiArray commands on group_effort
+  // (a JointGroupEffortController's).
+  std::uint64_t group_effort_index = 0;
   int pole_turns = 0;
   bool publish_velocities = true;
 };

@@ -9,6 +9,7 @@
 #include "cartpole_qlearning/lockstep_protocol.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -109,6 +110,39 @@ private:
   Stamp period_;
   Stamp tolerance_;
   std::optional<Stamp> last_;
+};
+
+// The sim posing as a robot whose joint_states come every `period` of sim time while its physics
+// steps every tau (~publish_period: a 100 Hz or 30 Hz driver over physics/tau = 0.02 s). A sensor
+// sampling the physics: the state stamped S shows the physics at its last step at or before S; the
+// command answering the state at S drives the steps that start in [S, S + period), as the command in
+// effect when they start. Times in ns of sim time; the physics starts at each start state (a reset).
+class SampledPhysics
+{
+public:
+  // tau, period > 0.
+  SampledPhysics(Stamp tau, Stamp period);
+  // A start state at `stamp`: the physics' next step starts there.
+  void restart(Stamp stamp);
+  // The steps to take after the state at `stamp` is answered, before the state at stamp + period.
+  std::uint64_t stepsAfter(Stamp stamp);
+  // Whether the answer to the state at `stamp` drives a step: else (a sample between two steps)
+  // a lockstep sim need not wait for it.
+  bool answerDrivesAStep(Stamp stamp) const
+  {
+    return next_step_ < stamp + period_;
+  }
+  // Whether the state at `stamp` is the physics before the last step taken: that step ends after
+  // `stamp` (samples that come faster than the steps, or a period that is no multiple of tau).
+  bool showsBeforeLastStep(Stamp stamp) const
+  {
+    return next_step_ > stamp;
+  }
+
+private:
+  Stamp tau_;
+  Stamp period_;
+  Stamp next_step_ = 0;  // when the next step starts
 };
 
 }  // namespace cartpole_qlearning

@@ -55,32 +55,48 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
                                       ros::TransportHints().tcpNoDelay());
   effort_sub_ =
       command_nh.subscribe("cart_effort", 10, &CartPoleSimNode::onEffort, this, ros::TransportHints().tcpNoDelay());
+  group_effort_sub_ = command_nh.subscribe("group_effort", 10, &CartPoleSimNode::onGroupEffort, this,
+                                           ros::TransportHints().tcpNoDelay());
   reset_srv_ = pnh_.advertiseService("reset", &CartPoleSimNode::onReset, this);
   reset_simulation_srv_ = pnh_.advertiseService("reset_simulation", &CartPoleSimNode::onResetSimulation, this);
 
   // The first state: a random start, which takes one tick of sim time like every reset.
   simulation_->resetRandom();
+  const bool own_rate = settings_.publish_period != settings_.physics.tau;
   if (settings_.mode == SimMode::Lockstep)
   {
-    lockstep_ = std::make_unique<SimProtocol>(tickOf(settings_.physics.tau), wallDuration(settings_.lockstep_timeout));
+    // Stamps go by the publish period; the physics steps by tau in between (SampledPhysics).
+    lockstep_ =
+        std::make_unique<SimProtocol>(tickOf(settings_.publish_period), wallDuration(settings_.lockstep_timeout));
+    sampled_ = std::make_unique<SampledPhysics>(tickOf(settings_.physics.tau), tickOf(settings_.publish_period));
     // A state that reaches no controller (one that subscribes late or restarts) is sent again
     // after lockstep_timeout; the timer looks twice per timeout.
     timer_ = nh_.createSteadyTimer(ros::WallDuration(settings_.lockstep_timeout / 2), &CartPoleSimNode::onLockstepTimer,
                                    this);
-    publishState(toRosTime(lockstep_->start(WallClock::now())));
+    const Stamp first = lockstep_->start(WallClock::now());
+    sampled_->restart(first);
+    publishState(toRosTime(first));
   }
   else
   {
     hold_ = std::make_unique<CommandHold>(wallDuration(settings_.command_timeout));
     timer_ = nh_.createSteadyTimer(ros::WallDuration(settings_.physics.tau), &CartPoleSimNode::onRealtimeTick, this);
+    // Another rate: a sensor sampling the physics on a timer of its own.
+    if (own_rate)
+      publish_timer_ =
+          nh_.createSteadyTimer(ros::WallDuration(settings_.publish_period), [this](const ros::SteadyTimerEvent&) {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            publishState(ros::Time::now());
+          });
     publishState(ros::Time::now());
   }
-  ROS_INFO_NAMED("cartpole_sim",
-                 "cartpole_sim: %s mode, tau %g s, integrator %s, seed %llu, start state [%g, %g, %g, %g]%s",
-                 settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau,
-                 toString(settings_.physics.integrator).c_str(), static_cast<unsigned long long>(settings_.seed),
-                 simulation_->state()[0], simulation_->state()[1], simulation_->state()[2], simulation_->state()[3],
-                 settings_.publish_clock ? ", publishing /clock" : "");
+  ROS_INFO_NAMED(
+      "cartpole_sim", "cartpole_sim: %s mode, tau %g s, integrator %s, seed %llu, start state [%g, %g, %g, %g]%s%s",
+      settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau,
+      toString(settings_.physics.integrator).c_str(), static_cast<unsigned long long>(settings_.seed),
+      simulation_->state()[0], simulation_->state()[1], simulation_->state()[2], simulation_->state()[3],
+      settings_.publish_clock ? ", publishing /clock" : "",
+      own_rate ? (", joint_states every " + SectionReader::numberText(settings_.publish_period) + " s").c_str() : "");
   if (!settings_.suite_case.empty())
     ROS_INFO_NAMED("cartpole_sim", "cartpole_sim: posing as case %s of %s", settings_.suite_case.c_str(),
                    settings_.suite.c_str());
@@ -139,8 +155,26 @@ void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
 void CartPoleSimNode::onEffort(const std_msgs::Float64ConstPtr& msg)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
+  onUnstampedEffort(msg->data);
+}
+
+void CartPoleSimNode::onGroupEffort(const std_msgs::Float64MultiArrayConstPtr& msg)
+{
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (msg->data.size() <= settings_.group_effort_index)
+  {
+    if (bad_command_warning_.ready())
+      ROS_WARN_NAMED("cartpole_sim", "cartpole_sim: dropped a group_effort of %zu values: the cart's is at index %llu",
+                     msg->data.size(), static_cast<unsigned long long>(settings_.group_effort_index));
+    return;
+  }
+  onUnstampedEffort(msg->data[settings_.group_effort_index]);
+}
+
+void CartPoleSimNode::onUnstampedEffort(double requested)
+{
   double effort = 0.0;
-  if (!acceptEffort(msg->data, effort))
+  if (!acceptEffort(requested, effort))
     return;
   const WallClock::time_point now = WallClock::now();
   if (settings_.mode == SimMode::Realtime)
@@ -155,9 +189,12 @@ void CartPoleSimNode::apply(SimProtocol::Verdict verdict, double effort, const r
 {
   if (verdict == SimProtocol::Verdict::Step)
   {
-    advance(effort, toRosTime(lockstep_->pending()));
+    stepLockstep(effort);
     return;
   }
+  const Stamp stamp = answers.toNSec();
+  if (stamp >= passed_from_ && stamp <= passed_to_ && stamp != 0)
+    return;  // a sample nobody waited for
   if (!dropped_warning_.ready())
     return;
   const SimProtocol::Counts& c = lockstep_->counts();
@@ -178,18 +215,43 @@ void CartPoleSimNode::apply(SimProtocol::Verdict verdict, double effort, const r
     ROS_WARN_NAMED("cartpole_sim", "%s", text);
 }
 
-void CartPoleSimNode::advance(double effort, const ros::Time& stamp)
+void CartPoleSimNode::step(double effort)
 {
   // The delay, the motor factor and the pushes are the simulation's: in realtime the delay is
   // counted in ticks as in lockstep, delay_steps x tau seconds.
-  simulation_->step(effort);
-  publishState(stamp);
+  simulation_->step(settings_.pose.effort_sign * effort);
+}
+
+void CartPoleSimNode::stepLockstep(double effort)
+{
+  const Stamp period = tickOf(settings_.publish_period);
+  Stamp stamp = lockstep_->pending();  // the answered state's, one period on
+  const std::uint64_t steps = sampled_->stepsAfter(stamp - period);
+  for (std::uint64_t i = 0; i < steps; ++i)
+  {
+    if (i + 1 == steps)
+      before_last_step_ = stateMessage();
+    step(effort);
+  }
+  publishState(toRosTime(stamp), sampled_->showsBeforeLastStep(stamp));
+  passed_from_ = passed_to_ = 0;
+  while (!sampled_->answerDrivesAStep(stamp))
+  {
+    if (passed_from_ == 0)
+      passed_from_ = stamp;
+    passed_to_ = stamp;
+    lockstep_->onUnstampedCommand(WallClock::now());
+    stamp = lockstep_->pending();
+    publishState(toRosTime(stamp), sampled_->showsBeforeLastStep(stamp));
+  }
 }
 
 void CartPoleSimNode::onRealtimeTick(const ros::SteadyTimerEvent&)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
-  advance(hold_->effort(WallClock::now()), ros::Time::now());
+  step(hold_->effort(WallClock::now()));
+  if (!publish_timer_.isValid())
+    publishState(ros::Time::now());
 }
 
 void CartPoleSimNode::onLockstepTimer(const ros::SteadyTimerEvent&)
@@ -214,7 +276,14 @@ bool CartPoleSimNode::onResetSimulation(std_srvs::Empty::Request&, std_srvs::Emp
 {
   const std::lock_guard<std::mutex> lock(mutex_);
   simulation_->resetRandom();
-  publishState(lockstep_ ? toRosTime(lockstep_->onResetTimeBack(WallClock::now())) : ros::Time::now());
+  if (!lockstep_)
+  {
+    publishState(ros::Time::now());
+    return true;
+  }
+  const Stamp first = lockstep_->onResetTimeBack(WallClock::now());
+  sampled_->restart(first);
+  publishState(toRosTime(first));
   return true;
 }
 
@@ -247,8 +316,14 @@ bool CartPoleSimNode::onReset(Reset::Request& request, Reset::Response& response
   }
   // In lockstep a reset takes one tick of sim time, so the new start state never shares a stamp
   // with the state before it, and an answer to that state still in flight is dropped.
-  publishState(settings_.mode == SimMode::Lockstep ? toRosTime(lockstep_->onReset(WallClock::now()))
-                                                   : ros::Time::now());
+  if (lockstep_)
+  {
+    const Stamp start = lockstep_->onReset(WallClock::now());
+    sampled_->restart(start);
+    publishState(toRosTime(start));
+  }
+  else
+    publishState(ros::Time::now());
   const CartPoleState& s = simulation_->state();
   std::ostringstream out;
   out.precision(17);
@@ -269,13 +344,23 @@ void CartPoleSimNode::republishState()
   joint_state_pub_.publish(joint_state_);
 }
 
-void CartPoleSimNode::publishState(const ros::Time& stamp)
+sensor_msgs::JointStatePtr CartPoleSimNode::stateMessage() const
+{
+  // The effort as the robot's joint reads it, in its sign.
+  return boost::make_shared<sensor_msgs::JointState>(jointStateFromReadings(
+      robotReadings(settings_.pose, simulation_->observation(), settings_.pole_turns, settings_.publish_velocities),
+      settings_.pose.effort_sign * simulation_->appliedForce(), ros::Time(), settings_.pose.cart_joint,
+      settings_.pose.pole_joint));
+}
+
+void CartPoleSimNode::publishState(const ros::Time& stamp, bool before_last_step)
 {
   // joint_states carry what the sensors read; TF shows the true state.
   const CartPoleState& s = simulation_->state();
-  auto msg = boost::make_shared<sensor_msgs::JointState>(jointStateFromReadings(
-      robotReadings(settings_.pose, simulation_->observation(), settings_.pole_turns, settings_.publish_velocities),
-      simulation_->appliedForce(), stamp, settings_.pose.cart_joint, settings_.pose.pole_joint));
+  // A new message each time (a subscriber in the manager may hold the last one).
+  auto msg = before_last_step && before_last_step_ ? boost::make_shared<sensor_msgs::JointState>(*before_last_step_)
+                                                   : stateMessage();
+  msg->header.stamp = stamp;
   joint_state_ = msg;
   republishState();
 

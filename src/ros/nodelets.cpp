@@ -105,6 +105,14 @@ class QLearningControllerNodelet : public nodelet::Nodelet
 public:
   ~QLearningControllerNodelet() override
   {
+    // Unloaded (or its manager stopping): zero effort first, as the executable does on Ctrl-C, since
+    // a robot's forward controller holds the last command forever. While ROS runs, a moment for
+    // the zero to leave on the connections to other processes, which the publishers' end closes.
+    if (node_ && ros::ok())
+    {
+      node_->stop();
+      ros::WallDuration(0.2).sleep();
+    }
     node_.reset();  // before the thread that serves its callbacks
   }
 

@@ -176,6 +176,9 @@ void QLearningControllerNode::command(Robot& robot, double effort, const ros::Ti
 
 void QLearningControllerNode::stop()
 {
+  // Without mutex_, which a state callback running on another thread (a nodelet's) holds till it returns.
+  for (Robot& robot : robots_)
+    robot.state_sub.shutdown();
   const std::lock_guard<std::mutex> lock(mutex_);
   for (Robot& robot : robots_)
     robot.command.stop();

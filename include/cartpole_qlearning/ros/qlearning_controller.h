@@ -57,7 +57,8 @@ public:
   // any reset call under way.
   ~QLearningControllerNode();
 
-  // Zero effort to every robot, before ROS shuts down (Ctrl-C, roslaunch's kill): a robot may hold its last command.
+  // Zero effort to every robot, and no state answered after it, before ROS shuts down (Ctrl-C, roslaunch's kill) or
+  // a nodelet is unloaded: a robot may hold its last command.
   void stop();
 
   QLearningControllerNode(const QLearningControllerNode&) = delete;
