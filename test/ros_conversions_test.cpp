@@ -65,6 +65,21 @@ void expectSameSettings(const LearningSettings& expected, const LearningSettings
   }
   EXPECT_EQ("", learningChangesText(expected, actual));
 }
+
+// What the controller reads from a message as the state, with the sim's default pose (readings
+// and state one to one): readingsFromJointState, velocities required.
+Reading<CartPoleState> readState(const sensor_msgs::JointState& msg, const std::string& cart_joint = "cart_joint",
+                                 const std::string& pole_joint = "pole_joint")
+{
+  const Reading<JointReadings> read = readingsFromJointState(msg, cart_joint, pole_joint);
+  if (!read)
+    return {std::nullopt, read.refusal};
+  if (!read.value->cart_velocity || !read.value->pole_velocity)
+    return {std::nullopt, "no velocities"};
+  return {CartPoleState(read.value->cart_position, *read.value->cart_velocity, read.value->pole_position,
+                        *read.value->pole_velocity),
+          ""};
+}
 }  // namespace
 
 // ---- joint_states: sim -> controller
@@ -79,7 +94,7 @@ TEST(JointStateConversion, TheControllerReadsExactlyTheStateTheSimPublished)
   EXPECT_EQ((std::vector<double>{7.5, 0.0}), msg.effort);  // the pole is not actuated
   EXPECT_EQ(123456789012u, msg.header.stamp.toNSec());
 
-  const Reading<CartPoleState> read = stateFromJointState(msg);
+  const Reading<CartPoleState> read = readState(msg);
   ASSERT_TRUE(read) << read.refusal;
   EXPECT_EQ("", read.refusal);
   EXPECT_EQ(state, *read.value);
@@ -90,7 +105,7 @@ TEST(JointStateConversion, JointsAreFoundByNameInAnyOrderAmongOthers)
   // A robot's joint_states: extra joints, the pole before the cart, no efforts.
   const sensor_msgs::JointState msg =
       joints({"wheel", "pole_joint", "gripper", "cart_joint"}, {9.0, 0.2, 8.0, 1.5}, {7.0, -0.3, 6.0, 0.4});
-  const Reading<CartPoleState> read = stateFromJointState(msg);
+  const Reading<CartPoleState> read = readState(msg);
   ASSERT_TRUE(read) << read.refusal;
   EXPECT_EQ(CartPoleState(1.5, 0.4, 0.2, -0.3), *read.value);
 }
@@ -98,48 +113,47 @@ TEST(JointStateConversion, JointsAreFoundByNameInAnyOrderAmongOthers)
 TEST(JointStateConversion, OtherJointNamesAreTakenAsGiven)
 {
   const sensor_msgs::JointState msg = joints({"cart_to_pole", "slider_to_cart"}, {0.1, 2.0}, {0.3, 4.0});
-  const Reading<CartPoleState> read = stateFromJointState(msg, "slider_to_cart", "cart_to_pole");
+  const Reading<CartPoleState> read = readState(msg, "slider_to_cart", "cart_to_pole");
   ASSERT_TRUE(read) << read.refusal;
   EXPECT_EQ(CartPoleState(2.0, 4.0, 0.1, 0.3), *read.value);
 
-  const Reading<CartPoleState> defaults = stateFromJointState(msg);
+  const Reading<CartPoleState> defaults = readState(msg);
   EXPECT_FALSE(defaults);
   EXPECT_EQ("dropped joint_states without cart_joint", defaults.refusal);
-  EXPECT_EQ("dropped joint_states without pole_joint",
-            stateFromJointState(msg, "slider_to_cart", "pole_joint").refusal);
+  EXPECT_EQ("dropped joint_states without pole_joint", readState(msg, "slider_to_cart", "pole_joint").refusal);
 }
 
 TEST(JointStateConversion, AMissingJointIsRefusedNamingIt)
 {
-  const Reading<CartPoleState> no_pole = stateFromJointState(joints({"cart_joint", "wheel"}, {1, 2}, {3, 4}));
+  const Reading<CartPoleState> no_pole = readState(joints({"cart_joint", "wheel"}, {1, 2}, {3, 4}));
   EXPECT_FALSE(no_pole);
   EXPECT_FALSE(no_pole.value.has_value());
   EXPECT_EQ("dropped joint_states without pole_joint", no_pole.refusal);
-  EXPECT_EQ("dropped joint_states without cart_joint", stateFromJointState(joints({"pole_joint"}, {1}, {2})).refusal);
-  EXPECT_EQ("dropped joint_states without cart_joint", stateFromJointState(joints({}, {}, {})).refusal);
+  EXPECT_EQ("dropped joint_states without cart_joint", readState(joints({"pole_joint"}, {1}, {2})).refusal);
+  EXPECT_EQ("dropped joint_states without cart_joint", readState(joints({}, {}, {})).refusal);
 }
 
 TEST(JointStateConversion, SizesThatDoNotMatchTheNamesAreRefused)
 {
   EXPECT_EQ("dropped joint_states with 2 names but 1 positions and 2 velocities",
-            stateFromJointState(joints({"cart_joint", "pole_joint"}, {1}, {2, 3})).refusal);
-  EXPECT_EQ("dropped joint_states with 2 names but 2 positions and 0 velocities",
-            stateFromJointState(joints({"pole_joint", "cart_joint"}, {1, 2}, {})).refusal);
+            readState(joints({"cart_joint", "pole_joint"}, {1}, {2, 3})).refusal);
+  EXPECT_EQ("dropped joint_states with 2 names but 2 positions and 1 velocities",
+            readState(joints({"pole_joint", "cart_joint"}, {1, 2}, {3})).refusal);
   // One value too many is no better than one too few: which joint it belongs to is unknown.
   EXPECT_EQ("dropped joint_states with 2 names but 3 positions and 2 velocities",
-            stateFromJointState(joints({"cart_joint", "pole_joint"}, {1, 2, 3}, {4, 5})).refusal);
+            readState(joints({"cart_joint", "pole_joint"}, {1, 2, 3}, {4, 5})).refusal);
 }
 
 TEST(JointStateConversion, NonFiniteValuesOfTheTwoJointsAreRefusedOthersNot)
 {
   const std::string refusal = "dropped joint_states with a non-finite position or velocity";
-  EXPECT_EQ(refusal, stateFromJointState(joints({"cart_joint", "pole_joint"}, {kNaN, 0}, {0, 0})).refusal);
-  EXPECT_EQ(refusal, stateFromJointState(joints({"cart_joint", "pole_joint"}, {0, 0}, {0, -kInf})).refusal);
-  EXPECT_EQ(refusal, stateFromJointState(joints({"pole_joint", "cart_joint"}, {kInf, 0}, {0, 0})).refusal);
-  EXPECT_FALSE(stateFromJointState(joints({"cart_joint", "pole_joint"}, {0, 0}, {kNaN, 0})));
+  EXPECT_EQ(refusal, readState(joints({"cart_joint", "pole_joint"}, {kNaN, 0}, {0, 0})).refusal);
+  EXPECT_EQ(refusal, readState(joints({"cart_joint", "pole_joint"}, {0, 0}, {0, -kInf})).refusal);
+  EXPECT_EQ(refusal, readState(joints({"pole_joint", "cart_joint"}, {kInf, 0}, {0, 0})).refusal);
+  EXPECT_FALSE(readState(joints({"cart_joint", "pole_joint"}, {0, 0}, {kNaN, 0})));
   // A broken sensor on a joint the controller does not use stops nothing.
   const Reading<CartPoleState> read =
-      stateFromJointState(joints({"cart_joint", "wheel", "pole_joint"}, {0.5, kNaN, 0.1}, {0.2, kInf, 0.3}));
+      readState(joints({"cart_joint", "wheel", "pole_joint"}, {0.5, kNaN, 0.1}, {0.2, kInf, 0.3}));
   ASSERT_TRUE(read) << read.refusal;
   EXPECT_EQ(CartPoleState(0.5, 0.2, 0.1, 0.3), *read.value);
 }
@@ -149,7 +163,7 @@ TEST(JointStateConversion, OtherJointNamesArePublishedAsGiven)
   const sensor_msgs::JointState msg =
       jointStateFromState(CartPoleState(1, 2, 3, 4), 0.0, ros::Time(), "slider_to_cart", "cart_to_pole");
   EXPECT_EQ((std::vector<std::string>{"slider_to_cart", "cart_to_pole"}), msg.name);
-  EXPECT_EQ(CartPoleState(1, 2, 3, 4), *stateFromJointState(msg, "slider_to_cart", "cart_to_pole").value);
+  EXPECT_EQ(CartPoleState(1, 2, 3, 4), *readState(msg, "slider_to_cart", "cart_to_pole").value);
 }
 
 // ---- joint_command: controller -> sim

@@ -19,23 +19,6 @@ int jointIndex(const sensor_msgs::JointState& msg, const std::string& name)
 }
 }  // namespace
 
-Reading<CartPoleState> stateFromJointState(const sensor_msgs::JointState& msg, const std::string& cart_joint,
-                                           const std::string& pole_joint)
-{
-  const int cart = jointIndex(msg, cart_joint);
-  const int pole = jointIndex(msg, pole_joint);
-  if (cart < 0 || pole < 0)
-    return {std::nullopt, "dropped joint_states without " + (cart < 0 ? cart_joint : pole_joint)};
-  if (msg.position.size() != msg.name.size() || msg.velocity.size() != msg.name.size())
-    return {std::nullopt, "dropped joint_states with " + std::to_string(msg.name.size()) + " names but " +
-                              std::to_string(msg.position.size()) + " positions and " +
-                              std::to_string(msg.velocity.size()) + " velocities"};
-  const CartPoleState state(msg.position[cart], msg.velocity[cart], msg.position[pole], msg.velocity[pole]);
-  if (!state.allFinite())
-    return {std::nullopt, "dropped joint_states with a non-finite position or velocity"};
-  return {state, ""};
-}
-
 Reading<JointReadings> readingsFromJointState(const sensor_msgs::JointState& msg, const std::string& cart_joint,
                                               const std::string& pole_joint)
 {

@@ -35,11 +35,6 @@ struct Reading
   }
 };
 
-// joint_states -> the state (x, x_dot, theta, theta_dot). The joints are found by name, in any
-// order and among any others; positions and velocities must be one per name and finite.
-Reading<CartPoleState> stateFromJointState(const sensor_msgs::JointState& msg,
-                                           const std::string& cart_joint = "cart_joint",
-                                           const std::string& pole_joint = "pole_joint");
 // joint_states from any cart-pole -> the two joints' readings, found by name in any order among
 // others. Positions one per name; velocities one per name or none at all (a position-only
 // driver: the core's StateMapping estimates them); finite.
