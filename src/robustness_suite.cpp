@@ -171,6 +171,13 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
   return result;
 }
 
+double shownReturn(double value, int decimals)
+{
+  const double scale = std::pow(10.0, decimals);
+  // + 0.0 turns -0.0 into 0.0 (IEEE 754 rounding to nearest).
+  return std::round(value * scale) / scale + 0.0;
+}
+
 bool SuiteResult::passed() const
 {
   return std::all_of(cases.begin(), cases.end(), [](const CaseResult& c) { return c.passed(); });
@@ -206,7 +213,7 @@ std::string SuiteResult::table() const
   {
     const std::string balanced = std::to_string(c.balanced) + "/" + std::to_string(c.episodes);
     std::snprintf(line, sizeof line, "%-*s  %8s  %6llu  %11.1f  %s\n", static_cast<int>(width), c.name.c_str(),
-                  balanced.c_str(), static_cast<unsigned long long>(c.pass), c.mean_return,
+                  balanced.c_str(), static_cast<unsigned long long>(c.pass), shownReturn(c.mean_return, 1),
                   c.passed() ? "pass" : "FAIL");
     out << line;
   }

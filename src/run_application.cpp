@@ -82,6 +82,8 @@ struct RunApplication::State
   void loadSuite(Saying& said);
   // Judges the session's table on the suite at this episode, keeping it when it is the best so far.
   SuiteResult judge(std::uint64_t episode);
+  // A resumed run goes on comparing against the best table its folder holds (judged again).
+  void restoreBest(Saying& said);
 
   RunSettings settings;
   TrainingConfig config;
@@ -109,6 +111,7 @@ struct RunApplication::State
   std::unique_ptr<QTable> best;  // the best table judged so far (suite_every > 0) and its verdict
   SuiteResult best_result;
   std::uint64_t best_episode = 0;
+  std::uint64_t best_saved_episode = 0;  // the best table in the run's folder (0: none)
 
   std::chrono::steady_clock::time_point started;
   std::chrono::steady_clock::time_point last_episode_end;
@@ -152,8 +155,28 @@ bool RunApplication::State::save(const std::string& path, std::string& message)
 
 bool RunApplication::State::checkpoint(const std::string& finished_as, std::string& message)
 {
+  // The best table before the record that names it: a record never points at a best not on disk.
+  if (best && best_episode != best_saved_episode)
+  {
+    try
+    {
+      saveQTableUnder(*best, settings.q_table_dir, run_folder + "/" + kRunBestTableFile);
+      best_saved_episode = best_episode;
+    }
+    catch (const std::exception& e)  // QTableFileError, or anything else: never out of a service
+    {
+      message = std::string("nothing written: the best table: ") + e.what();
+      return false;
+    }
+  }
   if (!save(run_folder + "/" + kRunTableFile, message))
     return false;
+  if (best_saved_episode > 0)
+  {
+    run.best_episode = best_episode;
+    run.best_worst_balanced = best_result.worstBalanced();
+    run.best_robustness = best_result.summary();
+  }
   run.episodes = session.table().episodes;
   run.steps = session.table().steps;
   run.recent_returns = session.recentReturns();
@@ -295,7 +318,9 @@ void RunApplication::State::resumeRun(bool respawn, Saying& said)
       formatText("%srun %s goes on from its checkpoint: episode %llu, %llu steps%s", restarted, run_folder.c_str(),
                  count(s.episode), count(s.total_steps),
                  record_matches ? "" : " (its record was one checkpoint behind: the solved window starts empty)"));
-  if (!record.finished.empty())
+  if (record.finished.empty())
+    restoreBest(said);
+  else
   {
     // Ended (or killed) after its final save: nothing to train. A controller stays up rather
     // than exit, which under respawn would only start it again.
@@ -304,6 +329,37 @@ void RunApplication::State::resumeRun(bool respawn, Saying& said)
         formatText("run %s has finished already (%s); nothing left to do", run_folder.c_str(),
                    record.finished.c_str()));
   }
+}
+
+void RunApplication::State::restoreBest(Saying& said)
+{
+  if (run.best_episode == 0 || !suite || config.limits.suite_every == 0)
+    return;
+  const std::string path = run_folder + "/" + kRunBestTableFile;
+  try
+  {
+    QTable table = loadQTableUnder(settings.q_table_dir, path);
+    // Judged again rather than taken from the record: the same suite gives the same verdict (it
+    // has its own seed), and a suite file changed since is then applied to both tables alike.
+    best_result = evaluateSuite(table, config, *suite);
+    best_episode = best_saved_episode = table.episodes;
+    best = std::make_unique<QTable>(std::move(table));
+  }
+  catch (const std::exception& e)  // FileError, or a ConfigError: the table does not fit this configuration
+  {
+    say(said, Said::Level::Warn,
+        formatText("the run's best table (episode %llu) cannot be used (%s): the best is looked for afresh",
+                   count(run.best_episode), e.what()));
+    run.best_episode = run.best_worst_balanced = 0;
+    run.best_robustness.clear();
+    return;
+  }
+  run.best_episode = best_episode;
+  run.best_worst_balanced = best_result.worstBalanced();
+  run.best_robustness = best_result.summary();
+  say(said, Said::Level::Info,
+      formatText("the best table so far is still the one to beat: episode %llu, worst case %llu balanced (%s)",
+                 count(best_episode), count(best_result.worstBalanced()), resolve(path).c_str()));
 }
 
 void RunApplication::State::startStatsCsv(Saying& said)
@@ -596,9 +652,9 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
                    s.terminated ? "fell" : "balanced to the step limit"));
     if (st.settings.evaluation_episodes == 0 || s.episode < st.settings.evaluation_episodes)
       return end;
-    std::string verdict =
-        formatText("EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f",
-                   count(s.episode), count(st.balanced), st.config.task.max_episode_steps, s.mean_return_window);
+    std::string verdict = formatText(
+        "EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f", count(s.episode),
+        count(st.balanced), st.config.task.max_episode_steps, shownReturn(s.mean_return_window, 1));
     if (!st.settings.evaluation_case.empty())
       verdict += formatText("; %s: %s (needs %llu)", st.settings.evaluation_case.c_str(),
                             st.balanced >= st.settings.evaluation_pass ? "PASSED" : "FAILED",
@@ -625,7 +681,7 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
                    : s.solved  ? "SOLVED"
                                : "NOT solved, max_episodes reached",
                    count(s.episode), count(s.total_steps), seconds(now - st.started), st.config.task.solved_window,
-                   s.mean_return_window, saved.c_str()));
+                   shownReturn(s.mean_return_window, 2), saved.c_str()));
     end.finished = true;
     return end;
   }

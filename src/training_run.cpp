@@ -65,6 +65,15 @@ std::string formatRunRecord(const RunRecord& record)
   out << YAML::Key << "finished" << YAML::Value << YAML::DoubleQuoted << record.finished;
   if (!record.robustness.empty())
     out << YAML::Key << "robustness" << YAML::Value << YAML::DoubleQuoted << record.robustness;
+  if (record.best_episode > 0)
+  {
+    out << YAML::Key << "best" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "table" << YAML::Value << kRunBestTableFile;
+    out << YAML::Key << "episode" << YAML::Value << record.best_episode;
+    out << YAML::Key << "worst_balanced" << YAML::Value << record.best_worst_balanced;
+    out << YAML::Key << "robustness" << YAML::Value << YAML::DoubleQuoted << record.best_robustness;
+    out << YAML::EndMap;
+  }
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
@@ -95,6 +104,14 @@ RunRecord parseRunRecord(const std::string& text)
     record.finished = get("finished").as<std::string>();
     if (root["robustness"])
       record.robustness = root["robustness"].as<std::string>();
+    if (const YAML::Node best = root["best"])
+    {
+      if (!best.IsMap() || !best["episode"] || !best["worst_balanced"] || !best["robustness"])
+        refuse("best must be a map with episode, worst_balanced and robustness");
+      record.best_episode = best["episode"].as<std::uint64_t>();
+      record.best_worst_balanced = best["worst_balanced"].as<std::uint64_t>();
+      record.best_robustness = best["robustness"].as<std::string>();
+    }
   }
   catch (const YAML::Exception& e)
   {

@@ -1,6 +1,7 @@
 // The robustness suite (robustness_suite.h): read from its file, run greedily, judged per case.
 #include "cartpole_qlearning/headless_trainer.h"
 #include "cartpole_qlearning/robustness_suite.h"
+#include "cartpole_qlearning/said.h"
 
 #include <gtest/gtest.h>
 
@@ -146,4 +147,21 @@ TEST(RobustnessSuite, ATableForOtherFeaturesIsRefused)
   TrainingConfig tiles;
   tiles.agent.features = FeatureKind::Tiles;
   EXPECT_THROW(evaluateCase(trainedTable(1), tiles, suite.cases[0], 1, 0), ConfigError);
+}
+
+TEST(RobustnessSuite, AMeanReturnThatRoundsToZeroPrintsWithoutASign)
+{
+  // Under sutton_barto (0 a step, -1 on the fall) a case where 2 of 100 fell has a mean return of
+  // -0.02: the table shows 0.0, never "-0.0"; a mean that does not round to zero keeps its sign.
+  SuiteResult result;
+  result.cases.push_back({"few_falls", 100, 98, 95, -0.02});
+  result.cases.push_back({"many_falls", 100, 40, 95, -0.6});
+  const std::string table = result.table();
+  EXPECT_EQ(table.find("-0.0"), std::string::npos) << table;
+  EXPECT_NE(table.find("98/100      95          0.0  pass"), std::string::npos) << table;
+  EXPECT_NE(table.find("40/100      95         -0.6  FAIL"), std::string::npos) << table;
+  EXPECT_EQ(formatText("%.1f", shownReturn(-0.04, 1)), "0.0");
+  EXPECT_EQ(formatText("%.2f", shownReturn(-0.004, 2)), "0.00");
+  EXPECT_EQ(formatText("%.1f", shownReturn(-0.06, 1)), "-0.1");
+  EXPECT_EQ(formatText("%.3f", shownReturn(475.25, 3)), "475.250");
 }

@@ -982,3 +982,114 @@ TEST_F(RunApplicationTest, ASuiteThatCannotBeReadStopsARunThatNeedsItAndIsOnlySa
   settings_.suite_folders = {dir_.string(), CARTPOLE_CONFIG_DIR};
   EXPECT_FALSE(says(startRun().started, "without a robustness verdict"));
 }
+
+TEST_F(RunApplicationTest, TheBestTableSeenSurvivesAResumeAndIsStillTheOneToBeat)
+{
+  // A suite no table passes here (as above): the best is what the run saves at max_episodes.
+  TrainingConfig config;
+  config.limits.suite = writeSuite(
+      "episodes: 20\ncases: [{name: pushed_hard, pass: 20, perturbations: "
+      "{delay_steps: 1, push_probability: 0.3, push_force: 8.0}}]");
+  config.limits.suite_every = 25;
+  config.limits.until = TrainUntil::SuitePasses;
+  config.limits.max_episodes = 400;
+  settings_.checkpoint_every = 25;
+  const RobustnessSuite suite = loadRobustnessSuite(config.limits.suite, config);
+  // The worst case's balanced episodes that a "robustness at episode" line gives.
+  const auto judged = [](const std::string& line) {
+    const std::size_t at = line.find("pushed_hard ") + 12;
+    return std::stoull(line.substr(at, line.find('/', at) - at));
+  };
+
+  // Stopped at episode 200 (a Ctrl-C, or a controller killed after its checkpoint).
+  std::uint64_t best = 0;
+  std::uint64_t best_at = 0;
+  {
+    HeadlessTrainer trainer(config, settings_.seed);
+    RunApplication app(settings_, config, trainer.session(), clocks_);
+    app.start();
+    trainer.runUntil(
+        [&](const EpisodeSummary& s) {
+          for (const std::string& line : lines({app.endEpisode("", false)}, "robustness at episode"))
+            if (judged(line) > best || best_at == 0)
+              std::tie(best, best_at) = std::make_tuple(judged(line), s.episode);
+          return s.episode == 200;
+        },
+        nullptr);
+    app.shutdown();
+  }
+  ASSERT_GT(best_at, 0u);
+  ASSERT_LT(best_at, 200u);  // else the checkpoint is the best, and this shows nothing
+  // The folder says which table is the best and its score.
+  const fs::path folder = dir_ / folderName();
+  const RunRecord record = parseRunRecord(text(folder / "run.yaml"));
+  EXPECT_EQ(200u, record.episodes);
+  EXPECT_EQ(best_at, record.best_episode);
+  EXPECT_EQ(best, record.best_worst_balanced);
+  const QTable best_table = loadQTableFile((folder / "best_q_table.yaml").string());
+  EXPECT_EQ(best_at, best_table.episodes);
+  const SuiteResult best_result = evaluateSuite(best_table, config, suite);
+  EXPECT_EQ(best, best_result.worstBalanced());
+  EXPECT_EQ(best_result.summary(), record.best_robustness);
+  EXPECT_NE(std::string::npos, text(folder / "run.yaml").find("table: best_q_table.yaml"));
+
+  // Resumed: every later table is compared with that best, and the run saves the best of them all.
+  HeadlessTrainer trainer(config, settings_.seed);
+  RunApplication app(settings_, config, trainer.session(), clocks_);
+  const Saying resumed = app.resume(folderName());
+  EXPECT_TRUE(says(resumed, "the best table so far is still the one to beat: episode " + std::to_string(best_at) +
+                                ", worst case " + std::to_string(best) + " balanced"))
+      << all(resumed);
+  std::vector<EpisodeEnd> ends;
+  std::uint64_t later_best = 0;
+  std::uint64_t later_best_at = 0;
+  trainer.runUntil(
+      [&](const EpisodeSummary& s) {
+        const bool reached = config.limits.reached(s.episode, s.solved);
+        ends.push_back(app.endEpisode("", reached));
+        for (const std::string& line : lines({ends.back()}, "robustness at episode"))
+          if (judged(line) > later_best || later_best_at == 0)
+            std::tie(later_best, later_best_at) = std::make_tuple(judged(line), s.episode);
+        return ends.back().finished || reached;
+      },
+      nullptr);
+  ASSERT_EQ(200u, ends.size());
+  const std::uint64_t kept = later_best > best ? later_best_at : best_at;
+  const QTable saved = loadQTableFile((folder / "q_table.yaml").string());
+  EXPECT_EQ(kept, saved.episodes);
+  EXPECT_NE(std::string::npos,
+            ends.back().robustness.find("pushed_hard " + std::to_string(std::max(best, later_best)) + "/20"));
+  // Here no later table beats the one found before the stop: a run that forgot it would save another.
+  EXPECT_LE(later_best, best);
+  EXPECT_EQ(1u, lines(ends, "keeping the table of episode " + std::to_string(best_at)).size());
+  EXPECT_EQ(best_at, parseRunRecord(text(folder / "run.yaml")).best_episode);
+}
+
+TEST_F(RunApplicationTest, ABestTableThatCannotBeReadIsSaidAndTheBestLookedForAfresh)
+{
+  TrainingConfig config;
+  config.limits.suite = writeSuite(
+      "episodes: 5\ncases: [{name: pushed_hard, pass: 5, perturbations: {delay_steps: 1, push_probability: 0.3, "
+      "push_force: 8.0}}]");
+  config.limits.suite_every = 10;
+  config.limits.until = TrainUntil::SuitePasses;
+  settings_.checkpoint_every = 10;
+  {
+    HeadlessTrainer trainer(config, settings_.seed);
+    RunApplication app(settings_, config, trainer.session(), clocks_);
+    app.start();
+    trainer.runUntil([&](const EpisodeSummary& s) { return app.endEpisode("", false).finished || s.episode == 20; },
+                     nullptr);
+  }
+  const fs::path folder = dir_ / folderName();
+  const std::uint64_t best_at = parseRunRecord(text(folder / "run.yaml")).best_episode;
+  ASSERT_GT(best_at, 0u);
+  std::ofstream(folder / "best_q_table.yaml") << "not a table";
+  HeadlessTrainer trainer(config, settings_.seed);
+  RunApplication app(settings_, config, trainer.session(), clocks_);
+  const Saying resumed = app.resume(folderName());
+  EXPECT_EQ(Said::Level::Warn,
+            said(resumed, "the run's best table (episode " + std::to_string(best_at) + ") cannot be used").level)
+      << all(resumed);
+  EXPECT_FALSE(says(resumed, "still the one to beat"));
+}

@@ -153,6 +153,23 @@ TEST_F(TrainHeadlessTest, EveryRunSaysWhatItsTableIsWorthOnTheRobustnessSuite)
   EXPECT_NE(std::string::npos, run.output.find(": FAILED")) << run.output;
 }
 
+TEST_F(TrainHeadlessTest, QuietKeepsTheRobustnessOfTheSavedTableBesideTheResultLine)
+{
+  const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --no-run-folder --max-episodes 5");
+  EXPECT_EQ(0, run.status) << run.output;
+  // What the table is worth (a table of 5 episodes falls everywhere), then the result line; no
+  // progress line, no other line of the suite.
+  std::smatch worth;
+  EXPECT_TRUE(std::regex_search(run.output, worth,
+                                std::regex("(^|\n)robustness of the saved table: nominal [0-9]+/100, one_step_late "
+                                           "[0-9]+/100, .*all_at_once [0-9]+/100: FAILED\nsolved=false episodes=5 ")))
+      << run.output;
+  EXPECT_EQ(0u, run.lastLine().find("solved=false episodes=5 ")) << run.output;
+  EXPECT_EQ(std::string::npos, run.output.find("robustness at episode")) << run.output;
+  EXPECT_EQ(std::string::npos, run.output.find("mean_return_100")) << run.output;
+  EXPECT_EQ(std::string::npos, run.output.find("balanced  needed")) << run.output;
+}
+
 TEST_F(TrainHeadlessTest, TheRobustConfigTrainsOnUntilItsTablePassesTheSuite)
 {
   const std::string table = file("robust.yaml");
@@ -655,6 +672,43 @@ TEST_P(TrainHeadlessStopTest, AStoppedRunGoesOnWithResume)
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, TrainHeadlessStopTest, ::testing::Values(SIGINT, SIGTERM, SIGKILL));
+
+// A kill between a checkpoint's two saves leaves the record a checkpoint behind its table, and the
+// table wins on resume: --max-episodes counts the table's episodes, so a run whose table already
+// reached it is refused, not trained one episode further.
+TEST_F(TrainHeadlessTest, ResumeCountsMaxEpisodesFromTheCheckpointTableNotTheRecord)
+{
+  const CommandRun first = trainHeadless(endlessConfig() + " --seed 2 --quiet --max-episodes 40 --checkpoint-every 20");
+  ASSERT_EQ(0, first.status) << first.output;
+  const std::vector<std::string> runs = written();
+  const auto record_file = std::find_if(runs.begin(), runs.end(), [](const std::string& f) {
+    return f.size() > 9 && f.compare(f.size() - 9, 9, "/run.yaml") == 0;
+  });
+  ASSERT_NE(runs.end(), record_file) << first.output;
+  const fs::path record_path = dir_ / "cartpole_qlearning" / *record_file;
+  const std::string folder = fs::relative(record_path.parent_path(), tables()).string();
+  ASSERT_EQ(40u, cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string()).episodes);
+  // The record as the checkpoint of episode 20 left it, not yet finished: the kill came after the
+  // table of episode 40 was written and before its record.
+  cartpole_qlearning::RunRecord record = cartpole_qlearning::parseRunRecord(fileText(record_path.string()));
+  record.episodes = 20;
+  record.steps = 1000;
+  record.finished = "";
+  record.robustness = "";
+  std::ofstream(record_path) << cartpole_qlearning::formatRunRecord(record);
+
+  const CommandRun resumed = trainHeadless(endlessConfig() + " --resume " + folder + " --max-episodes 40");
+  EXPECT_EQ(2, resumed.status) << resumed.output;
+  EXPECT_NE(std::string::npos, resumed.output.find("--resume " + folder +
+                                                   ": its table has 40 episodes of training already, and training "
+                                                   "ends at episode 40"))
+      << resumed.output;
+  EXPECT_EQ(40u, cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string()).episodes);
+  // One more allowed: it trains exactly one, from the table's count.
+  const CommandRun more = trainHeadless(endlessConfig() + " --resume " + folder + " --max-episodes 41 --quiet");
+  EXPECT_EQ(0, more.status) << more.output;
+  EXPECT_TRUE(std::regex_search(more.lastLine(), std::regex("^solved=(true|false) episodes=41 "))) << more.output;
+}
 
 // Several robots are named as train.launch robots:=N names their namespaces, as the node logs.
 TEST_F(TrainHeadlessTest, TheTraceNamesRobotsByTheirNamespaces)

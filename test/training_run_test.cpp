@@ -33,6 +33,17 @@ TEST(RunRecord, RoundTripsExactly)
   EXPECT_EQ(record.recent_returns, back.recent_returns);
   EXPECT_EQ(record.finished, back.finished);
   EXPECT_EQ(record.robustness, back.robustness);
+  // No best judged yet: none written, none read.
+  EXPECT_EQ(std::string::npos, formatRunRecord(record).find("best"));
+  EXPECT_EQ(0u, back.best_episode);
+  record.best_episode = 70;
+  record.best_worst_balanced = 93;
+  record.best_robustness = "nominal 100/100, all_at_once 93/100: PASSED";
+  const RunRecord with_best = parseRunRecord(formatRunRecord(record));
+  EXPECT_EQ(70u, with_best.best_episode);
+  EXPECT_EQ(93u, with_best.best_worst_balanced);
+  EXPECT_EQ(record.best_robustness, with_best.best_robustness);
+  EXPECT_NE(std::string::npos, formatRunRecord(record).find("table: best_q_table.yaml"));
 }
 
 TEST(RunRecord, BadRecordsAreRefusedWithTheReason)
@@ -55,6 +66,7 @@ TEST(RunRecord, BadRecordsAreRefusedWithTheReason)
   std::string other = good;
   other.replace(other.find("finished: \"\""), 12, "finished: \"maybe\"");
   EXPECT_NE(std::string::npos, refusal(other).find("finished is 'maybe'")) << refusal(other);
+  EXPECT_NE(std::string::npos, refusal(good + "best: 3\n").find("best must be a map")) << refusal(good + "best: 3\n");
   std::string nan = good;
   nan.replace(nan.find("recent_returns: []"), 18, "recent_returns: [1, .nan]");
   EXPECT_NE(std::string::npos, refusal(nan).find("not finite")) << refusal(nan);

@@ -6,7 +6,8 @@ of each column. The figures of docs/robust_tables.md come from one run of it:
 
   python3 tools/robust_seeds.py --config config/robust.yaml --seeds 0-19
 
-train_headless is found on PATH (source devel/setup.bash) or given with --train-headless.
+train_headless is found on PATH, else by catkin_find (source devel/setup.bash), or given with
+--train-headless.
 Nothing is written (--no-run-folder).
 """
 import argparse
@@ -23,11 +24,24 @@ def seeds(text):
     return range(int(low), int(high or low) + 1)
 
 
+def find_train_headless():
+    """train_headless on PATH, else where catkin puts it (devel/lib/cartpole_qlearning: not on PATH)."""
+    found = shutil.which('train_headless')
+    if found:
+        return found
+    try:
+        out = subprocess.run(['catkin_find', '--first-only', '--libexec', 'cartpole_qlearning', 'train_headless'],
+                             capture_output=True, text=True).stdout.split()
+    except OSError:
+        out = []
+    return out[0] if out else 'train_headless'
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--config', required=True)
     parser.add_argument('--seeds', type=seeds, default=seeds('0-19'))
-    parser.add_argument('--train-headless', default=shutil.which('train_headless') or 'train_headless')
+    parser.add_argument('--train-headless', default=find_train_headless())
     args = parser.parse_args()
     rows = []
     for seed in args.seeds:

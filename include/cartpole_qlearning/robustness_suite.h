@@ -76,4 +76,9 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
                         std::uint64_t episodes, std::uint64_t seed);
 SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite);
 
+// A mean return as printed with this many decimals: rounded there, a zero without its sign.
+// Under sutton_barto a case where 2 of 100 fell has a mean of -0.02, which "%.1f" prints as
+// "-0.0"; printed through this it reads 0.0, and the balanced column says who fell.
+double shownReturn(double value, int decimals);
+
 }  // namespace cartpole_qlearning

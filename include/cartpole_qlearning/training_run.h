@@ -16,6 +16,9 @@ namespace cartpole_qlearning
 // The files in a run's folder.
 constexpr const char* kRunTableFile = "q_table.yaml";
 constexpr const char* kRunRecordFile = "run.yaml";
+// The best table the robustness suite has seen in the run (training/suite_every > 0), which a
+// resumed run goes on comparing against.
+constexpr const char* kRunBestTableFile = "best_q_table.yaml";
 // Where run folders go, under the table directory.
 constexpr const char* kRunsFolder = "runs";
 
@@ -34,6 +37,12 @@ struct RunRecord
   // What the final table is worth: the robustness suite's one-line summary (robustness_suite.h),
   // written when training ends ("": not judged).
   std::string robustness;
+  // The best table the suite has judged so far (kRunBestTableFile beside the record, saved before
+  // it): the episode it was judged at (0: none yet), its worst case's balanced episodes and the
+  // suite's summary of it. What the user reads; a resumed run judges that file again.
+  std::uint64_t best_episode = 0;
+  std::uint64_t best_worst_balanced = 0;
+  std::string best_robustness;
 };
 
 // The record as YAML, and back. parseRunRecord throws FileError saying what is wrong.

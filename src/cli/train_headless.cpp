@@ -88,7 +88,8 @@ void usage(std::ostream& out)
          "  --stats-csv FILE     one CSV row per episode, as each ends (the learning curve, for rosrun\n"
          "                       cartpole_qlearning plot_learning_curve FILE) instead of the run's episodes.csv;\n"
          "                       none: no curve. An earlier curve there is replaced, any other file refused\n"
-         "  --quiet              nothing but warnings, errors and the result line\n"
+         "  --quiet              nothing but warnings, errors, the robustness of the saved table (one line) and the\n"
+         "                       result line\n"
          "  --returns            before the result line, one line \"returns=R1 R2 ...\": every episode's return\n"
          "                       in order\n"
          "  --trace              print every update as the tutorial works it (state, action, reward, next state,\n"
@@ -606,16 +607,21 @@ int run(int argc, char** argv)
   }
 
   // Training goes on from a table's episode count, and max_episodes counts it: a table at or past
-  // it has nothing to train (else one episode would run). A resumed run that has finished says
-  // so below; a table that cannot be read is said by RunApplication.
+  // it has nothing to train (else one episode would run). A resumed run goes on from its
+  // checkpoint table's count, not its record's: a kill between the two saves leaves the record a
+  // checkpoint behind, and the table wins (RunApplication::resume). A resumed run that has
+  // finished says so below; a table that cannot be read is said by RunApplication.
   if (!resume_folder.empty() || !load_path.empty())
   {
     std::uint64_t episodes = 0;
     try
     {
-      episodes = !resume_folder.empty()     ? (resumed.finished.empty() ? resumed.episodes : 0)
-                 : load_path.front() == '/' ? loadQTableFile(load_path).episodes
-                                            : loadQTableUnder(table_dir, load_path).episodes;
+      episodes =
+          !resume_folder.empty()
+              ? (resumed.finished.empty() ? loadQTableUnder(table_dir, resume_folder + "/" + kRunTableFile).episodes
+                                          : 0)
+          : load_path.front() == '/' ? loadQTableFile(load_path).episodes
+                                     : loadQTableUnder(table_dir, load_path).episodes;
     }
     catch (const FileError&)
     {
@@ -710,6 +716,9 @@ int run(int argc, char** argv)
         const bool training_finished = !evaluating && config.limits.reached(s.episode, s.solved);
         const EpisodeEnd end = application->endEpisode(robot_names[s.robot], training_finished);
         error = say(end.said, quiet) || error;
+        // What the saved table is worth is a result, as the result line is: --quiet keeps it.
+        if (quiet && !end.robustness.empty())
+          std::printf("robustness of the saved table: %s\n", end.robustness.c_str());
         return end.finished || training_finished;
       },
       &g_stop);
@@ -726,7 +735,7 @@ int run(int argc, char** argv)
   {
     const EvaluationVerdict verdict = application->verdict();
     std::printf("evaluated=%llu balanced=%llu mean_return=%.3f\n", static_cast<unsigned long long>(verdict.episodes),
-                static_cast<unsigned long long>(verdict.balanced), verdict.mean_return);
+                static_cast<unsigned long long>(verdict.balanced), shownReturn(verdict.mean_return, 3));
   }
   else
   {
