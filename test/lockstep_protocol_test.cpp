@@ -617,6 +617,38 @@ TEST_F(ControllerProtocolTest, AFallRequestsAResetAndOnlyANonTerminalNewStateBeg
   EXPECT_EQ(before + 2, learntSteps());
 }
 
+TEST_F(ControllerProtocolTest, AStartDrawnPastTheFallInAWideStartRegionIsAnEpisodeOfOneStep)
+{
+  // config/robust.yaml draws starts in +-0.25 rad, past the fall at 12 degrees (0.2094 rad):
+  // train_headless begins such an episode and learns from its one step, and the lockstep sim
+  // waits for an answer to it. Only inside the start region: a pole past it is still falling.
+  params_.start_region = CartPoleState::Constant(0.25);
+  ControllerProtocol controller(session_, params_);
+  const CartPoleState fallen_start(0.1, -0.2, 0.22, 0.15);
+  ASSERT_TRUE(session_.task().isTerminal(fallen_start));
+  const Reaction first = controller.onState(tick(1), fallen_start);
+  EXPECT_TRUE(first.episode_began);
+  EXPECT_TRUE(first.answer);
+  EXPECT_FALSE(first.request_reset);
+  const Reaction fall = controller.onState(tick(2), CartPoleState(0.1, -0.1, 0.225, 0.4));
+  EXPECT_TRUE(fall.episode_ended);
+  EXPECT_TRUE(fall.request_reset);
+  EXPECT_EQ(1u, session_.lastEpisode().steps);
+  EXPECT_EQ(1u, learntSteps());
+
+  // After the reset, another start past the fall: answered again, not waited on.
+  const Reaction again = controller.onState(tick(3), CartPoleState(-0.05, 0.0, -0.24, 0.1));
+  EXPECT_TRUE(again.episode_began);
+  EXPECT_TRUE(again.answer);
+  // A pole fallen beyond the region (a realtime sim stepping on before its reset is served)
+  // still begins nothing.
+  ASSERT_TRUE(controller.onState(tick(4), CartPoleState(0.0, 0.0, -0.3, -1.0)).request_reset);
+  const Reaction falling = controller.onState(tick(5), CartPoleState(0.0, 0.0, -0.35, -1.2));
+  EXPECT_FALSE(falling.episode_began);
+  EXPECT_FALSE(falling.answer);
+  EXPECT_TRUE(controller.onState(tick(6), kUpright).episode_began);
+}
+
 TEST_F(ControllerProtocolTest, AControllerRestartedMidRunAnswersTheSimsPendingState)
 {
   SimProtocol sim(kTick, kRepeatAfter);
