@@ -90,12 +90,5 @@ TEST(RobotProfile, TrainsUntilSolvedThenTheTableIsEvaluated)
 
 int main(int argc, char** argv)
 {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "robot_profile_test");
-  ros::NodeHandle nh;
-  const int result = RUN_ALL_TESTS();
-  const std::string home = privateParam("ros_home");
-  if (!home.empty())
-    std::filesystem::remove_all(home);
-  return result;
+  return cartpole_qlearning::test::runTestsRemovingRosHome(argc, argv, "robot_profile_test");
 }
