@@ -22,6 +22,7 @@ mkdir -p "$WORK"
 
 # The core's sources, as CMakeLists.txt lists them for the core library.
 mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_core/,/^)/p' "$SRC/CMakeLists.txt" | grep -o 'src/[a-z_]*\.cpp')
+# shellcheck disable=SC2054 # the commas belong to -fsanitize=...
 COMPILE=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
   -I "$SRC/include" -isystem /usr/include/eigen3)
 # The core is compiled once, for every target (with coverage hooks: fuzzer-no-link), two sources at
@@ -46,6 +47,7 @@ while ((running > 0)); do
 done
 ((failed == 0)) || { echo "fuzz.sh: the core does not compile with $CXX" >&2; exit 2; }
 echo "[fuzz] compiled in $SECONDS s"
+# shellcheck disable=SC2206 # FUZZ_TARGETS is a space-separated list: split on purpose
 TARGETS=(${FUZZ_TARGETS:-q_table config})
 for target in "${TARGETS[@]}"; do
   echo "[fuzz] building $target"
