@@ -13,6 +13,7 @@
 #include <ros/ros.h>
 
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <string>
 #include <vector>
@@ -70,19 +71,31 @@ TEST(RobotProfile, TrainsUntilSolvedThenTheTableIsEvaluated)
                                    "mean return ([0-9.]+)")))
       << output;
   std::printf("%s: %s\n", robot.c_str(), verdict[0].str().c_str());
-  // The verdict is the episodes the evaluation published: the same count balanced.
-  spinUntil([&] { return stats.size() >= 10u; }, 5.0);
-  ASSERT_EQ(10u, stats.size()) << output;
+  // The verdict is the ten episodes the evaluation printed: the same count balanced, the same mean return.
+  std::map<unsigned, std::pair<unsigned, double>> episodes;  // episode -> steps, return
   unsigned balanced = 0;
   double returns = 0.0;
+  const std::regex line("evaluation episode ([0-9]+): ([0-9]+) steps, return ([0-9.-]+), (fell|balanced)");
+  for (auto it = std::sregex_iterator(output.begin(), output.end(), line); it != std::sregex_iterator(); ++it)
+  {
+    episodes[std::stoul((*it)[1].str())] = {std::stoul((*it)[2].str()), std::stod((*it)[3].str())};
+    balanced += (*it)[4].str() == "balanced";
+    returns += std::stod((*it)[3].str());
+  }
+  ASSERT_EQ(10u, episodes.size()) << output;
+  EXPECT_EQ(std::to_string(balanced), verdict[1].str());
+  EXPECT_NEAR(returns / 10.0, std::stod(verdict[2].str()), 0.051);
+  // And what episode_stats published: greedy, the same episodes. (The first ones may be gone: this node
+  // subscribes to the evaluation's controller only once it has started.)
+  spinUntil([&] { return stats.size() >= 10u; }, 5.0);
+  ASSERT_FALSE(stats.empty()) << "no episode_stats from the evaluation";
   for (const EpisodeStats& s : stats)
   {
     EXPECT_DOUBLE_EQ(0.0, s.epsilon) << "evaluation is greedy";
-    balanced += s.truncated && !s.terminated;
-    returns += s.episode_return;
+    ASSERT_EQ(1u, episodes.count(s.episode)) << "episode_stats of an episode not printed: " << s.episode;
+    EXPECT_EQ(episodes[s.episode].first, s.steps);
+    EXPECT_NEAR(episodes[s.episode].second, s.episode_return, 0.051);
   }
-  EXPECT_EQ(std::to_string(balanced), verdict[1].str());
-  EXPECT_NEAR(returns / 10.0, std::stod(verdict[2].str()), 0.051);
   // A learnt table, not a random one (which falls within about 20 steps): the pole is held up for most of the
   // episodes' length on average.
   EXPECT_GE(returns / 10.0, 250.0) << output;
