@@ -63,13 +63,8 @@ strip_plain() { # VAR: removes the entries under $WS/devel from the :-separated 
 for var in CMAKE_PREFIX_PATH LD_LIBRARY_PATH PKG_CONFIG_PATH PYTHONPATH; do strip_plain "$var"; done
 
 FLAGS="-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
-# A unity build (CMake joins each target's sources, 8 at a time, into one translation unit): the
-# ROS, gtest and Eigen headers are parsed once per batch instead of once per file, which took the
-# instrumented build from about 850 to about 330 CPU seconds. The price: two files of one target
-# must not define the same name at file scope (in an anonymous namespace included); shared test
-# helpers live in test/test_support.h for that reason.
 ARGS=(--build "$BUILD" -DCATKIN_DEVEL_PREFIX="$DEVEL" -DCMAKE_BUILD_TYPE=Sanitize "-DCMAKE_CXX_FLAGS=$FLAGS"
-  -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE -DCMAKE_UNITY_BUILD=ON)
+  -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE)
 [ -x /usr/bin/python3 ] && ARGS+=(-DPYTHON_EXECUTABLE=/usr/bin/python3)
 cd "$WS"
 echo "[sanitize] building the nodes, the nodelet library and every test with ASan + UBSan ($CXX) in $BUILD"
