@@ -10,7 +10,7 @@ median wall time to solve.
 config/tutorial.yaml) and, for reference, the tutorial's method in Python with Gymnasium
 (<repo>/../shared/anchors/gym_tabular_q.py, beside the development tree; skipped with a note
 where it is absent, as in a user's clone) over the same seeds, and prints one markdown table
-with the machine and the date: the README's "How fast it learns" table.
+with the machine and the date: the "How fast it learns" table of docs/results.md.
 
 Statistics over all the seeds run: a seed that did not solve within --max-episodes ranks
 after every solved one, so a percentile that falls on it reads "> N". Steps and wall time are

@@ -154,7 +154,7 @@ void readFinite(SectionReader& priv, const std::string& name, double& value)
     priv.fail(name, SectionReader::numberText(value), "must be finite");
 }
 
-// The robot's joints, offsets and command (robot_interface.h; README: "Your own cart-pole").
+// The robot's joints, offsets and command (robot_interface.h; docs/your_own_cartpole.md).
 void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& robot)
 {
   for (const auto& [name, text] : {std::pair<const char*, std::string*>{"cart_joint", &robot.cart_joint},

@@ -114,7 +114,7 @@ struct SimSettings
   // region and perturbations over the shared ones; its seed unless ~seed is given). "": none.
   std::string suite;
   std::string suite_case;
-  // Posing as another cart-pole (README: "Your own cart-pole"): its joint names, offsets and signs
+  // Posing as another cart-pole (docs/your_own_cartpole.md): its joint names, offsets and signs
   // (~cart_joint, ~pole_joint, ~cart_zero, ~cart_sign, ~pole_upright, ~pole_angle_sign), whole turns
   // added to the pole's reading (~pole_turns) and whether velocities are published.
   // (~effort_sign too: -1, a robot whose + effort pushes the cart toward -x.)

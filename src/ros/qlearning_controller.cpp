@@ -58,7 +58,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   setUpRobots(state_queue);
   if (settings_.protocol.reset_service)
   {
-    // README: the ~reset_service row.
+    // docs/nodes.md: the ~reset_service row.
     const auto give_up_after = resetGiveUpAfter(settings_.sim_timeout);
     for (Robot& robot : robots_)
       robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(settings_.reset_service),
