@@ -110,7 +110,18 @@ export GTEST_FILTER="-FileAccessTest.AProcessKilledMidSaveLeavesTheOldFileOrTheN
 echo "[sanitize] running the gtests and rostests under ASan + UBSan; reports go to $LOGS"
 # The gtests and rostests; not the launch file checks (Python only: nothing instrumented runs).
 SECONDS=0
-catkin_make "${ARGS[@]}" run_tests_cartpole_qlearning_gtest run_tests_cartpole_qlearning_rostest || true
+# Every rostest but four of the five robot profiles (the isaac one runs): in the plain run each
+# trains to solved and evaluates; here they would go over code that robot_profile_isaac,
+# robot_group_command, robot_position_only, decision_period, time_back and zero_effort* already
+# take under the sanitizers (Float64 commands, another state rate, offsets and signs, resets
+# that set time back), for about 80 s of CI's time.
+SKIPPED="robot_profile_gym_gazebo robot_profile_openai_ros robot_profile_invpend robot_profile_oskooo"
+TARGETS=(run_tests_cartpole_qlearning_gtest)
+for target in $(make -C "$BUILD" help | grep -o 'run_tests_cartpole_qlearning_rostest_test_[a-z0-9_]*\.test' | sort -u); do
+  name=${target#run_tests_cartpole_qlearning_rostest_test_}
+  case " $SKIPPED " in *" ${name%.test} "*) echo "[sanitize] not run here: ${name}" ;; *) TARGETS+=("$target") ;; esac
+done
+catkin_make "${ARGS[@]}" "${TARGETS[@]}" || true
 echo "[sanitize] ran in $SECONDS s"
 unset ASAN_OPTIONS LSAN_OPTIONS UBSAN_OPTIONS GTEST_FILTER
 
