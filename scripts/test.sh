@@ -9,6 +9,13 @@ trap 'echo "0 passed, 1 failed"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 set -eo pipefail
 cd "$CARTPOLE_WS"
+# failed_case FILE SUITE CASE MESSAGE: a JUnit file with one failed case, for a part of the run
+# that produced no results of its own (so that it counts as a failure, not as tests fewer).
+failed_case() {
+  mkdir -p "$(dirname "$1")"
+  printf '<?xml version="1.0" encoding="UTF-8"?>\n<testsuite name="%s" tests="1" failures="1" errors="0">\n  <testcase classname="%s" name="%s"><failure message="%s"/></testcase>\n</testsuite>\n' \
+    "$2" "$2" "$3" "$4" >"$1"
+}
 rm -rf build/test_results/cartpole_qlearning
 echo "[test] catkin_make tests (about 2 to 4 minutes), then run_tests (about 5 to 8 minutes); log in $CARTPOLE_WS/test.log"
 # A test that does not compile is a failure, not a test fewer.
@@ -47,13 +54,7 @@ if [ "${SANITIZE:-1}" != 0 ]; then
   if ! bash "$CARTPOLE_SRC/tools/sanitize.sh" "$CARTPOLE_WS/$sanitized" >"$CARTPOLE_WS/sanitize.log" 2>&1; then
     grep -E "error|Error" "$CARTPOLE_WS/sanitize.log" | head -n 20
     tail -n 10 "$CARTPOLE_WS/sanitize.log"
-    mkdir -p "$sanitized"
-    cat >"$sanitized/sanitized-build-failed.xml" <<XML
-<?xml version="1.0" encoding="UTF-8"?>
-<testsuite name="sanitized_build" tests="1" failures="1" errors="0">
-  <testcase classname="sanitize" name="build_asan_ubsan"><failure message="the sanitized build failed; see $CARTPOLE_WS/sanitize.log"/></testcase>
-</testsuite>
-XML
+    failed_case "$sanitized/sanitized-build-failed.xml" sanitized_build build_asan_ubsan "the sanitized build failed; see $CARTPOLE_WS/sanitize.log"
   fi
   grep -E "^\[sanitize\] (built|ran|[0-9]+ sanitizer report)" "$CARTPOLE_WS/sanitize.log" || true
   echo "[test] ASan + UBSan suite: $SECONDS s"
@@ -66,24 +67,14 @@ if [ "${FUZZ_SECONDS:-30}" -gt 0 ]; then
   grep -E "^\[fuzz\] .*(ok|FOUND|compiled)" "$CARTPOLE_WS/fuzz.log" || true
   if ! ls build/test_results/cartpole_qlearning/fuzz-*.xml >/dev/null 2>&1; then
     tail -n 20 "$CARTPOLE_WS/fuzz.log"
-    cat >build/test_results/cartpole_qlearning/fuzz-aborted.xml <<XML
-<?xml version="1.0" encoding="UTF-8"?>
-<testsuite name="fuzz" tests="1" failures="1" errors="0">
-  <testcase classname="fuzz" name="fuzz_script"><failure message="the fuzzers did not run; see $CARTPOLE_WS/fuzz.log"/></testcase>
-</testsuite>
-XML
+    failed_case build/test_results/cartpole_qlearning/fuzz-aborted.xml fuzz fuzz_script "the fuzzers did not run; see $CARTPOLE_WS/fuzz.log"
   fi
 fi
 if [ "${FIRST_HOUR:-1}" != 0 ]; then
   grep -E "^\[first-hour\] +([0-9.]+ s|[0-9]+ passed)" "$CARTPOLE_WS/first_hour.log" | grep -E "FAIL|passed" || true
   if [ ! -s build/test_results/cartpole_qlearning/first_hour.xml ]; then
     tail -n 30 "$CARTPOLE_WS/first_hour.log"
-    cat >build/test_results/cartpole_qlearning/first_hour-aborted.xml <<XML
-<?xml version="1.0" encoding="UTF-8"?>
-<testsuite name="first_hour" tests="1" failures="1" errors="0">
-  <testcase classname="first_hour" name="first_hour_script"><failure message="see $CARTPOLE_WS/first_hour.log"/></testcase>
-</testsuite>
-XML
+    failed_case build/test_results/cartpole_qlearning/first_hour-aborted.xml first_hour first_hour_script "see $CARTPOLE_WS/first_hour.log"
   fi
 fi
 if ! ls build/test_results/cartpole_qlearning/*.xml >/dev/null 2>&1; then
