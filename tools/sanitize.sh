@@ -62,7 +62,10 @@ strip_plain() { # VAR: removes the entries under $WS/devel from the :-separated 
 }
 for var in CMAKE_PREFIX_PATH LD_LIBRARY_PATH PKG_CONFIG_PATH PYTHONPATH; do strip_plain "$var"; done
 
-FLAGS="-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
+# Line tables only (-gline-tables-only), not full debug info: a report's frames still name the
+# function, file and line (all that suppressions and readers need), and the build is lighter
+# (about 10 % less compile time per file measured here, and smaller objects to link).
+FLAGS="-O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
 ARGS=(--build "$BUILD" -DCATKIN_DEVEL_PREFIX="$DEVEL" -DCMAKE_BUILD_TYPE=Sanitize "-DCMAKE_CXX_FLAGS=$FLAGS"
   -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE)
 [ -x /usr/bin/python3 ] && ARGS+=(-DPYTHON_EXECUTABLE=/usr/bin/python3)
@@ -115,7 +118,10 @@ SECONDS=0
 # robot_group_command, robot_position_only, decision_period, time_back and zero_effort* already
 # take under the sanitizers (Float64 commands, another state rate, offsets and signs, resets
 # that set time back), for about 80 s of CI's time.
-SKIPPED="robot_profile_gym_gazebo robot_profile_openai_ros robot_profile_invpend robot_profile_oskooo"
+# robust_train, likewise: a long training (about 40 s here) whose logic (the suite judged during
+# training, the best table kept) is the core's RunApplication, which core_tests take here; the
+# node's own suite run at the end of training happens in controller_train and perturbed_graph.
+SKIPPED="robot_profile_gym_gazebo robot_profile_openai_ros robot_profile_invpend robot_profile_oskooo robust_train"
 TARGETS=(run_tests_cartpole_qlearning_gtest)
 for target in $(make -C "$BUILD" help | grep -o 'run_tests_cartpole_qlearning_rostest_test_[a-z0-9_]*\.test' | sort -u); do
   name=${target#run_tests_cartpole_qlearning_rostest_test_}
