@@ -22,8 +22,10 @@ mkdir -p "$WORK"
 
 # The core's sources, as CMakeLists.txt lists them for the core library.
 mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_core/,/^)/p' "$SRC/CMakeLists.txt" | grep -o 'src/[a-z_]*\.cpp')
+# Line tables only (as tools/sanitize.sh): a report's frames still name function, file and line,
+# for about 10 % less compile time.
 # shellcheck disable=SC2054 # the commas belong to -fsanitize=...
-COMPILE=(-std=c++17 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
+COMPILE=(-std=c++17 -O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
   -I "$SRC/include" -isystem /usr/include/eigen3)
 # The core is compiled once, for every target (with coverage hooks: fuzzer-no-link), two sources at
 # a time; each target then compiles its own file and links with libFuzzer's main.
