@@ -2,11 +2,12 @@
 // it may include the standard library, POSIX, Eigen, yaml-cpp and the core's own headers, and
 // nothing else. Debian installs the ROS headers on the default include path, so a stray
 // #include <ros/ros.h> would still compile; this test is what stops it.
+#include "text_match.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -15,6 +16,7 @@
 namespace
 {
 namespace fs = std::filesystem;
+namespace text_match = cartpole_qlearning::test::text_match;
 
 const fs::path kSource = CARTPOLE_SOURCE_DIR;
 
@@ -24,22 +26,22 @@ template <typename CoreHeader>
 std::vector<std::string> foreignIncludes(const std::string& text, CoreHeader core_header)
 {
   // <vector>, <cstdint>; <unistd.h>, <sys/stat.h>; <Eigen/Core>; <yaml-cpp/yaml.h>
-  static const std::regex allowed_system(
-      R"(<([a-z_]+|[a-z_]+\.h|sys/[a-z_]+\.h|Eigen/[A-Za-z]+|yaml-cpp/[a-z_/]+\.h)>)");
-  static const std::regex include(R"re(^\s*#\s*include\s*([<"][^>"]*[>"]))re");
-  static const std::regex own(R"re("cartpole_qlearning/([a-z0-9_]+\.h)")re");
+  static const std::string allowed_system =
+      R"(<([a-z_]+|[a-z_]+\.h|sys/[a-z_]+\.h|Eigen/[A-Za-z]+|yaml-cpp/[a-z_/]+\.h)>)";
+  static const std::string include = R"re(^\s*#\s*include\s*([<"][^>"]*[>"]))re";
+  static const std::string own = R"re("cartpole_qlearning/([a-z0-9_]+\.h)")re";
   std::vector<std::string> foreign;
   std::istringstream lines(text);
   std::string line;
   for (int number = 1; std::getline(lines, line); ++number)
   {
-    std::smatch m;
-    if (!std::regex_search(line, m, include))
+    text_match::Groups m;
+    if (!text_match::contains(line, include, &m))
       continue;
     const std::string target = m[1];
-    std::smatch o;
-    const bool ok =
-        std::regex_match(target, allowed_system) || (std::regex_match(target, o, own) && core_header(o[1].str()));
+    text_match::Groups o;
+    const bool ok = text_match::matchesWhole(target, allowed_system) ||
+                    (text_match::matchesWhole(target, own, &o) && core_header(o[1]));
     if (!ok)
       foreign.push_back("line " + std::to_string(number) + ": " + line);
   }
@@ -106,10 +108,9 @@ std::set<std::string> layoutNames(const std::string& page, const std::string& fi
     return names;
   const std::string line = page.substr(row + 1, page.find('\n', row + 1) - row - 1);
   const std::string cells = line.substr(first_cell.size() + 4);
-  static const std::regex quoted("`([^`]+)`");
-  for (std::sregex_iterator it(cells.begin(), cells.end(), quoted), end; it != end; ++it)
+  for (const text_match::Groups& quoted : text_match::allMatches(cells, "`([^`]+)`"))
   {
-    const std::string name = (*it)[1];
+    const std::string& name = quoted[1];
     if (name.find('/') == std::string::npos && name.find('*') == std::string::npos)
       names.insert(name);
   }

@@ -2,6 +2,8 @@
 // for a link with #anchor into a Markdown page, that page has a heading with that anchor. The
 // pages move text between one another; a link left pointing at where the text was fails here.
 // Anchors are made the way GitHub makes them, since that is where users read the pages.
+#include "text_match.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,7 +11,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -18,6 +19,7 @@
 namespace
 {
 namespace fs = std::filesystem;
+namespace text_match = cartpole_qlearning::test::text_match;
 
 const fs::path kSource = CARTPOLE_SOURCE_DIR;
 
@@ -56,8 +58,8 @@ std::vector<std::string> proseLines(const std::string& text)
 // letters, which no heading here has; should one come, its links fail here rather than pass.
 std::string anchorOf(std::string heading)
 {
-  static const std::regex link(R"(!?\[([^\]]*)\]\([^)]*\))");
-  heading = std::regex_replace(heading, link, "$1");
+  static const std::string link = R"(!?\[([^\]]*)\]\([^)]*\))";
+  heading = text_match::replaceAll(heading, link, "$1");
   std::string anchor;
   for (const char c : heading)
   {
@@ -75,13 +77,13 @@ std::string anchorOf(std::string heading)
 // Every anchor a page's headings give, with GitHub's -1, -2, ... for repeated headings.
 std::set<std::string> anchorsOf(const std::string& text)
 {
-  static const std::regex heading(R"(^#{1,6}\s+(.*?)\s*#*\s*$)");
+  static const std::string heading = R"(^#{1,6}\s+(.*?)\s*#*\s*$)";
   std::set<std::string> anchors;
   std::map<std::string, int> seen;
   for (const std::string& line : proseLines(text))
   {
-    std::smatch m;
-    if (!std::regex_match(line, m, heading))
+    text_match::Groups m;
+    if (!text_match::matchesWhole(line, heading, &m))
       continue;
     const std::string anchor = anchorOf(m[1]);
     const int n = seen[anchor]++;
@@ -94,19 +96,19 @@ std::set<std::string> anchorsOf(const std::string& text)
 // href of HTML tags. Code spans are left out first: `[a](b)` there is an example, not a link.
 std::vector<std::string> linksOf(const std::string& text)
 {
-  static const std::regex code_span("`[^`]*`");
-  static const std::regex inline_link(R"re(\]\(\s*<?([^)\s>]+)>?(?:\s+"[^"]*")?\s*\))re");
-  static const std::regex reference(R"(^\s*\[[^\]]+\]:\s*(\S+))");
-  static const std::regex html(R"re(\b(?:src|href)\s*=\s*"([^"]+)")re");
+  static const std::string code_span = "`[^`]*`";
+  static const std::string inline_link = R"re(\]\(\s*<?([^)\s>]+)>?(?:\s+"[^"]*")?\s*\))re";
+  static const std::string reference = R"(^\s*\[[^\]]+\]:\s*(\S+))";
+  static const std::string html = R"re(\b(?:src|href)\s*=\s*"([^"]+)")re";
   std::vector<std::string> links;
   for (const std::string& raw : proseLines(text))
   {
-    const std::string line = std::regex_replace(raw, code_span, "``");
-    for (const std::regex* pattern : {&inline_link, &html})
-      for (std::sregex_iterator it(line.begin(), line.end(), *pattern), end; it != end; ++it)
-        links.push_back((*it)[1]);
-    std::smatch m;
-    if (std::regex_search(line, m, reference))
+    const std::string line = text_match::replaceAll(raw, code_span, "``");
+    for (const std::string* pattern : {&inline_link, &html})
+      for (const text_match::Groups& link : text_match::allMatches(line, *pattern))
+        links.push_back(link[1]);
+    text_match::Groups m;
+    if (text_match::contains(line, reference, &m))
       links.push_back(m[1]);
   }
   return links;
@@ -114,8 +116,7 @@ std::vector<std::string> linksOf(const std::string& text)
 
 bool isExternal(const std::string& target)
 {
-  static const std::regex scheme("^[a-zA-Z][a-zA-Z0-9+.-]*:");
-  return std::regex_search(target, scheme);
+  return text_match::contains(target, "^[a-zA-Z][a-zA-Z0-9+.-]*:");
 }
 
 // What is wrong with one relative link of `page`, or "" when it leads somewhere.

@@ -5,18 +5,20 @@
 // is gone, fails here with the names.
 #include "cartpole_qlearning/node_settings.h"
 
+#include "text_match.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <iterator>
 #include <memory>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
 using namespace cartpole_qlearning;
+namespace text_match = cartpole_qlearning::test::text_match;
 
 namespace
 {
@@ -83,9 +85,8 @@ std::set<std::string> rosLayerReads(const std::string& source_file)
   const std::string text = fileText(std::string(CARTPOLE_SOURCE_DIR) + "/" + source_file);
   EXPECT_FALSE(text.empty()) << source_file;
   std::set<std::string> keys;
-  const std::regex read(R"(pnh_\.(?:getParam|param)\s*\(\s*"([^"]+)\")");
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), read); it != std::sregex_iterator(); ++it)
-    keys.insert((*it)[1].str());
+  for (const text_match::Groups& read : text_match::allMatches(text, R"(pnh_\.(?:getParam|param)\s*\(\s*"([^"]+)\")"))
+    keys.insert(read[1]);
   return keys;
 }
 
@@ -97,16 +98,16 @@ std::set<std::string> documentedParameters(const std::string& page, const std::s
   std::string line;
   bool in_node = false;
   bool in_parameters = false;
-  const std::regex item(R"(^- `~([A-Za-z0-9_/]+)` \()");
+  const std::string item = R"(^- `~([A-Za-z0-9_/]+)` \()";
   while (std::getline(in, line))
   {
     if (line.rfind("## ", 0) == 0)
       in_node = line == "## " + node;
     if (line.rfind("### ", 0) == 0 || line.rfind("## ", 0) == 0)
       in_parameters = in_node && line == "### Parameters";
-    std::smatch match;
-    if (in_parameters && std::regex_search(line, match, item))
-      names.insert(match[1].str());
+    text_match::Groups match;
+    if (in_parameters && text_match::contains(line, item, &match))
+      names.insert(match[1]);
   }
   return names;
 }

@@ -5,12 +5,12 @@
 // a suite and gives the verdict train_headless --evaluate TABLE --suite FILE gives for it.
 #include "ros_test_support.h"
 #include "test_support.h"
+#include "text_match.h"
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <filesystem>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -19,6 +19,7 @@ using cartpole_qlearning::test::CommandRun;
 using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::runCommand;
 using cartpole_qlearning::test::TrainLaunch;
+namespace text_match = cartpole_qlearning::test::text_match;
 
 namespace
 {
@@ -76,9 +77,8 @@ TEST(PerturbedGraph, EvaluateLaunchPosingAsASuiteCaseGivesTheHeadlessVerdict)
   // train_headless's row of the case: "everything  B/20  19  R  pass|FAIL".
   const CommandRun headless = trainHeadless(home, "--ns evaluate --evaluate q_table.yaml --suite " + suite);
   ASSERT_EQ(0, headless.status) << headless.output;
-  std::smatch row;
-  ASSERT_TRUE(
-      std::regex_search(headless.output, row, std::regex("\\neverything +([0-9]+)/20 +19 +([0-9.]+) +(pass|FAIL)\\n")))
+  text_match::Groups row;
+  ASSERT_TRUE(text_match::contains(headless.output, "\\neverything +([0-9]+)/20 +19 +([0-9.]+) +(pass|FAIL)\\n", &row))
       << headless.output;
 
   // The graph, in lockstep, with the suite's seed and episodes (evaluate.launch's defaults for a case).
@@ -87,16 +87,16 @@ TEST(PerturbedGraph, EvaluateLaunchPosingAsASuiteCaseGivesTheHeadlessVerdict)
   ASSERT_EQ(0, launch.waitFor(90.0)) << launch.output();
   const std::string output = launch.output();
   EXPECT_NE(std::string::npos, output.find("cartpole_sim: posing as case everything of " + suite)) << output;
-  std::smatch verdict;
-  ASSERT_TRUE(
-      std::regex_search(output, verdict,
-                        std::regex("EVALUATED 20 episodes: ([0-9]+) balanced to the step limit \\(500 steps\\), "
+  text_match::Groups verdict;
+  ASSERT_TRUE(text_match::contains(output,
+                                   "EVALUATED 20 episodes: ([0-9]+) balanced to the step limit \\(500 steps\\), "
                                    "mean return ([0-9.]+); case everything of [^:]+: (PASSED|FAILED) "
-                                   "\\(needs 19\\)")))
+                                   "\\(needs 19\\)",
+                                   &verdict))
       << output;
-  EXPECT_EQ(row[1].str(), verdict[1].str()) << "balanced episodes";
-  EXPECT_EQ(row[2].str(), verdict[2].str()) << "mean return";
-  EXPECT_EQ(row[3] == "pass" ? "PASSED" : "FAILED", verdict[3].str());
+  EXPECT_EQ(row[1], verdict[1]) << "balanced episodes";
+  EXPECT_EQ(row[2], verdict[2]) << "mean return";
+  EXPECT_EQ(row[3] == "pass" ? "PASSED" : "FAILED", verdict[3]);
   // The case is no walkover for seed 0's default table (6 of 20 when this was written): the
   // episodes that agree are of both kinds.
   EXPECT_LT(std::stoul(row[1]), 20u);

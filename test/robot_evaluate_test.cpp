@@ -6,17 +6,18 @@
 // stay below max_return, so that the first result is the setting's doing.
 #include "ros_test_support.h"
 #include "test_support.h"
+#include "text_match.h"
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <filesystem>
-#include <regex>
 #include <string>
 
 using cartpole_qlearning::test::privateParam;
 using cartpole_qlearning::test::runCommand;
 using cartpole_qlearning::test::TrainLaunch;
+namespace text_match = cartpole_qlearning::test::text_match;
 
 namespace
 {
@@ -34,15 +35,16 @@ double evaluate(const std::string& home, const std::string& name, const std::str
   const int status = launch.waitFor(90.0);
   const std::string output = launch.output();
   EXPECT_EQ(0, status) << output;
-  std::smatch m;
-  if (!std::regex_search(output, m,
-                         std::regex("EVALUATED 5 episodes: [0-9]+ balanced to the step limit \\(500 steps\\), "
-                                    "mean return ([0-9.]+)")))
+  text_match::Groups m;
+  if (!text_match::contains(output,
+                            "EVALUATED 5 episodes: [0-9]+ balanced to the step limit \\(500 steps\\), "
+                            "mean return ([0-9.]+)",
+                            &m))
   {
     ADD_FAILURE() << output;
     return -1.0;
   }
-  std::printf("%s: %s\n", name.c_str(), m[0].str().c_str());
+  std::printf("%s: %s\n", name.c_str(), m[0].c_str());
   return std::stod(m[1]);
 }
 }  // namespace

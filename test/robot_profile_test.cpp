@@ -8,13 +8,13 @@
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "ros_test_support.h"
 #include "test_support.h"
+#include "text_match.h"
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <filesystem>
 #include <map>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -23,6 +23,7 @@ using cartpole_qlearning::test::pidOf;
 using cartpole_qlearning::test::privateParam;
 using cartpole_qlearning::test::spinUntil;
 using cartpole_qlearning::test::TrainLaunch;
+namespace text_match = cartpole_qlearning::test::text_match;
 
 namespace
 {
@@ -64,27 +65,27 @@ TEST(RobotProfile, TrainsUntilSolvedThenTheTableIsEvaluated)
   const int status = evaluation.waitFor(120.0);
   const std::string output = evaluation.output();
   ASSERT_EQ(0, status) << output;
-  std::smatch verdict;
-  ASSERT_TRUE(
-      std::regex_search(output, verdict,
-                        std::regex("EVALUATED 10 episodes: ([0-9]+) balanced to the step limit \\(500 steps\\), "
-                                   "mean return ([0-9.]+)")))
+  text_match::Groups verdict;
+  ASSERT_TRUE(text_match::contains(output,
+                                   "EVALUATED 10 episodes: ([0-9]+) balanced to the step limit \\(500 steps\\), "
+                                   "mean return ([0-9.]+)",
+                                   &verdict))
       << output;
-  std::printf("%s: %s\n", robot.c_str(), verdict[0].str().c_str());
+  std::printf("%s: %s\n", robot.c_str(), verdict[0].c_str());
   // The verdict is the ten episodes the evaluation printed: the same count balanced, the same mean return.
   std::map<unsigned, std::pair<unsigned, double>> episodes;  // episode -> steps, return
   unsigned balanced = 0;
   double returns = 0.0;
-  const std::regex line("evaluation episode ([0-9]+): ([0-9]+) steps, return ([0-9.-]+), (fell|balanced)");
-  for (auto it = std::sregex_iterator(output.begin(), output.end(), line); it != std::sregex_iterator(); ++it)
+  for (const text_match::Groups& line : text_match::allMatches(
+           output, "evaluation episode ([0-9]+): ([0-9]+) steps, return ([0-9.-]+), (fell|balanced)"))
   {
-    episodes[std::stoul((*it)[1].str())] = {std::stoul((*it)[2].str()), std::stod((*it)[3].str())};
-    balanced += (*it)[4].str() == "balanced";
-    returns += std::stod((*it)[3].str());
+    episodes[std::stoul(line[1])] = {std::stoul(line[2]), std::stod(line[3])};
+    balanced += line[4] == "balanced";
+    returns += std::stod(line[3]);
   }
   ASSERT_EQ(10u, episodes.size()) << output;
-  EXPECT_EQ(std::to_string(balanced), verdict[1].str());
-  EXPECT_NEAR(returns / 10.0, std::stod(verdict[2].str()), 0.051);
+  EXPECT_EQ(std::to_string(balanced), verdict[1]);
+  EXPECT_NEAR(returns / 10.0, std::stod(verdict[2]), 0.051);
   // And what episode_stats published: greedy, the same episodes. (The first ones may be gone: this node
   // subscribes to the evaluation's controller only once it has started.)
   spinUntil([&] { return stats.size() >= 10u; }, 5.0);

@@ -2,10 +2,11 @@
 // and redoes its arithmetic: shared by the tests of train_headless and of the controller.
 #pragma once
 
+#include "text_match.h"
+
 #include <cmath>
 #include <cstdlib>
 #include <map>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -47,23 +48,23 @@ class TraceReading
 public:
   TraceReading(const std::string& text, const std::vector<std::string>& names) : names_(names)
   {
-    static const std::regex update(
+    static const std::string update =
         "episode ([0-9]+) step ([0-9]+): (.+) --A([0-9]+) \\([^)]*\\)--> (.+?)( \\(terminal\\)| \\(truncated\\))?, "
         "r = (\\S+); target = (?:(\\S+) \\+ (\\S+) \\* (\\S+) = (\\S+)|(\\S+) \\(no future\\)); "
-        "Q\\((.+), A([0-9]+)\\) = (\\S+) \\+ (\\S+) \\* \\((\\S+) - (\\S+)\\) = (\\S+)$");
-    static const std::regex title("Q-table after (.*):$");
+        "Q\\((.+), A([0-9]+)\\) = (\\S+) \\+ (\\S+) \\* \\((\\S+) - (\\S+)\\) = (\\S+)$";
+    static const std::string title = "Q-table after (.*):$";
     std::istringstream in(text);
     std::string line;
     TracedTable* table = nullptr;
-    static const std::regex colour("\x1b\\[[0-9;]*m");  // rosconsole's, around each message
+    static const std::string colour = "\x1b\\[[0-9;]*m";  // rosconsole's, around each message
     while (std::getline(in, line))
     {
-      line = std::regex_replace(line, colour, "");
-      std::smatch m;
+      line = text_match::replaceAll(line, colour, "");
+      text_match::Groups m;
       if (table != nullptr && readRow(line, *table))
         continue;
       table = nullptr;
-      if (std::regex_search(line, m, update))
+      if (text_match::contains(line, update, &m))
       {
         TracedUpdate u;
         u.episode = std::stoul(m[1]);
@@ -75,18 +76,19 @@ public:
         u.reward = m[7];
         u.gamma = bare(m[9]);
         u.next_max = bare(m[10]);
-        u.target = m[11].matched ? std::string(m[11]) : std::string(m[12]);
+        // Groups 8 and 11 are (\S+), never empty when they take part: empty means the other branch matched.
+        u.target = !m[11].empty() ? m[11] : m[12];
         if (m[13] != u.state || std::stoul(m[14]) != u.action || m[15] != bare(m[18]) || m[17] != u.target)
           errors.push_back("a line whose parts disagree: " + line);
         u.old_value = m[15];
         u.alpha = bare(m[16]);
         u.new_value = m[19];
-        if (m[8].matched && m[8] != u.reward)
+        if (!m[8].empty() && m[8] != u.reward)
           errors.push_back("target's reward is not the step's: " + line);
         updates.push_back(u);
         order.push_back('u');
       }
-      else if (std::regex_search(line, m, title))
+      else if (text_match::contains(line, title, &m))
       {
         tables.push_back(TracedTable{m[1], {}});
         table = &tables.back();

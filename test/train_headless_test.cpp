@@ -9,6 +9,7 @@
 
 #include "test_support.h"
 #include "trace_check.h"
+#include "text_match.h"
 
 #include <gtest/gtest.h>
 
@@ -18,7 +19,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -36,6 +36,7 @@ using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::processGone;
 using cartpole_qlearning::test::runCommand;
 using cartpole_qlearning::test::TraceReading;
+namespace text_match = cartpole_qlearning::test::text_match;
 
 namespace
 {
@@ -95,8 +96,8 @@ protected:
   // The run folder a run's output names ("run runs/...: checkpoints go to ..."), "" if none.
   static std::string runFolder(const std::string& output)
   {
-    std::smatch match;
-    return std::regex_search(output, match, std::regex("run (runs/[^ :]+): checkpoints go to")) ? match[1].str() : "";
+    text_match::Groups match;
+    return text_match::contains(output, "run (runs/[^ :]+): checkpoints go to", &match) ? match[1] : "";
   }
   // A config that trains until stopped (1,000,000 episodes, not stopping when solved).
   std::string endlessConfig() const
@@ -135,7 +136,7 @@ TEST_F(TrainHeadlessTest, SolvesAndEndsWithTheResultLine)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0");
   EXPECT_EQ(0, run.status) << run.output;
-  EXPECT_TRUE(std::regex_match(run.lastLine(), std::regex("solved=true episodes=[0-9]+ steps=[0-9]+ wall_s=[0-9.]+")))
+  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "solved=true episodes=[0-9]+ steps=[0-9]+ wall_s=[0-9.]+"))
       << run.lastLine();
   // Progress lines come before it.
   EXPECT_NE(std::string::npos, run.output.find("mean_return_100")) << run.output;
@@ -159,10 +160,9 @@ TEST_F(TrainHeadlessTest, QuietKeepsTheRobustnessOfTheSavedTableBesideTheResultL
   EXPECT_EQ(0, run.status) << run.output;
   // What the table is worth (a table of 5 episodes falls everywhere), then the result line; no
   // progress line, no other line of the suite.
-  std::smatch worth;
-  EXPECT_TRUE(std::regex_search(run.output, worth,
-                                std::regex("(^|\n)robustness of the saved table: nominal [0-9]+/100, one_step_late "
-                                           "[0-9]+/100, .*all_at_once [0-9]+/100: FAILED\nsolved=false episodes=5 ")))
+  EXPECT_TRUE(text_match::contains(run.output,
+                                   "(^|\n)robustness of the saved table: nominal [0-9]+/100, one_step_late "
+                                   "[0-9]+/100, .*all_at_once [0-9]+/100: FAILED\nsolved=false episodes=5 "))
       << run.output;
   EXPECT_EQ(0u, run.lastLine().find("solved=false episodes=5 ")) << run.output;
   EXPECT_EQ(std::string::npos, run.output.find("robustness at episode")) << run.output;
@@ -282,10 +282,9 @@ TEST_F(TrainHeadlessTest, EvaluateRunsATableGreedilyAndEndsWithItsVerdict)
   const auto before = written();
   const CommandRun trained = trainHeadless(config() + " --evaluate trained.yaml --episodes 20");
   ASSERT_EQ(0, trained.status) << trained.output;
-  std::smatch verdict;
+  text_match::Groups verdict;
   const std::string last = trained.lastLine();
-  ASSERT_TRUE(std::regex_match(last, verdict, std::regex("evaluated=20 balanced=([0-9]+) mean_return=([0-9.]+)")))
-      << last;
+  ASSERT_TRUE(text_match::matchesWhole(last, "evaluated=20 balanced=([0-9]+) mean_return=([0-9.]+)", &verdict)) << last;
   // Seed 0's table balanced 19 of these 20 when this was written.
   EXPECT_GE(std::stoul(verdict[1]), 15u) << trained.output;
   EXPECT_GT(std::stod(verdict[2]), 450.0) << trained.output;
@@ -305,7 +304,7 @@ TEST_F(TrainHeadlessTest, EvaluateRunsATableGreedilyAndEndsWithItsVerdict)
   const CommandRun falls = trainHeadless(config() + " --quiet --evaluate " + zeros + " --episodes 10");
   ASSERT_EQ(0, falls.status) << falls.output;
   const std::string fell = falls.lastLine();
-  ASSERT_TRUE(std::regex_match(fell, verdict, std::regex("evaluated=10 balanced=0 mean_return=([0-9.]+)"))) << fell;
+  ASSERT_TRUE(text_match::matchesWhole(fell, "evaluated=10 balanced=0 mean_return=([0-9.]+)", &verdict)) << fell;
   EXPECT_LT(std::stod(verdict[1]), 100.0);
 }
 
@@ -349,7 +348,7 @@ TEST_F(TrainHeadlessTest, EvaluateOnASuitePrintsEachCaseAndEndsWithTheSuitesVerd
   const std::string easy = file("easy.yaml", "episodes: 5\ncases:\n  - {name: nominal, pass: 0}\n");
   const CommandRun passes = trainHeadless(config() + " --evaluate trained.yaml --suite " + easy);
   ASSERT_EQ(0, passes.status) << passes.output;
-  EXPECT_TRUE(std::regex_match(passes.lastLine(), std::regex("suite=PASSED cases=1 passed=1 worst=[0-5]/5")))
+  EXPECT_TRUE(text_match::matchesWhole(passes.lastLine(), "suite=PASSED cases=1 passed=1 worst=[0-5]/5"))
       << passes.lastLine();
 }
 
@@ -393,18 +392,18 @@ TEST_F(TrainHeadlessTest, LoadTrainsFurtherFromTheTablesCounters)
                                                   " (30 episodes, " + std::to_string(table.steps) + " steps"))
       << loaded.output;
   // Ten more episodes, numbered on from 31; the steps add up from the table's (+1 a step).
-  std::smatch result;
+  text_match::Groups result;
   const std::string last = loaded.lastLine();
-  ASSERT_TRUE(std::regex_match(last, result, std::regex("solved=false episodes=40 steps=([0-9]+) wall_s=.*"))) << last;
-  std::smatch returns;
-  ASSERT_TRUE(std::regex_search(loaded.output, returns, std::regex("returns=([0-9 ]+)\n"))) << loaded.output;
-  std::istringstream values(returns[1].str());
+  ASSERT_TRUE(text_match::matchesWhole(last, "solved=false episodes=40 steps=([0-9]+) wall_s=.*", &result)) << last;
+  text_match::Groups returns;
+  ASSERT_TRUE(text_match::contains(loaded.output, "returns=([0-9 ]+)\n", &returns)) << loaded.output;
+  std::istringstream values(returns[1]);
   const std::vector<double> more{std::istream_iterator<double>(values), std::istream_iterator<double>()};
   ASSERT_EQ(10u, more.size());
   double sum = 0.0;
   for (const double r : more)
     sum += r;
-  EXPECT_EQ(static_cast<double>(table.steps) + sum, std::stod(result[1].str()));
+  EXPECT_EQ(static_cast<double>(table.steps) + sum, std::stod(result[1]));
   EXPECT_EQ((std::vector<unsigned long>{31, 32, 33, 34, 35, 36, 37, 38, 39, 40}), curveEpisodes(curve));
 
   // A table at or past --max-episodes has nothing to train.
@@ -439,9 +438,9 @@ TEST_F(TrainHeadlessTest, TheStatsCsvHasOneRowPerEpisodeEndingWhereTheResultLine
   const std::string csv = file("curve/episodes.csv");  // a folder that does not exist yet
   const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --stats-csv " + csv);
   ASSERT_EQ(0, run.status) << run.output;
-  std::smatch result;
+  text_match::Groups result;
   const std::string last = run.lastLine();
-  ASSERT_TRUE(std::regex_match(last, result, std::regex("solved=true episodes=([0-9]+) steps=([0-9]+) wall_s=.*")))
+  ASSERT_TRUE(text_match::matchesWhole(last, "solved=true episodes=([0-9]+) steps=([0-9]+) wall_s=.*", &result))
       << last;
   const unsigned long episodes = std::stoul(result[1]);
   const unsigned long steps = std::stoul(result[2]);
@@ -492,15 +491,14 @@ TEST_F(TrainHeadlessTest, UnsolvedRunSaysSo)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
   EXPECT_EQ(0, run.status);
-  EXPECT_TRUE(std::regex_match(run.lastLine(), std::regex("solved=false episodes=5 steps=[0-9]+ wall_s=[0-9.]+")))
+  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "solved=false episodes=5 steps=[0-9]+ wall_s=[0-9.]+"))
       << run.lastLine();
 }
 
 TEST_F(TrainHeadlessTest, WallTimeHasMicrosecondsSoAFewMillisecondsCanBeRead)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
-  EXPECT_TRUE(
-      std::regex_match(run.lastLine(), std::regex("solved=false episodes=5 steps=[0-9]+ wall_s=[0-9]+\\.[0-9]{6}")))
+  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "solved=false episodes=5 steps=[0-9]+ wall_s=[0-9]+\\.[0-9]{6}"))
       << run.lastLine();
 }
 
@@ -508,20 +506,20 @@ TEST_F(TrainHeadlessTest, ReturnsListsEveryEpisodesReturnBeforeTheResultLine)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 7 --returns");
   EXPECT_EQ(0, run.status) << run.output;
-  std::smatch result;
+  text_match::Groups result;
   const std::string last = run.lastLine();
-  ASSERT_TRUE(std::regex_match(last, result, std::regex("solved=false episodes=7 steps=([0-9]+) wall_s=[0-9.]+")))
+  ASSERT_TRUE(text_match::matchesWhole(last, "solved=false episodes=7 steps=([0-9]+) wall_s=[0-9.]+", &result))
       << run.output;
-  std::smatch returns;
-  ASSERT_TRUE(std::regex_search(run.output, returns, std::regex("returns=([0-9 ]+)\n"))) << run.output;
-  std::istringstream values(returns[1].str());
+  text_match::Groups returns;
+  ASSERT_TRUE(text_match::contains(run.output, "returns=([0-9 ]+)\n", &returns)) << run.output;
+  std::istringstream values(returns[1]);
   std::vector<double> episode_returns{std::istream_iterator<double>(values), std::istream_iterator<double>()};
   ASSERT_EQ(7u, episode_returns.size()) << returns[1];
   // The default reward is +1 a step, so the returns add up to the steps run.
   double sum = 0.0;
   for (const double r : episode_returns)
     sum += r;
-  EXPECT_EQ(std::stod(result[1].str()), sum);
+  EXPECT_EQ(std::stod(result[1]), sum);
 
   const CommandRun without = trainHeadless(config() + " --seed 0 --quiet --max-episodes 7");
   EXPECT_EQ(std::string::npos, without.output.find("returns=")) << without.output;
@@ -568,7 +566,7 @@ TEST_F(TrainHeadlessTest, BadArgumentsAreRefusedNamingThem)
     const CommandRun run = trainHeadless(config() + " " + c.first);
     EXPECT_EQ(2, run.status) << c.first << ": " << run.output;
     EXPECT_NE(std::string::npos, run.output.find("train_headless: " + c.second)) << c.first << ": " << run.output;
-    EXPECT_FALSE(std::regex_search(run.output, std::regex("solved=(true|false) episodes=[0-9]"))) << run.output;
+    EXPECT_FALSE(text_match::contains(run.output, "solved=(true|false) episodes=[0-9]")) << run.output;
   }
   EXPECT_EQ(std::vector<std::string>(), written());
   const CommandRun help = trainHeadless("--help");
@@ -647,7 +645,7 @@ TEST_P(TrainHeadlessStopTest, AStoppedRunGoesOnWithResume)
       << resumed.output;
   // (It may end solved: the last 100 episodes of so long a run balance.)
   EXPECT_TRUE(
-      std::regex_match(resumed.lastLine(), std::regex("solved=(true|false) episodes=" + std::to_string(until) + " .*")))
+      text_match::matchesWhole(resumed.lastLine(), "solved=(true|false) episodes=" + std::to_string(until) + " .*"))
       << resumed.output;
   const cartpole_qlearning::QTable table =
       cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string());
@@ -707,7 +705,7 @@ TEST_F(TrainHeadlessTest, ResumeCountsMaxEpisodesFromTheCheckpointTableNotTheRec
   // One more allowed: it trains exactly one, from the table's count.
   const CommandRun more = trainHeadless(endlessConfig() + " --resume " + folder + " --max-episodes 41 --quiet");
   EXPECT_EQ(0, more.status) << more.output;
-  EXPECT_TRUE(std::regex_search(more.lastLine(), std::regex("^solved=(true|false) episodes=41 "))) << more.output;
+  EXPECT_TRUE(text_match::contains(more.lastLine(), "^solved=(true|false) episodes=41 ")) << more.output;
 }
 
 // Several robots are named as train.launch robots:=N names their namespaces, as the node logs.
@@ -717,7 +715,7 @@ TEST_F(TrainHeadlessTest, TheTraceNamesRobotsByTheirNamespaces)
   ASSERT_EQ(0, run.status) << run.output;
   EXPECT_NE(std::string::npos, run.output.find("\nrobot_0: episode 1 step 1: ")) << run.output;
   EXPECT_NE(std::string::npos, run.output.find("\nrobot_1: episode 1 step 1: ")) << run.output;
-  EXPECT_TRUE(std::regex_search(run.output, std::regex("\nQ-table after robot_[01]'s episode 1 \\(1 in all\\):\n")))
+  EXPECT_TRUE(text_match::contains(run.output, "\nQ-table after robot_[01]'s episode 1 \\(1 in all\\):\n"))
       << run.output;
 }
 
