@@ -17,7 +17,7 @@ failed_case() {
     "$2" "$2" "$3" "$4" >"$1"
 }
 rm -rf build/test_results/cartpole_qlearning
-echo "[test] catkin_make tests (about 2 to 4 minutes), then run_tests (about 5 to 8 minutes); log in $CARTPOLE_WS/test.log"
+echo "[test] catkin_make tests (about 2 minutes on 2 cores), then run_tests (about 3 minutes); log in $CARTPOLE_WS/test.log"
 # A test that does not compile is a failure, not a test fewer.
 if ! catkin_make tests -DCMAKE_BUILD_TYPE=Release >"$CARTPOLE_WS/test.log" 2>&1; then
   grep -E "error|Error" "$CARTPOLE_WS/test.log" | head -n 20
@@ -35,7 +35,7 @@ catkin_make run_tests -DCMAKE_BUILD_TYPE=Release "-j${TEST_JOBS:-3}" >>"$CARTPOL
 # failed test. Both run beside the sanitized suite (they share nothing with it: other home,
 # workspace, master and ports), which overlaps one's builds with the other's waits.
 # FIRST_HOUR=0 and FUZZ_SECONDS=0 skip them.
-echo "[test] beside the sanitized suite: the README's and docs' commands in a fresh home (tools/first_hour.sh, about 6 to 10 minutes; log in $CARTPOLE_WS/first_hour.log), then fuzzing the table file and config parsers (${FUZZ_SECONDS:-30} s each; log in $CARTPOLE_WS/fuzz.log)"
+echo "[test] beside the sanitized suite: the README's and docs' commands in a fresh home (tools/first_hour.sh, about 5 minutes; log in $CARTPOLE_WS/first_hour.log), then fuzzing the table file and config parsers (${FUZZ_SECONDS:-30} s each; log in $CARTPOLE_WS/fuzz.log)"
 (
   if [ "${FIRST_HOUR:-1}" != 0 ]; then
     bash "$CARTPOLE_SRC/tools/first_hour.sh" build/test_results/cartpole_qlearning >"$CARTPOLE_WS/first_hour.log" 2>&1 || true
@@ -50,7 +50,7 @@ beside_pid=$!
 # devel_sanitize/. Its results join these as sanitized/sanitized-*.xml, with one case per
 # sanitizer report that any process wrote. SANITIZE=0 skips it.
 if [ "${SANITIZE:-1}" != 0 ]; then
-  echo "[test] the whole suite again under ASan + UBSan: build and run, about 4 to 8 minutes; log in $CARTPOLE_WS/sanitize.log"
+  echo "[test] the whole suite again under ASan + UBSan: build and run, about 8 minutes; log in $CARTPOLE_WS/sanitize.log"
   sanitized=build/test_results/cartpole_qlearning/sanitized
   SECONDS=0
   if ! bash "$CARTPOLE_SRC/tools/sanitize.sh" "$CARTPOLE_WS/$sanitized" >"$CARTPOLE_WS/sanitize.log" 2>&1; then
