@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Builds the whole package and every test (nodes, nodelet library, train_headless, gtests and
-# rostests) with clang-14's AddressSanitizer (with LeakSanitizer) and UndefinedBehaviorSanitizer
-# in a build and devel space of their own beside the plain ones ($WS/build_sanitize,
-# $WS/devel_sanitize), and runs the gtests and rostests there. Any sanitizer report, in a test or
-# in a node that roslaunch started, fails the run.
+# Builds the whole package and its tests (nodes, nodelet library, train_headless, gtests and
+# rostests, but for the five long trainings: see ARGS below) with clang-14's AddressSanitizer
+# (with LeakSanitizer) and UndefinedBehaviorSanitizer in a build and devel space of their own
+# beside the plain ones ($WS/build_sanitize, $WS/devel_sanitize), and runs those tests there
+# (gtests, rostests, launch file checks). Any sanitizer report, in a test or in a node that
+# roslaunch started, fails the run.
 #
 # usage: bash tools/sanitize.sh [RESULTS_DIR]
 #   The workspace is the one scripts/setup.sh chose (CARTPOLE_WS, or the one this clone is in);
