@@ -2,6 +2,7 @@
 // for a link with #anchor into a Markdown page, that page has a heading with that anchor. The
 // pages move text between one another; a link left pointing at where the text was fails here.
 // Anchors are made the way GitHub makes them, since that is where users read the pages.
+#include "test_support.h"
 #include "text_match.h"
 
 #include <gtest/gtest.h>
@@ -19,17 +20,10 @@
 namespace
 {
 namespace fs = std::filesystem;
+using cartpole_qlearning::test::fileText;
 namespace text_match = cartpole_qlearning::test::text_match;
 
 const fs::path kSource = CARTPOLE_SOURCE_DIR;
-
-std::string readText(const fs::path& path)
-{
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 // The lines of a page outside fenced code blocks: a "[x](y)" or "# x" inside a block of
 // commands or output is not Markdown.
@@ -130,7 +124,7 @@ std::string brokenBecause(const fs::path& page, const std::string& target)
     return "no such file: " + fs::relative(file.lexically_normal(), kSource).string();
   if (anchor.empty() || file.extension() != ".md")
     return "";
-  if (anchorsOf(readText(file)).count(anchor) == 0)
+  if (anchorsOf(fileText(file)).count(anchor) == 0)
     return "no heading in " + fs::relative(file.lexically_normal(), kSource).string() + " gives #" + anchor;
   return "";
 }
@@ -176,7 +170,7 @@ TEST(DocsLinksTest, EveryRelativeLinkInTheReadmeAndDocsLeadsSomewhere)
   std::size_t checked = 0;
   for (const fs::path& page : pages())
   {
-    for (const std::string& target : linksOf(readText(page)))
+    for (const std::string& target : linksOf(fileText(page)))
     {
       if (isExternal(target))
         continue;
@@ -195,7 +189,7 @@ TEST(DocsLinksTest, EveryDocsPageLinksBackToTheReadme)
   {
     if (page.filename() == "README.md")
       continue;
-    const std::vector<std::string> links = linksOf(readText(page));
+    const std::vector<std::string> links = linksOf(fileText(page));
     const bool back =
         std::any_of(links.begin(), links.end(), [](const std::string& l) { return l.rfind("../README.md", 0) == 0; });
     EXPECT_TRUE(back) << fs::relative(page, kSource).string() << " has no link back to ../README.md";

@@ -5,6 +5,7 @@
 // is gone, fails here with the names.
 #include "cartpole_qlearning/node_settings.h"
 
+#include "test_support.h"
 #include "text_match.h"
 
 #include <gtest/gtest.h>
@@ -18,6 +19,7 @@
 #include <vector>
 
 using namespace cartpole_qlearning;
+using cartpole_qlearning::test::fileText;
 namespace text_match = cartpole_qlearning::test::text_match;
 
 namespace
@@ -72,12 +74,6 @@ private:
   std::unique_ptr<ParameterSource> inner_;
   std::set<std::string>& asked_;
 };
-
-std::string fileText(const std::string& path)
-{
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 // The private keys a ROS-layer source reads itself: pnh_.getParam("KEY", ...) and pnh_.param("KEY", ...).
 std::set<std::string> rosLayerReads(const std::string& source_file)

@@ -12,6 +12,7 @@
 #include <ros/ros.h>
 
 #include <filesystem>
+#include <limits>
 #include <string>
 
 using cartpole_qlearning::test::privateParam;
@@ -21,10 +22,15 @@ namespace text_match = cartpole_qlearning::test::text_match;
 
 namespace
 {
+// A number the .test file must set: a missing one fails the test (NaN fails every comparison).
 double numberParam(const std::string& name)
 {
   double value = 0.0;
-  ros::param::get("~" + name, value);
+  if (!ros::param::get("~" + name, value))
+  {
+    ADD_FAILURE() << "~" << name << " is not set";
+    return std::numeric_limits<double>::quiet_NaN();
+  }
   return value;
 }
 

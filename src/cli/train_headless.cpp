@@ -102,7 +102,9 @@ void usage(std::ostream& out)
          "                       (the table's bounds), the action the controller takes and max_a Q, found by the\n"
          "                       table's own features (for rosrun cartpole_qlearning plot_policy); learns and\n"
          "                       writes nothing\n"
-         "  --grid N             with --policy: points per axis, in [2, 1000] (default 101)\n"
+         "  --grid N             with --policy: points per axis, in [2, "
+      << cartpole_qlearning::kMaxPolicyGridPoints
+      << "] (default 101)\n"
          "  --axes X,Y           with --policy: the two dimensions among x, x_dot, theta, theta_dot (default\n"
          "                       theta,theta_dot)\n"
          "  --at NAME=V,...      with --policy: the values of the other dimensions (default 0)\n"
@@ -368,7 +370,9 @@ int run(int argc, char** argv)
       policy_options = true;
       if (!parseCount(argv[++i], grid_points) || grid_points < 2 ||
           grid_points > cartpole_qlearning::kMaxPolicyGridPoints)
-        return refuse(arg, argv[i], "must be a whole number in [2, 1000]");
+        return refuse(
+            arg, argv[i],
+            "must be a whole number in [2, " + std::to_string(cartpole_qlearning::kMaxPolicyGridPoints) + "]");
     }
     else if (arg == "--config" && has_value)
       config_path = argv[++i];
