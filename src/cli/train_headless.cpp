@@ -168,6 +168,12 @@ void saveTable(const cartpole_qlearning::QTable& table, const std::string& table
   else
     cartpole_qlearning::saveQTableUnder(table, table_dir, path);
 }
+// The same path rule for reading a table.
+cartpole_qlearning::QTable loadTable(const std::string& table_dir, const std::string& path)
+{
+  return path.front() == '/' ? cartpole_qlearning::loadQTableFile(path)
+                             : cartpole_qlearning::loadQTableUnder(table_dir, path);
+}
 // --evaluate TABLE --suite FILE: every case of the suite, greedily; exit 0 when it ran (the verdict
 // is in the last line), 2 on a bad suite, table or configuration.
 int runSuite(const cartpole_qlearning::TrainingConfig& config, const std::string& suite_path,
@@ -190,8 +196,7 @@ int runSuite(const cartpole_qlearning::TrainingConfig& config, const std::string
   SuiteResult result;
   try
   {
-    const QTable table =
-        table_path.front() == '/' ? loadQTableFile(table_path) : loadQTableUnder(table_dir, table_path);
+    const QTable table = loadTable(table_dir, table_path);
     result = cartpole_qlearning::evaluateSuite(table, config, suite);
   }
   catch (const std::runtime_error& e)  // FileError, ConfigError: the table cannot be read or does not fit
@@ -262,7 +267,7 @@ int printPolicy(const std::string& table_path, const std::string& table_dir, std
   QTable table;
   try
   {
-    table = table_path.front() == '/' ? loadQTableFile(table_path) : loadQTableUnder(table_dir, table_path);
+    table = loadTable(table_dir, table_path);
   }
   catch (const FileError& e)
   {
@@ -624,8 +629,7 @@ int run(int argc, char** argv)
           !resume_folder.empty()
               ? (resumed.finished.empty() ? loadQTableUnder(table_dir, resume_folder + "/" + kRunTableFile).episodes
                                           : 0)
-          : load_path.front() == '/' ? loadQTableFile(load_path).episodes
-                                     : loadQTableUnder(table_dir, load_path).episodes;
+              : loadTable(table_dir, load_path).episodes;
     }
     catch (const FileError&)
     {
