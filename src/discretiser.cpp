@@ -11,6 +11,19 @@ namespace
 const char* const kDimensionNames[kStateDimensions] = {"x", "x_dot", "theta", "theta_dot"};
 }  // namespace
 
+std::size_t stateDimension(const std::string& name)
+{
+  for (std::size_t d = 0; d < kStateDimensions; ++d)
+    if (name == kDimensionNames[d])
+      return d;
+  throw std::invalid_argument("'" + name + "' is not a state dimension (allowed: x, x_dot, theta, theta_dot)");
+}
+
+const char* stateDimensionName(std::size_t dimension)
+{
+  return dimension < kStateDimensions ? kDimensionNames[dimension] : "?";
+}
+
 std::string uniformGridError(const char* count_key, const std::array<unsigned, kStateDimensions>& counts,
                              const std::array<double, kStateDimensions>& lower,
                              const std::array<double, kStateDimensions>& upper)

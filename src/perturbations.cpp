@@ -1,5 +1,7 @@
 #include "cartpole_qlearning/perturbations.h"
 
+#include "cartpole_qlearning/discretiser.h"
+
 #include <cmath>
 #include <sstream>
 
@@ -37,13 +39,13 @@ std::string PerturbationParams::validate() const
     out << name << " = " << value << " is not allowed (" << allowed << ")";
     return out.str();
   };
-  static const char* const kDims[] = {"x", "x_dot", "theta", "theta_dot"};
   for (std::size_t i = 0; i < 4; ++i)
   {
     if (!(std::isfinite(noise_std[i]) && noise_std[i] >= 0.0))
-      return bad(std::string("noise_std[") + kDims[i] + "]", noise_std[i], "must be finite and >= 0");
+      return bad(std::string("noise_std[") + stateDimensionName(i) + "]", noise_std[i], "must be finite and >= 0");
     if (!(std::isfinite(noise_fraction[i]) && noise_fraction[i] >= 0.0))
-      return bad(std::string("noise_fraction[") + kDims[i] + "]", noise_fraction[i], "must be finite and >= 0");
+      return bad(std::string("noise_fraction[") + stateDimensionName(i) + "]", noise_fraction[i],
+                 "must be finite and >= 0");
   }
   const std::pair<const char*, const ScaleRange*> ranges[] = {
       {"mass_cart", &mass_cart}, {"mass_pole", &mass_pole}, {"half_length", &half_length}, {"motor", &motor}};

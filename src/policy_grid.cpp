@@ -11,8 +11,6 @@ namespace cartpole_qlearning
 {
 namespace
 {
-const char* const kNames[kStateDimensions] = {"x", "x_dot", "theta", "theta_dot"};
-
 std::string number(double value)
 {
   char text[32];
@@ -29,19 +27,6 @@ double spread(std::size_t i, std::size_t n, double lower, double upper)
 }
 }  // namespace
 
-std::size_t stateDimension(const std::string& name)
-{
-  for (std::size_t d = 0; d < kStateDimensions; ++d)
-    if (name == kNames[d])
-      return d;
-  throw std::invalid_argument("'" + name + "' is not a state dimension (allowed: x, x_dot, theta, theta_dot)");
-}
-
-const char* stateDimensionName(std::size_t dimension)
-{
-  return dimension < kStateDimensions ? kNames[dimension] : "?";
-}
-
 std::string PolicyGridParams::validate(std::size_t actions) const
 {
   std::ostringstream out;
@@ -56,7 +41,7 @@ std::string PolicyGridParams::validate(std::size_t actions) const
   {
     if (d != x_dimension && d != y_dimension && !std::isfinite(slice[d]))
     {
-      out << "the slice's " << kNames[d] << " = " << slice[d] << " is not allowed (must be finite)";
+      out << "the slice's " << stateDimensionName(d) << " = " << slice[d] << " is not allowed (must be finite)";
       return out.str();
     }
   }
@@ -98,7 +83,8 @@ PolicyGrid policyGrid(const QTable& table, const PolicyGridParams& params)
   grid.y_upper = bounds.upper[params.y_dimension];
   for (const std::size_t d : {params.x_dimension, params.y_dimension})
     if (!(std::isfinite(bounds.lower[d]) && std::isfinite(bounds.upper[d]) && bounds.lower[d] < bounds.upper[d]))
-      throw std::invalid_argument(std::string("the table's bounds of ") + kNames[d] + " are not a range to plot over");
+      throw std::invalid_argument(std::string("the table's bounds of ") + stateDimensionName(d) +
+                                  " are not a range to plot over");
 
   const std::size_t n = params.points;
   grid.points.reserve(n * n);
@@ -144,12 +130,13 @@ std::string policyGridCsv(const PolicyGrid& grid, const QTable& table)
   out << "\n# slice:";
   for (std::size_t d = 0; d < kStateDimensions; ++d)
     if (d != p.x_dimension && d != p.y_dimension)
-      out << " " << kNames[d] << "=" << number(p.slice[d]);
+      out << " " << stateDimensionName(d) << "=" << number(p.slice[d]);
   if (features.previous_action)
     out << " previous=" << (p.previous == 0 ? std::string("none") : std::to_string(p.previous - 1));
-  out << "\n# bounds: " << kNames[p.x_dimension] << " " << number(grid.x_lower) << " " << number(grid.x_upper) << ", "
-      << kNames[p.y_dimension] << " " << number(grid.y_lower) << " " << number(grid.y_upper) << "\n";
-  out << kNames[p.x_dimension] << "," << kNames[p.y_dimension] << ",action,effort,value,tie\n";
+  out << "\n# bounds: " << stateDimensionName(p.x_dimension) << " " << number(grid.x_lower) << " "
+      << number(grid.x_upper) << ", " << stateDimensionName(p.y_dimension) << " " << number(grid.y_lower) << " "
+      << number(grid.y_upper) << "\n";
+  out << stateDimensionName(p.x_dimension) << "," << stateDimensionName(p.y_dimension) << ",action,effort,value,tie\n";
   for (const PolicyPoint& point : grid.points)
     out << number(point.x) << "," << number(point.y) << "," << point.action << ","
         << number(table.actions()[point.action]) << "," << number(point.value) << "," << (point.tie ? 1 : 0) << "\n";

@@ -17,6 +17,12 @@ constexpr unsigned kMaxBinsPerDimension = 1000;
 // 160 MB).
 constexpr std::uint64_t kMaxStates = 10000000;
 
+// The state dimensions by name, in the order of CartPoleState: "x", "x_dot", "theta", "theta_dot".
+// stateDimension throws std::invalid_argument naming the allowed ones; stateDimensionName gives
+// "?" past the last.
+std::size_t stateDimension(const std::string& name);
+const char* stateDimensionName(std::size_t dimension);
+
 struct DiscretiserParams
 {
   // Bins per dimension (x, x_dot, theta, theta_dot). A dimension with 1 bin is ignored.

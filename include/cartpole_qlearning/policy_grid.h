@@ -17,10 +17,6 @@ namespace cartpole_qlearning
 // The most points per axis: 1000 x 1000 looks up a million states, about a second.
 constexpr std::size_t kMaxPolicyGridPoints = 1000;
 
-// "x", "x_dot", "theta" or "theta_dot" to 0..3; throws std::invalid_argument naming the allowed ones.
-std::size_t stateDimension(const std::string& name);
-const char* stateDimensionName(std::size_t dimension);
-
 struct PolicyGridParams
 {
   std::size_t x_dimension = 2;  // across: theta
