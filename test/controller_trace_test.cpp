@@ -80,10 +80,5 @@ TEST(ControllerTrace, NoTraceUnlessAskedFor)
 
 int main(int argc, char** argv)
 {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "controller_trace_test");
-  ros::NodeHandle nh;
-  const int result = RUN_ALL_TESTS();
-  fs::remove_all(rosHome());
-  return result;
+  return cartpole_qlearning::test::runTestsRemovingRosHome(argc, argv, "controller_trace_test");
 }
