@@ -2,15 +2,15 @@
 // decision and update (bins and tiles), one training-session step, and a whole training run to solved, headless and
 // through the lockstep protocol's classes (LockstepLoopback). The same code runs inside the nodes, so these are the
 // ceilings the ROS graph can approach.
-#include "cartpole_qlearning/cartpole_dynamics.h"
-#include "cartpole_qlearning/config.h"
-#include "cartpole_qlearning/discretiser.h"
-#include "cartpole_qlearning/headless_trainer.h"
-#include "cartpole_qlearning/lockstep_loopback.h"
-#include "cartpole_qlearning/q_learning_agent.h"
-#include "cartpole_qlearning/random.h"
-#include "cartpole_qlearning/tile_coder.h"
-#include "cartpole_qlearning/training_session.h"
+#include "cartpole_qlearning/simulation/cartpole_dynamics.h"
+#include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/learning/discretiser.h"
+#include "cartpole_qlearning/application/headless_trainer.h"
+#include "lockstep_loopback.h"
+#include "cartpole_qlearning/learning/q_learning_agent.h"
+#include "cartpole_qlearning/common/random.h"
+#include "cartpole_qlearning/learning/tile_coder.h"
+#include "cartpole_qlearning/learning/training_session.h"
 
 #include <benchmark/benchmark.h>
 

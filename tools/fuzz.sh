@@ -20,8 +20,10 @@ command -v "$CXX" >/dev/null || { echo "fuzz.sh: $CXX not found (Debian: clang-1
 WORK=${FUZZ_WORK:-$(mktemp -d "${TMPDIR:-/tmp}/cartpole_fuzz.XXXXXX")}
 mkdir -p "$WORK"
 
-# The core's sources, as CMakeLists.txt lists them for the core library.
-mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_core/,/^)/p' "$SRC/CMakeLists.txt" | grep -o 'src/[a-z_]*\.cpp')
+# The core layers the parsers live in and rest on (the table file and the config readers are
+# learning's), as CMakeLists.txt lists them for their libraries.
+mapfile -t CORE < <(sed -n '/^add_core_layer(\(common\|io\|simulation\|learning\)/,/)$/p' "$SRC/CMakeLists.txt" |
+  grep -o 'src/[a-z_]*/[a-z_]*\.cpp')
 # Line tables only (as tools/sanitize.sh): a report's frames still name function, file and line,
 # for about 10 % less compile time.
 # shellcheck disable=SC2054 # the commas belong to -fsanitize=...

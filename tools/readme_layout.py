@@ -2,7 +2,7 @@
 """Writes the Layout table of docs/design.md (the README's docs index links it) from the tree: the
 core's modules, the ROS layer's files, the command line, the configuration files, the launch
 files, users' scripts and developers' tools, each listed as it is in its folder.
-test/core_layout_test.cpp fails when the table and the tree differ, so a new file means running
+test/unit/core_layout_test.cpp fails when the table and the tree differ, so a new file means running
 this again:
 
   tools/readme_layout.py          # rewrites docs/design.md's Layout table in place
@@ -32,9 +32,24 @@ def quoted(names):
 
 def table():
     rows = [
-        ("`include/cartpole_qlearning/`, `src/`",
-         "the ROS-free core, one module a file pair, named for what it models: "
-         + quoted(stems("include/cartpole_qlearning", "src"))),
+        ("`include/cartpole_qlearning/common/`, `src/common/`",
+         "core layer 1 of 6 (no ROS; each links only layers listed before it here): random numbers, "
+         "log lines as values, a wall-clock throttle: " + quoted(stems("include/cartpole_qlearning/common", "src/common"))),
+        ("`include/cartpole_qlearning/io/`, `src/io/`",
+         "core layer 2: files (atomic saves, confined paths, size-checked reads): "
+         + quoted(stems("include/cartpole_qlearning/io", "src/io"))),
+        ("`include/cartpole_qlearning/simulation/`, `src/simulation/`",
+         "core layer 3: the cart-pole's equations and what a real one does: "
+         + quoted(stems("include/cartpole_qlearning/simulation", "src/simulation"))),
+        ("`include/cartpole_qlearning/learning/`, `src/learning/`",
+         "core layer 4: the task, features, the Q-table and its file, the learner, a training session, the "
+         "configuration readers: " + quoted(stems("include/cartpole_qlearning/learning", "src/learning"))),
+        ("`include/cartpole_qlearning/protocol/`, `src/protocol/`",
+         "core layer 5: the lockstep and controller message protocols, several robots, reset calls: "
+         + quoted(stems("include/cartpole_qlearning/protocol", "src/protocol"))),
+        ("`include/cartpole_qlearning/application/`, `src/application/`",
+         "core layer 6: runs, tables, suites and evaluation, what the nodes and train_headless carry out: "
+         + quoted(stems("include/cartpole_qlearning/application", "src/application"))),
         ("`include/cartpole_qlearning/ros/`, `src/ros/`",
          "the ROS layer: the node classes and their mains (`*_node.cpp`), the nodelets, message conversions, "
          "the parameter server reader, the reset caller, start-up and launch control: "
@@ -47,10 +62,11 @@ def table():
         ("`launch/`", "the launch files users type: " + quoted(files("launch")) + "; `launch/include/` holds their parts"),
         ("`urdf/`, `rviz/`", "`cartpole.urdf` (links match the TF frames), `cartpole.rviz`"),
         ("`docs/`", "pages and pictures (`docs/images/`), each picture made by the command beside it"),
-        ("`test/`", "gtest unit tests of the core (`core_tests`), of the ROS layer's message conversions "
-         "(`ros_conversions_test`, no master) and of `train_headless`; rostest tests of the nodes' wiring "
-         "(`*.test`), of `plot_learning_curve` and of RViz's picture; fuzzers (`test/fuzz/`); sanitizer "
-         "suppressions (`test/sanitizer/`)"),
+        ("`test/`", "`unit/<layer>/`: gtests of each core layer (`<layer>_tests`, no ROS) and of its layout; "
+         "`ros/`: the ROS layer's message conversions (no master); `cli/`: `train_headless` run as a user runs "
+         "it; `docs/`: the pages' links and parameters; `rostest/`: the nodes' wiring (`*.test` files and their "
+         "clients); `support/`: what the tests share; `data/`: their configs; `fuzz/`: fuzzers; "
+         "`sanitizer/`: suppressions"),
         ("`bench/`", "benchmarks (Google Benchmark for the core; the lockstep loops against raw TCPROS and "
          "intra-process round trips; the Python anchor)"),
         ("`scripts/`", "what users run: " + quoted(files("scripts"))),

@@ -6,14 +6,14 @@
 // with "suite=PASSED|FAILED cases=N passed=K worst=M/E". With --replay it learns from the transitions of a
 // file instead (the tutorial's worked example), tracing each update. --policy TABLE prints the
 // table's greedy policy over a grid of states as CSV (scripts/plot_policy draws it).
-#include "cartpole_qlearning/headless_trainer.h"
-#include "cartpole_qlearning/policy_grid.h"
-#include "cartpole_qlearning/q_table_file.h"
-#include "cartpole_qlearning/robustness_suite.h"
-#include "cartpole_qlearning/run_application.h"
-#include "cartpole_qlearning/trace.h"
-#include "cartpole_qlearning/training_run.h"
-#include "cartpole_qlearning/transition_replay.h"
+#include "cartpole_qlearning/application/headless_trainer.h"
+#include "cartpole_qlearning/learning/policy_grid.h"
+#include "cartpole_qlearning/learning/q_table_file.h"
+#include "cartpole_qlearning/application/robustness_suite.h"
+#include "cartpole_qlearning/application/run_application.h"
+#include "cartpole_qlearning/learning/trace.h"
+#include "cartpole_qlearning/application/training_run.h"
+#include "cartpole_qlearning/learning/transition_replay.h"
 
 #include <ros/package.h>
 
@@ -138,14 +138,14 @@ std::string defaultConfigPath()
 
 // What the application says: information on stdout (none with --quiet), the rest on stderr.
 // Returns whether an error was said.
-bool say(const cartpole_qlearning::Saying& said, bool quiet)
+bool say(const cartpole_qlearning::LogLines& log, bool quiet)
 {
-  using cartpole_qlearning::Said;
+  using cartpole_qlearning::LogLine;
   bool error = false;
-  for (const Said& s : said)
+  for (const LogLine& s : log)
   {
-    error = error || s.level == Said::Level::Error;
-    if (s.level == Said::Level::Info)
+    error = error || s.level == LogLine::Level::Error;
+    if (s.level == LogLine::Level::Info)
     {
       if (!quiet)
         std::printf("%s\n", s.text.c_str());
@@ -591,7 +591,7 @@ int run(int argc, char** argv)
         std::printf("saved the Q-table to %s\n",
                     save_path.front() == '/' ? save_path.c_str() : resolvePathUnder(table_dir, save_path).c_str());
     }
-    catch (const QTableFileError& e)
+    catch (const FileError& e)
     {
       std::cerr << "train_headless: --save: " << e.what() << "\n";
       return 1;
@@ -723,7 +723,7 @@ int run(int argc, char** argv)
         }
         const bool training_finished = !evaluating && config.limits.reached(s.episode, s.solved);
         const EpisodeEnd end = application->endEpisode(robot_names[s.robot], training_finished);
-        error = say(end.said, quiet) || error;
+        error = say(end.log, quiet) || error;
         // What the saved table is worth is a result, as the result line is: --quiet keeps it.
         if (quiet && !end.robustness.empty())
           std::printf("robustness of the saved table: %s\n", end.robustness.c_str());

@@ -1,6 +1,6 @@
 #include "cartpole_qlearning/ros/cartpole_sim.h"
 
-#include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/ros/conversions.h"
 #include "cartpole_qlearning/ros/parameter_source.h"
 

@@ -1,6 +1,6 @@
 #include "cartpole_qlearning/ros/conversions.h"
 
-#include "cartpole_qlearning/schedule.h"
+#include "cartpole_qlearning/learning/schedule.h"
 
 #include <algorithm>
 #include <cmath>

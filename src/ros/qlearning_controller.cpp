@@ -25,9 +25,9 @@ double secondsSince(std::chrono::steady_clock::time_point then)
 }
 
 // The prefix of the node's lines: written here only.
-std::string prefixed(const Said& said)
+std::string prefixed(const LogLine& log)
 {
-  return said.prefixed ? "qlearning_controller: " + said.text : said.text;
+  return log.prefixed ? "qlearning_controller: " + log.text : log.text;
 }
 }  // namespace
 
@@ -45,7 +45,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
     state_names_ = stateNames(settings_.training.agent);
     session_->setTrace([this](std::size_t robot, const TraceStep& step) {
       const std::string& name = settings_.robots[robot];
-      say({{Said::Level::Info,
+      say({{LogLine::Level::Info,
             (settings_.robots.size() > 1 ? name + ": " : "") +
                 traceLine(step, state_names_, settings_.training.agent.actions),
             false}});
@@ -69,7 +69,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   std::string served;
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
-  say(Said::Level::Info, "%s",
+  say(LogLine::Level::Info, "%s",
       controllerStartText(settings_, session_->table(), app_->tableDirectory(), served).c_str());
   lock.unlock();
   startLiveTuning();
@@ -124,8 +124,8 @@ QLearningControllerNode::~QLearningControllerNode()
     robot.state_sub.shutdown();
   const std::lock_guard<std::mutex> lock(mutex_);
   // ROS may be shut down already: said on the console.
-  for (const Said& said : app_ ? app_->shutdown() : Saying())
-    std::printf("%s\n", prefixed(said).c_str());
+  for (const LogLine& log : app_ ? app_->shutdown() : LogLines())
+    std::printf("%s\n", prefixed(log).c_str());
   // Out now: under roslaunch stdout is a pipe, and a process killed after its slow exit (a
   // loaded machine) would lose what is still buffered (seen in a new Debian 12 root: the line
   // cut after the path).
@@ -157,7 +157,7 @@ bool QLearningControllerNode::extractState(Robot& robot, const sensor_msgs::Join
   if (!reading)
   {
     if (bad_state_warning_.ready())
-      say(Said::Level::Warn, "%s", reading.refusal.c_str());
+      say(LogLine::Level::Warn, "%s", reading.refusal.c_str());
     return false;
   }
   state = robot.mapping->map(msg.header.stamp.toNSec(), *reading.value);
@@ -195,15 +195,15 @@ void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::Joi
   if (robot.silent_reported)
   {
     robot.silent_reported = false;
-    say(Said::Level::Info, "joint_states are back on %s; going on", describe(robot).c_str());
+    say(LogLine::Level::Info, "joint_states are back on %s; going on", describe(robot).c_str());
   }
   if (rounds_->heard(r, robot.last_state_at))
-    say(Said::Level::Info, "%s takes part in the rounds again", describe(robot).c_str());
+    say(LogLine::Level::Info, "%s takes part in the rounds again", describe(robot).c_str());
 
   const ros::Time stamp = msg->header.stamp;
   const DecisionClock::Verdict decision = robot.decisions->onState(stamp.toNSec());
   if (decision.slow && slow_states_warning_.ready())
-    say(Said::Level::Warn,
+    say(LogLine::Level::Warn,
         "joint_states on %s come further apart than ~decision_period = %g s, the step the table learns",
         describe(robot).c_str(), settings_.robot.decision_period);
   // A fall ends the running episode whenever it comes, not a period later.
@@ -253,7 +253,7 @@ void QLearningControllerNode::serve(std::size_t r, const ros::Time& stamp, const
 
 void QLearningControllerNode::report(const Robot& robot, const Reaction& reaction, const ros::Time& stamp)
 {
-  say(reactionSaid(
+  say(reactionLog(
       reaction, robot.protocol->counts(), describe(robot), stamp.toSec(),
       [this] { return dropped_state_warning_.ready(); }, [this] { return restart_warning_.ready(); }));
 }
@@ -273,7 +273,7 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
   if (robot.stats_pub)
     robot.stats_pub.publish(robotEpisodeStats(s, robot.name, stamp, end.robot_steps_per_second));
 
-  say(end.said);
+  say(end.log);
   if (end.finished)
     endWhenFinished();
 }
@@ -284,7 +284,7 @@ void QLearningControllerNode::endWhenFinished()
     return;
   if (endParentLaunch())
   {
-    say(Said::Level::Info, "done; ending the launch");
+    say(LogLine::Level::Info, "done; ending the launch");
     return;
   }
   if (shutdown_)
@@ -319,7 +319,7 @@ void QLearningControllerNode::startRun()
   // A respawn of a run that has finished stays up rather than exit (under respawn that would
   // only start it again), and ends the launch when asked to.
   if (app_->finished() && settings_.shutdown_when_finished && endParentLaunch())
-    say(Said::Level::Info, "ending the launch");
+    say(LogLine::Level::Info, "ending the launch");
 }
 
 bool QLearningControllerNode::onSave(SaveQTable::Request& request, SaveQTable::Response& response)
@@ -328,7 +328,7 @@ bool QLearningControllerNode::onSave(SaveQTable::Request& request, SaveQTable::R
   const ServiceAnswer answer = app_->save(request.path);
   response.success = answer.success;
   response.message = answer.message;
-  say(answer.said);
+  say(answer.log);
   return true;
 }
 
@@ -338,7 +338,7 @@ bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::R
   const ServiceAnswer answer = app_->load(request.path);
   response.success = answer.success;
   response.message = answer.message;
-  say(answer.said);
+  say(answer.log);
   return true;
 }
 
@@ -353,12 +353,12 @@ void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
       continue;
     robot.silent_reported = true;
     robot.command.stop();
-    say(Said::Level::Warn, "no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting for it",
+    say(LogLine::Level::Warn, "no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting for it",
         describe(robot).c_str(), settings_.sim_timeout);
   }
   const std::vector<std::size_t> dropped = rounds_->dropOuts(WallClock::now());
   for (const std::size_t r : dropped)
-    say(Said::Level::Warn, "%s is silent; the rounds go on without it until it is back", describe(robots_[r]).c_str());
+    say(LogLine::Level::Warn, "%s is silent; the rounds go on without it until it is back", describe(robots_[r]).c_str());
   if (!dropped.empty())
     serveRounds();
 }
@@ -377,7 +377,7 @@ void QLearningControllerNode::startLiveTuning()
       left.__fromServer__(pnh_);  // only the fields present there change
       LearningSettings left_settings = running;
       fromConfig(left, left_settings);
-      say(liveTuningReplacedSaid(left_settings, running));
+      say(liveTuningReplacedLog(left_settings, running));
       toConfig(session_->learningSettings()).__toServer__(pnh_);
     }
   }
@@ -398,7 +398,7 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
   // What the server keeps, answers and publishes: the values in use (a refused change undone,
   // an override given as any negative number shown as -1).
   config = toConfig(session_->learningSettings());
-  say(liveTuningSaid(in_use, wanted, asServerField(error), first && app_->respawned(), settings_.run.learning));
+  say(liveTuningLog(in_use, wanted, asServerField(error), first && app_->respawned(), settings_.run.learning));
 }
 
 void QLearningControllerNode::requestReset(std::size_t robot)
@@ -408,26 +408,26 @@ void QLearningControllerNode::requestReset(std::size_t robot)
     robots_.at(robot).resetter->request();
 }
 
-void QLearningControllerNode::say(const Saying& said) const
+void QLearningControllerNode::say(const LogLines& log) const
 {
-  for (const Said& line : said)
+  for (const LogLine& line : log)
   {
     switch (line.level)
     {
-      case Said::Level::Info:
+      case LogLine::Level::Info:
         ROS_INFO_STREAM_NAMED("qlearning_controller", prefixed(line));
         break;
-      case Said::Level::Warn:
+      case LogLine::Level::Warn:
         ROS_WARN_STREAM_NAMED("qlearning_controller", prefixed(line));
         break;
-      case Said::Level::Error:
+      case LogLine::Level::Error:
         ROS_ERROR_STREAM_NAMED("qlearning_controller", prefixed(line));
         break;
     }
   }
 }
 
-void QLearningControllerNode::say(Said::Level level, const char* format, ...) const
+void QLearningControllerNode::say(LogLine::Level level, const char* format, ...) const
 {
   std::va_list args;
   va_start(args, format);

@@ -173,12 +173,12 @@ void ResetCaller::carryOut(const ResetCalls::Orders& orders)
   if (orders.give_up && caller_.joinable())
     caller_.detach();  // blocked in its call, or about to see that it was given up
   shared_->generation = calls_.generation();
-  for (const ResetCalls::Say& say : orders.say)
+  for (const LogLine& line : orders.log)
   {
-    if (say.level == ResetCalls::Say::Level::Warn)
-      ROS_WARN_NAMED("qlearning_controller", "qlearning_controller: %s", say.text.c_str());
+    if (line.level == LogLine::Level::Warn)
+      ROS_WARN_NAMED("qlearning_controller", "qlearning_controller: %s", line.text.c_str());
     else
-      ROS_INFO_NAMED("qlearning_controller", "qlearning_controller: %s", say.text.c_str());
+      ROS_INFO_NAMED("qlearning_controller", "qlearning_controller: %s", line.text.c_str());
   }
   if (orders.call)
   {

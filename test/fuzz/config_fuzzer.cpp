@@ -2,8 +2,8 @@
 // nodes apply to the parameter server). Whatever the bytes, it returns a valid config or throws
 // ConfigError; any other exception, a crash or a sanitizer report is a bug. An accepted config
 // must make a training session (no exception from the core for values the reader let through).
-#include "cartpole_qlearning/config.h"
-#include "cartpole_qlearning/training_session.h"
+#include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/learning/training_session.h"
 
 #include <cstdint>
 #include <string>

@@ -3,7 +3,7 @@
 // it accepts must write back to text that parses to the same table (a version 1 table is
 // written back as version 2; bins and tiles alike: shapeMismatch compares the features). The
 // corpus holds both versions and both kinds of features.
-#include "cartpole_qlearning/q_table_file.h"
+#include "cartpole_qlearning/learning/q_table_file.h"
 
 #include <cstdint>
 #include <cstdlib>
@@ -19,7 +19,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   {
     table = parseQTable(text);
   }
-  catch (const QTableFileError&)
+  catch (const FileError&)
   {
     return 0;
   }

@@ -7,11 +7,11 @@
 #pragma once
 
 #include "cartpole_qlearning/Reset.h"
-#include "cartpole_qlearning/cartpole_simulation.h"
-#include "cartpole_qlearning/lockstep_protocol.h"
-#include "cartpole_qlearning/node_settings.h"
-#include "cartpole_qlearning/robot_interface.h"
-#include "cartpole_qlearning/wall_throttle.h"
+#include "cartpole_qlearning/simulation/cartpole_simulation.h"
+#include "cartpole_qlearning/protocol/lockstep_protocol.h"
+#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/protocol/robot_interface.h"
+#include "cartpole_qlearning/common/wall_throttle.h"
 
 #include <ros/callback_queue.h>
 #include <ros/ros.h>

@@ -1,7 +1,7 @@
 // The controller's command to one robot, in the message type that robot takes (~command_type).
 #pragma once
 
-#include "cartpole_qlearning/robot_interface.h"
+#include "cartpole_qlearning/protocol/robot_interface.h"
 
 #include <ros/ros.h>
 

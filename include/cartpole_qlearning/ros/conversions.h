@@ -5,10 +5,10 @@
 
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/LearningConfig.h"
-#include "cartpole_qlearning/cartpole_dynamics.h"
-#include "cartpole_qlearning/learning_settings.h"
-#include "cartpole_qlearning/robot_interface.h"
-#include "cartpole_qlearning/training_session.h"
+#include "cartpole_qlearning/simulation/cartpole_dynamics.h"
+#include "cartpole_qlearning/learning/learning_settings.h"
+#include "cartpole_qlearning/protocol/robot_interface.h"
+#include "cartpole_qlearning/learning/training_session.h"
 
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/time.h>

@@ -15,15 +15,15 @@
 #include "cartpole_qlearning/LearningConfig.h"
 #include "cartpole_qlearning/LoadQTable.h"
 #include "cartpole_qlearning/SaveQTable.h"
-#include "cartpole_qlearning/config.h"
+#include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/ros/command_publisher.h"
 #include "cartpole_qlearning/ros/reset_caller.h"
-#include "cartpole_qlearning/lockstep_protocol.h"
-#include "cartpole_qlearning/node_settings.h"
-#include "cartpole_qlearning/robot_rounds.h"
-#include "cartpole_qlearning/run_application.h"
-#include "cartpole_qlearning/training_session.h"
-#include "cartpole_qlearning/wall_throttle.h"
+#include "cartpole_qlearning/protocol/lockstep_protocol.h"
+#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/protocol/robot_rounds.h"
+#include "cartpole_qlearning/application/run_application.h"
+#include "cartpole_qlearning/learning/training_session.h"
+#include "cartpole_qlearning/common/wall_throttle.h"
 
 #include <boost/thread/recursive_mutex.hpp>
 #include <dynamic_reconfigure/server.h>
@@ -122,8 +122,8 @@ private:
 
   // The node's log: every line on its named logger, "qlearning_controller: " before those said
   // with a prefix.
-  void say(const Saying& said) const;
-  void say(Said::Level level, const char* format, ...) const __attribute__((format(printf, 3, 4)));
+  void say(const LogLines& log) const;
+  void say(LogLine::Level level, const char* format, ...) const __attribute__((format(printf, 3, 4)));
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;

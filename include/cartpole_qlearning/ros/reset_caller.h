@@ -1,7 +1,7 @@
 // A robot's reset service, called on threads of its own (see ResetCaller).
 #pragma once
 
-#include "cartpole_qlearning/reset_calls.h"
+#include "cartpole_qlearning/protocol/reset_calls.h"
 
 #include <chrono>
 #include <cstdint>

@@ -1,0 +1,142 @@
+// The nodes' private parameters (~mode, ~q_table_dir, ~robots, ... for the controller; ~mode,
+// ~lockstep_timeout, ... for the sim), read and checked by the core through a ParameterSource,
+// so that every rule is a unit test with YAML text. The node passes in only what needs ROS.
+#pragma once
+
+#include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/protocol/lockstep_protocol.h"
+#include "cartpole_qlearning/learning/q_table.h"
+#include "cartpole_qlearning/protocol/robot_interface.h"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace cartpole_qlearning
+{
+// What the application around the learner needs (run_application.h): the controller node fills
+// it from its private parameters, train_headless from its command line.
+struct RunSettings
+{
+  bool learning = true;  // ~mode: train (true) or evaluate (greedy, no learning)
+  std::uint64_t seed = 0;
+  std::string name_space = "/cartpole";  // the learner's namespace: its table folder by default, its run folders' names
+  // Tables are read and written under this folder (a relative path there; one that escapes it is
+  // refused). "~/" at its start is the user's home.
+  std::string q_table_dir;
+  std::string q_table_path = "q_table.yaml";  // the default table, relative to q_table_dir ("": none)
+  std::string load_on_start;                  // a table to start from ("": none)
+  // An absolute q_table_path or load_on_start is the user's own, followed as the shell would
+  // (train_headless's command line); else it must lie inside q_table_dir (the node's parameters).
+  bool own_absolute_paths = false;
+  // "" the run's folder/episodes.csv (training; none when evaluating), "none" no file, else a
+  // path (relative: under q_table_dir; absolute: the user's own).
+  std::string stats_csv;
+  std::string run_id;                      // the launch's own id: a respawn finds its run by it
+  std::uint64_t evaluation_episodes = 10;  // evaluate: the verdict after this many episodes (0: never)
+  // evaluate: what the robot poses as ("case one_step_late of .../robust_suite.yaml"; "": not
+  // said) and the balanced episodes its verdict needs to pass.
+  std::string evaluation_case;
+  std::uint64_t evaluation_pass = 0;
+  std::uint64_t checkpoint_every = 100;  // training: a checkpoint every this many episodes (0: none)
+  bool save_on_shutdown = true;          // training: save into the run's folder when stopped early
+  // false (train_headless --no-run-folder): no run folder at all (no checkpoints, record, curve of
+  // its own or save on shutdown); a solved run's only save is the default table.
+  bool run_folder = true;
+  bool trace = false;  // log every update and the table at each episode end
+  // Where a relative training/suite is looked for, in order (the package's config/; for
+  // train_headless first its --config's folder). None: a relative suite is not found.
+  std::vector<std::string> suite_folders;
+};
+
+struct ControllerSettings
+{
+  TrainingConfig training;  // the shared sections, with ~stop_when_solved and ~max_episodes applied
+  RunSettings run;
+  bool shutdown_when_finished = true;                // end the launch (or the node) when done
+  double sim_timeout = 2.0;                          // [s] wall: a robot silent this long is said to be gone
+  std::string reset_service = "cartpole_sim/reset";  // "": a robot that cannot be reset on command
+  std::vector<std::string> robots{""};               // namespaces relative to the learner's
+  bool sync = true;                                  // several robots: served in lockstep rounds
+  ControllerProtocolParams protocol;                 // reset_service, start_region, limits
+  RobotInterfaceParams robot;                        // joints, offsets, command type, decision period
+  // ~reset_service_type: what ~reset_service is
+  std::string reset_service_type = "cartpole_qlearning/Reset";
+};
+
+// What only ROS knows, handed in by the node.
+struct ControllerContext
+{
+  std::string name_space = "/cartpole";  // the learner's namespace (the default table folder's name)
+  std::string home;                      // $HOME, for "~/" in paths ("": none)
+  bool shutdown_by_default = true;       // ~shutdown_when_finished's default (a nodelet: false)
+  // "" for a valid relative ROS name, else why it is not one (ros::names::validate; unset: any
+  // name passes).
+  std::function<std::string(const std::string&)> name_error;
+  // Private keys read by other means (dynamic_reconfigure's fields, ~run/...): not unknown.
+  std::vector<std::string> other_keys;
+  std::vector<std::string> suite_folders;  // RunSettings::suite_folders (the package's config/)
+};
+
+// Reads the shared sections from `shared` and the private parameters from `priv`. Throws
+// ConfigError naming the parameter, its value and what is allowed, on a bad value or an
+// unknown private key.
+ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& priv,
+                                          const ControllerContext& context);
+
+enum class SimMode
+{
+  Realtime,  // steps on a wall timer, holding the last command
+  Lockstep   // steps when the command answering the pending state arrives
+};
+
+struct SimSettings
+{
+  CartPoleParams physics;           // the shared physics section
+  double start_state_bound = 0.05;  // physics/start_state_bound
+  SimMode mode = SimMode::Realtime;
+  std::uint64_t seed = 0;
+  double command_timeout = 0.5;   // [s] realtime: an older command counts as zero
+  double lockstep_timeout = 0.5;  // [s] lockstep: republish the state when unanswered this long
+  double effort_limit = 10.0;     // [N] <= physics.force_mag, which is its default
+  bool publish_clock = false;     // lockstep only: drive /clock (one lockstep instance per master)
+  bool publish_tf = true;
+  double tf_rate = 30.0;  // [Hz] lockstep: TF at most this often (wall clock)
+  double track_y = 0.0;   // [m] where the track lies along world y (several robots side by side)
+  std::string world_frame = "world";
+  std::string cart_frame = "cart";
+  std::string pole_frame = "pole";
+  // What a real cart-pole does (the shared perturbations section, as train_headless reads it from
+  // its config), or the suite case's when ~suite_case names one.
+  PerturbationParams perturbations;
+  // ~suite and ~suite_case: the sim poses as this case of the suite file (its physics, start
+  // region and perturbations over the shared ones; its seed unless ~seed is given). "": none.
+  std::string suite;
+  std::string suite_case;
+  // Posing as another cart-pole (docs/your_own_cartpole.md): its joint names, offsets and signs
+  // (~cart_joint, ~pole_joint, ~cart_zero, ~cart_sign, ~pole_upright, ~pole_angle_sign), whole turns
+  // added to the pole's reading (~pole_turns) and whether velocities are published.
+  // (~effort_sign too: -1, a robot whose + effort pushes the cart toward -x.)
+  RobotInterfaceParams pose;
+  // [s] ~publish_period: joint_states every this much sim time (physics/tau by default); the physics
+  // still steps every tau (SampledPhysics).
+  double publish_period = 0.02;
+  // ~group_effort_index: the cart's slot in the std_msgs/Float64MultiArray commands on group_effort
+  // (a JointGroupEffortController's).
+  std::uint64_t group_effort_index = 0;
+  int pole_turns = 0;
+  bool publish_velocities = true;
+};
+
+// Reads the physics and perturbations sections from `shared` and the sim's private parameters
+// from `priv` (loading ~suite when ~suite_case is set); throws ConfigError as
+// readControllerSettings does.
+SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource& priv);
+
+// The controller's first line: what it does, with which table, serving whom ("training, seed 0,
+// 72 states x 2 actions, tables under DIR; serving ROBOTS; resets by ~cartpole_sim/reset").
+std::string controllerStartText(const ControllerSettings& settings, const QTable& table,
+                                const std::string& table_directory, const std::string& served);
+
+}  // namespace cartpole_qlearning

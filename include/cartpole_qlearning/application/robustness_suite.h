@@ -1,0 +1,84 @@
+// A robustness suite: what a table is worth on a robot. Each case is a set of conditions a real
+// cart-pole meets (a late command, noisy sensors, other masses, a weaker motor, pushes, wider
+// starts, all at once: perturbations.h), run greedily for a number of episodes; a case passes
+// when enough of them balance to the step limit. train_headless --evaluate TABLE --suite FILE,
+// evaluate.launch and the end of every training run use it.
+#pragma once
+
+#include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/learning/q_table.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace cartpole_qlearning
+{
+struct SuiteCase
+{
+  std::string name;
+  // The case's physics (the configuration's, with the case's physics keys over it) and start region.
+  CartPoleParams physics;
+  double start_state_bound = 0.05;
+  PerturbationParams perturbations;
+  std::uint64_t pass = 95;  // balanced episodes (of the suite's episodes) needed to pass
+};
+
+struct RobustnessSuite
+{
+  std::string origin;            // the file, for messages
+  std::uint64_t episodes = 100;  // per case
+  std::uint64_t seed = 1000;     // the evaluation's own seed: start states, noise, draws, pushes
+  // The suite's own criterion, whatever the training used: balanced means reaching this many
+  // steps, from starts in +-start_state_bound (a case's physics/start_state_bound overrides it).
+  unsigned max_episode_steps = 500;
+  double start_state_bound = 0.05;
+  std::vector<SuiteCase> cases;
+};
+
+// Reads a suite file (see config/robust_suite.yaml). base: the physics that the cases' keys
+// override (the configuration the table was trained with; its step limit and start region play
+// no part: the suite's own do). Throws ConfigError naming
+// the case and key on a bad value or an unknown key.
+RobustnessSuite parseRobustnessSuite(const std::string& yaml, const std::string& origin, const TrainingConfig& base);
+RobustnessSuite loadRobustnessSuite(const std::string& path, const TrainingConfig& base);
+
+struct CaseResult
+{
+  std::string name;
+  std::uint64_t episodes = 0;
+  std::uint64_t balanced = 0;  // reached the task's step limit without falling
+  std::uint64_t pass = 0;
+  double mean_return = 0.0;
+  bool passed() const
+  {
+    return balanced >= pass;
+  }
+};
+
+struct SuiteResult
+{
+  std::vector<CaseResult> cases;
+  bool passed() const;
+  // The fewest balanced episodes of any case, and that case's name.
+  std::uint64_t worstBalanced() const;
+  // "nominal 100/100, one_step_late 97/100, ... : PASSED" on one line.
+  std::string summary() const;
+  // One line per case, aligned, then the verdict: for a console.
+  std::string table() const;
+};
+
+// Runs the table greedily (no learning, no exploration) on one case. config: the task (step
+// limit, thresholds, reward) and the agent's features and actions the table was made for;
+// evaluateSuite runs each case with the suite's step limit in place of the task's.
+// Throws ConfigError when the table does not fit the configuration.
+CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
+                        std::uint64_t episodes, std::uint64_t seed);
+SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite);
+
+// A mean return as printed with this many decimals: rounded there, a zero without its sign.
+// Under sutton_barto a case where 2 of 100 fell has a mean of -0.02, which "%.1f" prints as
+// "-0.0"; printed through this it reads 0.0, and the balanced column says who fell.
+double shownReturn(double value, int decimals);
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,160 @@
+// The application around the learner: one training or evaluation run. It owns what a run
+// writes and decides: the table folder and the default table, the run's folder and record,
+// checkpoints and their cadence, the robustness suite (training/suite: run greedily on a copy of
+// the table every training/suite_every episodes, keeping the best table seen, ending training
+// when it passes under training/until suite_passes, and always on the table a run saves), the resume of a respawned
+// controller (or of `train_headless
+// --resume`), the per-episode CSV, which save replaces the default table, the save on shutdown,
+// the evaluation verdict, progress lines and their rates. It returns what to say as values (as
+// ControllerProtocol returns a Reaction), with its clocks injected, so that the controller node
+// and train_headless carry out the same decisions and every decision is a unit test.
+//
+// The controller node logs what it says on its named logger; train_headless prints it.
+#pragma once
+
+#include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/application/episode_csv.h"
+#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/application/training_run.h"
+#include "cartpole_qlearning/learning/training_session.h"
+
+#include <chrono>
+#include <cstdint>
+#include <ctime>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cartpole_qlearning
+{
+// The clocks a run reads, injected so that tests drive them.
+struct RunClocks
+{
+  // Rates and durations (steps per second, the time a run took).
+  std::function<std::chrono::steady_clock::time_point()> steady = [] { return std::chrono::steady_clock::now(); };
+  // The CSV's wall_time column (Unix seconds).
+  std::function<double()> unix_seconds = [] {
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  };
+  // Run folder names and the record's start time (local time).
+  std::function<std::time_t()> calendar = [] { return std::time(nullptr); };
+};
+
+// What identifies a run to a respawn of the controller that started it (the node keeps it on
+// the parameter server as ~run/id, ~run/launcher, ~run/folder).
+struct RunIdentity
+{
+  std::string id;      // ~run_id ("": runs are not resumed)
+  int launcher = 0;    // the roslaunch (else the parent) process that started the run
+  std::string folder;  // relative to the table folder
+};
+
+// The greedy evaluation's outcome so far.
+struct EvaluationVerdict
+{
+  std::uint64_t episodes = 0;
+  std::uint64_t balanced = 0;  // reached the step limit without falling
+  double mean_return = 0.0;
+};
+
+// What the caller does after an episode's end.
+struct EpisodeEnd
+{
+  LogLines log;
+  // For episode_stats: the learner's steps per second since the previous episode's end (any
+  // robot), and this robot's since its own previous end.
+  double steps_per_second = 0.0;
+  double robot_steps_per_second = 0.0;
+  // Training reached its limits and its table is saved, or the evaluation has its verdict: end
+  // the launch when asked to. (When the final save failed this stays false while finished()
+  // turns true: no more states are served, and the node stays up for ~save_q_table.)
+  bool finished = false;
+  // The run's folder was made or renamed now: the node stores it (~run/folder) for a respawn.
+  std::optional<std::string> run_folder;
+  // Training ended here: the robustness suite's summary of the table it saved (episode_stats'
+  // robustness); "" otherwise, or when there is no suite (training/suite none).
+  std::string robustness;
+};
+
+// A service's answer (SaveQTable, LoadQTable): success and message, and what to log.
+struct ServiceAnswer
+{
+  bool success = false;
+  std::string message;
+  LogLines log;
+};
+
+// A setting the run cannot work with (a ~stats_csv that cannot be written): a ConfigError that
+// keeps the parameter's name (without "~"), its value and why, so that the node names the
+// parameter as it names its others. what(): "~NAME = VALUE is not allowed (WHY)".
+class RunSettingError : public ConfigError
+{
+public:
+  RunSettingError(const std::string& name, const std::string& value, const std::string& why);
+  std::string name;
+  std::string value;
+  std::string why;
+};
+
+class RunApplication
+{
+public:
+  // session: the learner; it outlives this. config: the training configuration in use (limits,
+  // the task's solved window and step limit, the features for the trace).
+  RunApplication(RunSettings settings, const TrainingConfig& config, TrainingSession& session, RunClocks clocks = {});
+  ~RunApplication();
+
+  RunApplication(const RunApplication&) = delete;
+  RunApplication& operator=(const RunApplication&) = delete;
+
+  // Starts the run: the table of load_on_start, the CSV, the suite (training), and (training) this run's folder, or,
+  // when `previous` names this very run (same id and launcher: a respawn), goes on from its
+  // checkpoint. launcher: this process's roslaunch (else parent) pid, 0 when not applicable
+  // (train_headless). Throws ConfigError naming the parameter for what must stop the node: a
+  // ~load_on_start table that cannot be used, a ~stats_csv that cannot be written (a
+  // RunSettingError), a checkpoint that does not fit the configuration, a training/suite that
+  // cannot be read when training evaluates it (suite_every > 0; else a warning says that the run
+  // ends without a verdict).
+  LogLines start(const RunIdentity& previous = {}, int launcher = 0);
+  // train_headless --resume FOLDER: goes on from that run folder's checkpoint (relative: under
+  // the table folder), instead of start(): ~load_on_start plays no part, the curve keeps the rows
+  // the checkpoint covers. Throws ConfigError when it holds no usable checkpoint, when the folder
+  // escapes the table folder, or when evaluating.
+  LogLines resume(const std::string& folder);
+
+  // An episode has just ended on robot `robot` (its namespace, "" for the learner's own): the
+  // session's lastEpisode(). training_finished: the protocol (or the headless loop) says
+  // training reached its limits with this episode. Training also ends here when the suite,
+  // evaluated at this episode, passes under training/until suite_passes (EpisodeEnd::finished,
+  // finished()): the caller then serves no more states.
+  EpisodeEnd endEpisode(const std::string& robot, bool training_finished);
+
+  // The services: paths relative to the table folder (empty: the default table); a path that
+  // escapes the folder is refused. Never throw.
+  ServiceAnswer save(const std::string& path);
+  ServiceAnswer load(const std::string& path);
+
+  // The process is going away: the save on shutdown into the run's folder (training, when
+  // asked and when the final save has not happened).
+  LogLines shutdown();
+
+  // What a respawn needs to find this run (empty id: nothing to store).
+  RunIdentity identity() const;
+  bool respawned() const;  // start() went on with a run a dead controller started
+  bool finished() const;   // nothing left to do (a respawn of a finished run, training over, verdict given)
+  EvaluationVerdict verdict() const;
+  // A path as the services and parameters take it, made absolute (throws QTableFileError when
+  // it escapes the table folder).
+  std::string resolve(const std::string& path) const;
+  const std::string& tableDirectory() const;
+  const std::string& runFolder() const;  // "" when evaluating
+
+private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,69 @@
+// The CartPole-v1 task: when an episode ends and what each step is worth. The controller
+// decides this from the state it receives; the simulator is only physics, like a robot.
+#pragma once
+
+#include "cartpole_qlearning/simulation/cartpole_dynamics.h"
+
+#include <string>
+
+namespace cartpole_qlearning
+{
+enum class RewardScheme
+{
+  Gymnasium,   // +1 every step, the terminating one included (CartPole-v1)
+  Seed,        // +1 while alive, -1 on the step that falls (the Q-learning tutorial's)
+  SuttonBarto  // 0 while alive, -1 on the step that falls (Barto, Sutton and Anderson 1983)
+};
+
+// Parses "gymnasium", "seed" or "sutton_barto"; throws std::invalid_argument otherwise.
+RewardScheme rewardSchemeFromString(const std::string& name);
+std::string toString(RewardScheme scheme);
+
+struct TaskParams
+{
+  double x_threshold = 2.4;           // [m] terminated when |x| > this
+  double theta_threshold_deg = 12.0;  // [deg] terminated when |theta| > this
+  unsigned max_episode_steps = 500;   // truncated after this many steps
+  RewardScheme reward = RewardScheme::Gymnasium;
+  double solved_mean_return = 475.0;  // solved when the mean return of the last window episodes >= this
+  unsigned solved_window = 100;       // episodes in that window
+
+  // The threshold in radians, computed the way Gymnasium does (12 * 2 * pi / 360).
+  double thetaThresholdRad() const;
+  // Empty when valid, else a message naming the first bad field, its value and the allowed range.
+  std::string validate() const;
+};
+
+struct StepOutcome
+{
+  double reward = 0.0;
+  bool terminated = false;  // fell: the transition does not bootstrap
+  bool truncated = false;   // out of time: the transition bootstraps
+  bool done() const
+  {
+    return terminated || truncated;
+  }
+};
+
+class CartPoleTask
+{
+public:
+  explicit CartPoleTask(const TaskParams& params = TaskParams());
+
+  const TaskParams& params() const
+  {
+    return params_;
+  }
+
+  // True when the state is outside the thresholds (strict inequalities, as Gymnasium).
+  bool isTerminal(const CartPoleState& state) const;
+
+  // Judges the step that produced new_state, the steps_taken-th of its episode (1-based).
+  StepOutcome evaluate(const CartPoleState& new_state, unsigned steps_taken) const;
+
+private:
+  TaskParams params_;
+  double theta_threshold_rad_;
+};
+
+}  // namespace cartpole_qlearning

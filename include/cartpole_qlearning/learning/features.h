@@ -1,0 +1,121 @@
+// What the learner sees of a state: the rows of its weight table that the state activates.
+// Bins activate one row (a discretised state); tiles activate one row per tiling. Q(s, a) is
+// the sum of the active rows' weights for a, so both share one table, one learner and one file.
+#pragma once
+
+#include "cartpole_qlearning/simulation/cartpole_dynamics.h"
+#include "cartpole_qlearning/learning/discretiser.h"
+#include "cartpole_qlearning/learning/tile_coder.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace cartpole_qlearning
+{
+enum class FeatureKind
+{
+  Bins,  // uniform bins, one row per state (the tutorial's)
+  Tiles  // tile coding, one row per tile of every tiling
+};
+
+// Parses "bins" or "tiles"; throws std::invalid_argument otherwise.
+FeatureKind featureKindFromString(const std::string& name);
+std::string toString(FeatureKind kind);
+
+struct FeatureParams
+{
+  FeatureKind kind = FeatureKind::Bins;
+  // Bins per dimension and the bounds; the bounds serve the tiles too.
+  DiscretiserParams discretiser;
+  unsigned tilings = 8;
+  std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
+  // The learner also sees the action it took last: what a robot that answers a step late is
+  // still carrying out, which the state alone does not show. The rows repeat once for "none"
+  // (an episode's first state) and once per action.
+  bool previous_action = false;
+
+  TileCoderParams tileCoder() const;
+  // Empty when the kind in use is valid, else validate()'s message of its parameters.
+  std::string validate() const;
+  // Weight rows: states for bins, tiles of every tiling for tiles, times the previous action's
+  // blocks. Valid params only.
+  std::size_t rowCount(std::size_t actions) const;
+  // The rows of one block: what the state alone activates.
+  std::size_t stateRowCount() const;
+  // 1, or (previous_action) one block for "none" and one per action.
+  std::size_t blocks(std::size_t actions) const
+  {
+    return previous_action ? actions + 1 : 1;
+  }
+  // Empty when both map states to the same rows, else what differs ("tilings 4 differ from 8"),
+  // the other's value first. Only the parameters of the kind in use count.
+  std::string mismatch(const FeatureParams& other) const;
+};
+
+// The rows a state activates: rows[0 .. count). Fixed capacity, so that finding them allocates
+// nothing.
+struct ActiveRows
+{
+  std::array<std::uint32_t, kMaxTilings> rows{};
+  unsigned count = 0;
+
+  // One row: a discretised state.
+  static ActiveRows single(std::size_t row)
+  {
+    ActiveRows active;
+    active.rows[0] = static_cast<std::uint32_t>(row);
+    active.count = 1;
+    return active;
+  }
+};
+
+class FeatureMap
+{
+public:
+  // actions: how many actions the table has (the previous action's blocks). Throws
+  // std::invalid_argument with validate()'s message.
+  explicit FeatureMap(const FeatureParams& params = FeatureParams(), std::size_t actions = 2);
+
+  const FeatureParams& params() const
+  {
+    return params_;
+  }
+  std::size_t rowCount() const
+  {
+    return row_count_;
+  }
+  // The discretiser of the bins (the default one, unused, for tiles).
+  const Discretiser& discretiser() const
+  {
+    return discretiser_;
+  }
+
+  // previous: 0 for none (an episode's first state), 1 + the index of the action taken last;
+  // ignored unless params().previous_action.
+  void activeRows(const CartPoleState& state, ActiveRows& active, std::size_t previous = 0) const
+  {
+    const auto offset = static_cast<std::uint32_t>(params_.previous_action ? previous * state_rows_ : 0);
+    if (!tile_coder_)
+    {
+      active.rows[0] = static_cast<std::uint32_t>(discretiser_.index(state)) + offset;
+      active.count = 1;
+      return;
+    }
+    tile_coder_->activeTiles(state, active.rows.data());
+    active.count = tile_coder_->tilings();
+    for (unsigned i = 0; offset != 0 && i < active.count; ++i)
+      active.rows[i] += offset;
+  }
+
+private:
+  FeatureParams params_;
+  Discretiser discretiser_;
+  std::optional<TileCoder> tile_coder_;
+  std::size_t state_rows_;
+  std::size_t row_count_;
+};
+
+}  // namespace cartpole_qlearning

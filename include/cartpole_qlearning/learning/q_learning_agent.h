@@ -1,0 +1,156 @@
+// Q-learning with epsilon-greedy exploration over a fixed set of efforts, on bins (tabular) or
+// tiles (linear in the tiles' weights). A state is given as the rows it activates (ActiveRows);
+// Q(s, a) is the sum of their weights for a, one row for bins.
+#pragma once
+
+#include "cartpole_qlearning/learning/discretiser.h"
+#include "cartpole_qlearning/learning/features.h"
+#include "cartpole_qlearning/learning/q_table.h"
+#include "cartpole_qlearning/common/random.h"
+#include "cartpole_qlearning/learning/schedule.h"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace cartpole_qlearning
+{
+struct AgentParams
+{
+  // What the learner sees of the state (features.h). The bins are used by bins only, the bounds
+  // by both, tilings and tiles (per dimension) by tiles only.
+  FeatureKind features = FeatureKind::Bins;
+  DiscretiserParams discretiser;
+  unsigned tilings = 8;
+  std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
+  bool previous_action = false;               // the action taken last is part of what the learner sees
+  std::vector<double> actions{-10.0, 10.0};   // [N] the effort of each action
+  double gamma = 0.99;                        // discount, in [0, 1]
+  ScheduleParams epsilon = defaultEpsilon();  // exploration rate per episode
+  ScheduleParams alpha = defaultAlpha();      // learning rate per episode
+  // Names of the table's rows for the trace, then the name of the terminal state (which has no
+  // row: its Q is 0); empty: S0 ... S<n-1> and "fallen". Display only: not part of the table.
+  std::vector<std::string> state_names;
+
+  // The defaults of config/cartpole.yaml (why: its comments): epsilon linear from 1.0 to 0.03
+  // over 150 episodes, alpha on the log schedule from 1.0 to 0.05 over ~150.
+  static ScheduleParams defaultEpsilon();
+  static ScheduleParams defaultAlpha();
+
+  FeatureParams featureParams() const;
+
+  // Empty when valid, else a message naming the first bad field, its value and the allowed range.
+  std::string validate() const;
+};
+
+// What one update did, in the tutorial's terms: Q(s,a) went from old_value to
+// new_value = old_value + alpha * (target - old_value), with target = reward + gamma * next_max
+// (next_max = max_a' Q(s',a'), 0 and unused when the next state is terminal).
+struct QUpdate
+{
+  double old_value = 0.0;
+  double next_max = 0.0;
+  double target = 0.0;
+  double new_value = 0.0;
+};
+
+class QLearningAgent
+{
+public:
+  // The exploration draws come from the agent's own stream of this seed.
+  QLearningAgent(const AgentParams& params, std::uint64_t seed);
+
+  const AgentParams& params() const
+  {
+    return params_;
+  }
+  const FeatureMap& features() const
+  {
+    return features_;
+  }
+  // Bins only (the default discretiser for tiles).
+  const Discretiser& discretiser() const
+  {
+    return features_.discretiser();
+  }
+  // The rows a state activates. No allocation.
+  // previous: 0 for none (an episode's first state), else 1 + the action taken last.
+  void activeRows(const CartPoleState& state, ActiveRows& active, std::size_t previous = 0) const
+  {
+    features_.activeRows(state, active, previous);
+  }
+  const QTable& table() const
+  {
+    return table_;
+  }
+  QTable& table()
+  {
+    return table_;
+  }
+
+  double epsilon(unsigned long episode) const
+  {
+    return epsilon_.value(episode);
+  }
+  double alpha(unsigned long episode) const
+  {
+    return alpha_.value(episode);
+  }
+
+  // Replaces the discount and the schedules of a running agent (live tuning), checked as the
+  // configuration is (AgentParams::validate); on a bad value returns the message and changes
+  // nothing. The schedules are then read at the table's episode count, as if they had applied
+  // from the start.
+  std::string setLearning(double gamma, const ScheduleParams& epsilon, const ScheduleParams& alpha);
+
+  // Q(s, a): the sum of the active rows' weights for the action.
+  double value(const ActiveRows& state, std::size_t action) const;
+
+  // With probability epsilon a uniformly drawn action, else the greedy one. Always takes one
+  // draw for the coin and, when exploring, one for the action.
+  std::size_t selectAction(const ActiveRows& state, double epsilon);
+  // The first action with the largest Q (ties go to the lowest index, as numpy's argmax).
+  std::size_t greedyAction(const ActiveRows& state) const;
+  // The same for a bins state given as its row.
+  std::size_t selectAction(std::size_t state, double epsilon)
+  {
+    return selectAction(ActiveRows::single(state), epsilon);
+  }
+  std::size_t greedyAction(std::size_t state) const
+  {
+    return table_.argmax(state);
+  }
+
+  // Q(s,a) += alpha * (target - Q(s,a)) with target = reward + gamma * max_a' Q(s',a'); the max
+  // term is dropped when next_is_terminal (a fall has no future), kept on truncation. With N
+  // active rows each of their weights moves by alpha / N of the error, so Q(s,a) moves by alpha
+  // of it whatever N is (alpha keeps its meaning across bins and tilings). Returns what it did
+  // (the trace).
+  QUpdate update(const ActiveRows& state, std::size_t action, double reward, const ActiveRows& next_state,
+                 bool next_is_terminal, double alpha);
+  // The same for bins states given as their rows.
+  QUpdate update(std::size_t state, std::size_t action, double reward, std::size_t next_state, bool next_is_terminal,
+                 double alpha)
+  {
+    return update(ActiveRows::single(state), action, reward, ActiveRows::single(next_state), next_is_terminal, alpha);
+  }
+
+  // Replaces the table after checking it has this agent's features and actions; on a
+  // mismatch returns what differs and leaves the table in use as it was.
+  std::string replaceTable(QTable table);
+
+private:
+  // Over several rows: the greedy action, and its Q in best_q when given.
+  std::size_t greedyAction(const ActiveRows& state, double* best_q) const;
+  double maxValue(const ActiveRows& state) const;
+
+  AgentParams params_;
+  FeatureMap features_;
+  Schedule epsilon_;
+  Schedule alpha_;
+  QTable table_;
+  RandomStream rng_;
+};
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,86 @@
+// The Q-table and what it takes to interpret it: the features that number its rows (bins: one
+// row per state; tiles: one row of weights per tile, Q the sum over the active tiles), the
+// efforts that name its columns, and how much training produced it.
+#pragma once
+
+#include "cartpole_qlearning/learning/discretiser.h"
+#include "cartpole_qlearning/learning/features.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace cartpole_qlearning
+{
+// The most actions (table columns) a config or a file may have.
+constexpr std::size_t kMaxActions = 100;
+
+class QTable
+{
+public:
+  QTable() = default;
+  // A table of zeros with one row per discretiser state and one column per action effort.
+  QTable(const DiscretiserParams& discretiser, const std::vector<double>& actions);
+  // A table of zeros with one row per feature row (state or tile) and one column per action.
+  QTable(const FeatureParams& features, const std::vector<double>& actions);
+
+  // Rows: states for bins, tiles of all tilings for tiles.
+  std::size_t stateCount() const
+  {
+    return state_count_;
+  }
+  std::size_t actionCount() const
+  {
+    return actions_.size();
+  }
+
+  double& at(std::size_t state, std::size_t action)
+  {
+    return values_[state * actions_.size() + action];
+  }
+  double at(std::size_t state, std::size_t action) const
+  {
+    return values_[state * actions_.size() + action];
+  }
+
+  // The first action with the largest value (ties go to the lowest index, as numpy's argmax).
+  std::size_t argmax(std::size_t state) const;
+  double max(std::size_t state) const;
+
+  const FeatureParams& features() const
+  {
+    return features_;
+  }
+  // The bins and the bounds (the bounds serve tiles too).
+  const DiscretiserParams& discretiser() const
+  {
+    return features_.discretiser;
+  }
+  const std::vector<double>& actions() const
+  {
+    return actions_;
+  }
+  // Row-major: state * actionCount() + action.
+  const std::vector<double>& values() const
+  {
+    return values_;
+  }
+  // Replaces the values; throws std::invalid_argument unless the size is stateCount() * actionCount().
+  void setValues(std::vector<double> values);
+
+  // Training that produced the table, so that a loaded table resumes its schedules.
+  std::uint64_t episodes = 0;
+  std::uint64_t steps = 0;
+
+  // Empty when the other table has the same features (kind, bins or tilings and tiles, bounds)
+  // and actions, else what differs.
+  std::string shapeMismatch(const QTable& other) const;
+
+private:
+  FeatureParams features_;
+  std::vector<double> actions_;
+  std::size_t state_count_ = 0;
+  std::vector<double> values_;
+};
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,40 @@
+// The Q-table file: a versioned, self-describing YAML document with a checksum. Saving is
+// atomic; loading checks everything before the caller's table is touched.
+#pragma once
+
+#include "cartpole_qlearning/io/file_access.h"
+#include "cartpole_qlearning/learning/q_table.h"
+
+#include <string>
+
+namespace cartpole_qlearning
+{
+// Anything wrong with a path or a table file; the message says what, and nothing was changed.
+using FileError = FileError;
+
+// Version 2 says which features number the rows (bins or tiles, with their parameters);
+// version 1 (bins only) is still read, as bins.
+constexpr int kQTableFormatVersion = 2;
+
+// Saves atomically (see file_access.h: the target is either the old file or the complete new
+// one, whatever happens). Creates missing parent directories. Throws QTableFileError.
+void saveQTableFile(const QTable& table, const std::string& path);
+// The same for a path under a directory, as services take it: no links, no "..".
+void saveQTableUnder(const QTable& table, const std::string& directory, const std::string& path);
+
+// Reads and checks a file: format name, version, shape, counts, finite values and checksum.
+// Throws QTableFileError saying what is wrong. Whether it fits a given agent is the caller's
+// check (QTable::shapeMismatch), made before the live table is replaced.
+QTable loadQTableFile(const std::string& path);
+QTable loadQTableUnder(const std::string& directory, const std::string& path);
+
+// Where a controller in this ROS namespace keeps its tables unless told otherwise, and where
+// train_headless saves a relative --save path: $ROS_HOME/cartpole_qlearning<namespace>
+// ($ROS_HOME defaults to ~/.ros), e.g. ~/.ros/cartpole_qlearning/cartpole for "/cartpole".
+std::string defaultTableDirectory(const std::string& name_space);
+
+// The document's text and its parse, separately (save and load are these plus file handling).
+std::string formatQTable(const QTable& table);
+QTable parseQTable(const std::string& text);
+
+}  // namespace cartpole_qlearning

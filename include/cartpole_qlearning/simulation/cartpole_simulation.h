@@ -1,0 +1,93 @@
+// The simulated robot: dynamics, the current state, the seeded draw of start states, and what a
+// real cart-pole does beside the ideal model (perturbations.h: a late command, noisy sensors,
+// other masses per episode, pushes). The simulator node owns one; the headless trainer owns one
+// in the same way.
+#pragma once
+
+#include "cartpole_qlearning/simulation/cartpole_dynamics.h"
+#include "cartpole_qlearning/simulation/perturbations.h"
+#include "cartpole_qlearning/common/random.h"
+
+#include <cstdint>
+
+namespace cartpole_qlearning
+{
+class CartPoleSimulation
+{
+public:
+  // start_state_bound: a random reset draws each state value uniformly in +-this.
+  CartPoleSimulation(const CartPoleParams& params, double start_state_bound, std::uint64_t seed,
+                     const PerturbationParams& perturbations = PerturbationParams());
+
+  // This episode's dynamics (the configured physics, or the physics drawn for this episode).
+  const CartPoleDynamics& dynamics() const
+  {
+    return dynamics_;
+  }
+  // The true state.
+  const CartPoleState& state() const
+  {
+    return state_;
+  }
+  // What the sensors read of it (the true state when they are not noisy): drawn once per reset
+  // and step, so it reads the same however often it is asked.
+  const CartPoleState& observation() const
+  {
+    return observation_;
+  }
+  // The force that acted during the last step [N]: the command that came through the delay,
+  // clamped to +-force_mag, times this episode's motor factor, plus any push.
+  double appliedForce() const
+  {
+    return applied_force_;
+  }
+  // This episode's motor factor (1 unless perturbations.motor varies).
+  double motorFactor() const
+  {
+    return motor_factor_;
+  }
+  // This episode's actuation delay [steps].
+  unsigned delaySteps() const
+  {
+    return delay_.steps();
+  }
+  // The push that acted during the last step [N] (0: none).
+  double lastPush() const
+  {
+    return last_push_;
+  }
+  const PerturbationParams& perturbations() const
+  {
+    return perturbations_;
+  }
+
+  // A new episode: draws x, x_dot, theta, theta_dot in that order from the environment stream,
+  // then this episode's physics (when the perturbations vary it). Returns the true state.
+  const CartPoleState& resetRandom();
+  // A new episode from the given state (physics drawn as resetRandom does).
+  const CartPoleState& reset(const CartPoleState& state);
+
+  // Advances one tau: the command joins the actuation delay, and the one that comes out of it
+  // acts (clamped to +-force_mag, times the motor factor, plus a push when one is drawn).
+  // Returns the true state.
+  const CartPoleState& step(double command);
+
+private:
+  void beginEpisode();
+
+  CartPoleParams nominal_;
+  CartPoleDynamics dynamics_;
+  double start_state_bound_;
+  PerturbationParams perturbations_;
+  RandomStream rng_;
+  RandomStream noise_rng_;
+  RandomStream perturbation_rng_;
+  ActuationDelay delay_;
+  CartPoleState state_ = CartPoleState::Zero();
+  CartPoleState observation_ = CartPoleState::Zero();
+  double applied_force_ = 0.0;
+  double motor_factor_ = 1.0;
+  double last_push_ = 0.0;
+};
+
+}  // namespace cartpole_qlearning

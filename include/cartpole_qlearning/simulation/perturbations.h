@@ -1,0 +1,97 @@
+// What a real cart-pole does that the ideal model does not: it answers a command late, its
+// sensors are noisy, its masses, pole and motor are not the model's, and it gets pushed. The
+// core simulation applies these (CartPoleSimulation), so that the sim node, train_headless and
+// the robustness suite share one model, reproducible by seed. All off by default: the ideal
+// model, bit for bit.
+#pragma once
+
+#include "cartpole_qlearning/simulation/cartpole_dynamics.h"
+#include "cartpole_qlearning/common/random.h"
+
+#include <array>
+#include <deque>
+#include <string>
+
+namespace cartpole_qlearning
+{
+// A factor of a configured value, drawn per episode uniformly in [low, high].
+struct ScaleRange
+{
+  double low = 1.0;
+  double high = 1.0;
+
+  bool varies() const
+  {
+    return !(low == 1.0 && high == 1.0);
+  }
+};
+
+struct PerturbationParams
+{
+  // Actuation delay [steps]: a command takes effect this many steps after the state it answers
+  // (a controller over topics on ros_control hardware: one control period). Until then the
+  // earlier commands act; after a reset, zero. Drawn per episode, uniformly among the whole
+  // numbers in [delay_steps, delay_steps_max] (one value when they are equal).
+  unsigned delay_steps = 0;
+  unsigned delay_steps_max = 0;
+  // Sensor noise: each observed value is the true one plus Gaussian noise of standard deviation
+  // noise_std[i] + noise_fraction[i] * |value| ([m, m/s, rad, rad/s]; a fraction). The true
+  // state, which the physics integrates, is untouched.
+  std::array<double, 4> noise_std{};
+  std::array<double, 4> noise_fraction{};
+  // Physics drawn per episode, each as a factor of the configured value.
+  ScaleRange mass_cart;
+  ScaleRange mass_pole;
+  ScaleRange half_length;
+  ScaleRange motor;  // the force the motor applies for a command (0.8: 20 % weaker)
+  // Random pushes: at each step, with this probability, push_force [N] in a random direction
+  // acts on the cart for that step, beside the motor's force.
+  double push_probability = 0.0;
+  double push_force = 0.0;
+
+  bool noisy() const;
+  bool any() const;
+  // Empty when valid, else a message naming the first bad field, its value and the allowed range.
+  std::string validate() const;
+};
+
+// The stream of the per-episode physics draws and the pushes (random.h has the others): its own,
+// so that turning perturbations on changes neither the start states nor exploration.
+constexpr std::uint64_t kPerturbationStream = 3;
+
+// The physics of one episode: the configured physics with the drawn factors applied (the motor
+// factor is kept apart: it scales commands, not force_mag's clamp), and its delay.
+CartPoleParams drawEpisodePhysics(const CartPoleParams& nominal, const PerturbationParams& perturbations,
+                                  RandomStream& rng, double& motor_factor, unsigned& delay_steps);
+
+// A command line that delivers each command delay_steps steps after it was given.
+class ActuationDelay
+{
+public:
+  explicit ActuationDelay(unsigned steps = 0);
+  // Empties the line (zero acts until new commands come through), now `steps` long.
+  void reset(unsigned steps);
+  void reset()
+  {
+    reset(steps_);
+  }
+  unsigned steps() const
+  {
+    return steps_;
+  }
+  // Takes the command for this step and returns the one that acts now.
+  double apply(double command);
+
+private:
+  unsigned steps_;
+  std::deque<double> line_;
+};
+
+// What is on, for a log line: "delay 1 step (0.02 s), noise_std [0.01, 0, 0.0087, 0], motor x[0.8, 0.8]"
+// (tau: the step [s]); "none" when nothing is.
+std::string describePerturbations(const PerturbationParams& perturbations, double tau);
+
+// Adds the sensor noise to a state (the draws come from rng, one normal per noisy value).
+CartPoleState addSensorNoise(const CartPoleState& state, const PerturbationParams& perturbations, RandomStream& rng);
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,441 @@
+#include "cartpole_qlearning/application/node_settings.h"
+
+#include "cartpole_qlearning/io/file_access.h"
+#include "cartpole_qlearning/application/headless_trainer.h"
+#include "cartpole_qlearning/learning/q_table_file.h"
+#include "cartpole_qlearning/application/robustness_suite.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <optional>
+#include <utility>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+constexpr std::int64_t kMaxRobots = 1000;
+
+// A value of any form as messages show it (for a key whose forms are all wrong).
+std::string anyValueText(const ParameterSource& source, const std::string& key)
+{
+  const auto quoted = [](const std::string& text) { return "'" + text + "'"; };
+  try
+  {
+    std::string text;
+    if (source.get(key, text))
+      return quoted(text);
+  }
+  catch (const ConfigError&)
+  {
+  }
+  try
+  {
+    double number = 0.0;
+    if (source.get(key, number))
+      return SectionReader::numberText(number);
+  }
+  catch (const ConfigError&)
+  {
+  }
+  try
+  {
+    bool flag = false;
+    if (source.get(key, flag))
+      return flag ? "true" : "false";
+  }
+  catch (const ConfigError&)
+  {
+  }
+  try
+  {
+    std::vector<double> numbers;
+    if (source.get(key, numbers))
+      return SectionReader::listText(numbers);
+  }
+  catch (const ConfigError&)
+  {
+  }
+  const std::vector<std::string> keys = source.keysUnder(key);
+  return keys.size() == 1 && keys.front() == key ? "a list of mixed values" : "a map";
+}
+
+std::string listText(const std::vector<std::string>& names)
+{
+  std::string text;
+  for (const std::string& name : names)
+    text += (text.empty() ? "" : ", ") + name;
+  return "[" + text + "]";
+}
+
+// ~robots: a list of namespaces (relative to the learner's), or a whole number N: one robot,
+// the learner's own namespace (N = 1), or robot_0 ... robot_<N-1> (train.launch robots:=N).
+void readRobots(const ParameterSource& source, SectionReader& priv, const ControllerContext& context,
+                std::vector<std::string>& robots)
+{
+  priv.know("robots");
+  const std::string allowed =
+      "a whole number in [1, " + std::to_string(kMaxRobots) + "] or a list of namespaces relative to the controller's";
+  std::int64_t count = 0;
+  bool whole_number = false;
+  try
+  {
+    if (!source.get("robots", count))
+      return;
+    whole_number = true;
+  }
+  catch (const ConfigError&)  // not a whole number: a list, or nothing allowed
+  {
+  }
+  if (whole_number)
+  {
+    if (count < 1 || count > kMaxRobots)
+      priv.fail("robots", std::to_string(count), allowed);
+    robots = robotNamespaces(static_cast<std::size_t>(count));
+    return;
+  }
+  std::vector<std::string> names;
+  try
+  {
+    source.get("robots", names);
+  }
+  catch (const ConfigError&)
+  {
+    priv.fail("robots", anyValueText(source, "robots"), allowed);
+  }
+  if (names.empty() || names.size() > static_cast<std::size_t>(kMaxRobots))
+    priv.fail("robots", listText(names), allowed);
+  for (auto it = names.begin(); it != names.end(); ++it)
+  {
+    const std::string error = it->empty() || !context.name_error ? "" : context.name_error(*it);
+    if (!error.empty())
+      priv.fail("robots", listText(names), "'" + *it + "' is not a valid ROS name: " + error);
+    if (std::find(names.begin(), it, *it) != it)
+      priv.fail("robots", listText(names), "'" + *it + "' is listed twice");
+  }
+  robots = std::move(names);
+}
+
+// ~suite and ~suite_case (the sim and the controller alike): the case, loaded with the suite's
+// episodes and seed, or nullopt when no case is named. base: the physics the cases vary.
+std::optional<std::pair<RobustnessSuite, SuiteCase>> readSuiteCase(SectionReader& priv, const TrainingConfig& base)
+{
+  std::string path;
+  std::string name;
+  priv.read("suite", path);
+  priv.read("suite_case", name);
+  if (name.empty())
+    return std::nullopt;
+  if (path.empty())
+    priv.fail("suite_case", "'" + name + "'", "needs ~suite, the suite file that holds the case");
+  const RobustnessSuite suite = loadRobustnessSuite(path, base);
+  std::string names;
+  for (const SuiteCase& c : suite.cases)
+  {
+    if (c.name == name)
+      return std::make_pair(suite, c);
+    names += (names.empty() ? "" : ", ") + c.name;
+  }
+  priv.fail("suite_case", "'" + name + "'", "the cases of " + path + ": " + names);
+}
+
+void readSign(SectionReader& priv, const std::string& name, double& sign)
+{
+  priv.read(name, sign);
+  if (sign != 1.0 && sign != -1.0)
+    priv.fail(name, SectionReader::numberText(sign), "must be 1 or -1");
+}
+
+void readFinite(SectionReader& priv, const std::string& name, double& value)
+{
+  priv.read(name, value);
+  if (!std::isfinite(value))
+    priv.fail(name, SectionReader::numberText(value), "must be finite");
+}
+
+// The robot's joints, offsets and command (robot_interface.h; docs/your_own_cartpole.md).
+void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& robot)
+{
+  for (const auto& [name, text] : {std::pair<const char*, std::string*>{"cart_joint", &robot.cart_joint},
+                                   {"pole_joint", &robot.pole_joint},
+                                   {"state_topic", &robot.state_topic},
+                                   {"command_topic", &robot.command_topic}})
+  {
+    priv.read(name, *text);
+    if (text->empty())
+      priv.fail(name, "''", "must not be empty");
+  }
+  if (robot.cart_joint == robot.pole_joint)
+    priv.fail("pole_joint", "'" + robot.pole_joint + "'", "must differ from ~cart_joint");
+  readFinite(priv, "cart_zero", robot.cart_zero);
+  readFinite(priv, "pole_upright", robot.pole_upright);
+  readSign(priv, "cart_sign", robot.cart_sign);
+  readSign(priv, "pole_angle_sign", robot.pole_angle_sign);
+  readSign(priv, "effort_sign", robot.effort_sign);
+  priv.read("velocity_smoothing", robot.velocity_smoothing);
+  if (!(robot.velocity_smoothing >= 0.0 && robot.velocity_smoothing < 1.0))
+    priv.fail("velocity_smoothing", SectionReader::numberText(robot.velocity_smoothing), "must be in [0, 1)");
+  std::string type = "joint_state";
+  priv.readChoice("command_type", type, {"joint_state", "float64", "float64_array"});
+  robot.command_type = type == "float64"         ? CommandType::Float64
+                       : type == "float64_array" ? CommandType::Float64Array
+                                                 : CommandType::JointState;
+  robot.command_joint = robot.cart_joint;
+  priv.read("command_joint", robot.command_joint);
+  if (robot.command_joint.empty())
+    priv.fail("command_joint", "''", "must name the cart's joint as the robot takes commands for it");
+  std::uint64_t index = 0;
+  std::uint64_t size = 1;
+  priv.read("command_index", index, 0);
+  priv.read("command_size", size, 1);
+  if (index >= size)
+    priv.fail("command_index", std::to_string(index), "must be < ~command_size = " + std::to_string(size));
+  robot.command_index = static_cast<std::size_t>(index);
+  robot.command_size = static_cast<std::size_t>(size);
+  robot.decision_period = tau;
+  priv.readAtLeast("decision_period", robot.decision_period, 0.0, false);
+}
+}  // namespace
+
+ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& source,
+                                          const ControllerContext& context)
+{
+  ControllerSettings settings;
+  settings.training = readTrainingConfig(shared);
+  RunSettings& run = settings.run;
+  run.name_space = context.name_space;
+  settings.shutdown_when_finished = context.shutdown_by_default;
+
+  // The same reader and checks as the shared sections; a key it does not know (a typo) stops
+  // the node instead of being ignored.
+  SectionReader priv(source, "");
+  // The launch files' stop_when_solved and max_episodes arrive as private parameters; they
+  // override the shared training/ keys for this controller only.
+  priv.read("stop_when_solved", settings.training.limits.stop_when_solved);
+  priv.read("max_episodes", settings.training.limits.max_episodes, 1);
+
+  std::string mode = "train";
+  priv.readChoice("mode", mode, {"train", "evaluate"});
+  run.learning = mode == "train";
+  priv.read("seed", run.seed, 0);
+
+  run.q_table_dir = defaultTableDirectory(context.name_space);
+  priv.read("q_table_dir", run.q_table_dir);
+  if (run.q_table_dir.empty())
+    priv.fail("q_table_dir", "''", "must name a directory");
+  // Paths given as "~/..." (roslaunch passes them on unexpanded) name the user's home.
+  const auto expand_home = [&](const std::string& name, std::string& path) {
+    try
+    {
+      path = expandHome(path, context.home);
+    }
+    catch (const FileError& e)
+    {
+      priv.fail(name, "'" + path + "'", e.what());
+    }
+  };
+  expand_home("q_table_dir", run.q_table_dir);
+  priv.read("q_table_path", run.q_table_path);
+  expand_home("q_table_path", run.q_table_path);
+  try
+  {
+    relativePathUnder(run.q_table_dir, run.q_table_path);
+  }
+  catch (const FileError& e)
+  {
+    priv.fail("q_table_path", "'" + run.q_table_path + "'", e.what());
+  }
+  priv.read("load_on_start", run.load_on_start);
+  expand_home("load_on_start", run.load_on_start);
+  priv.read("stats_csv", run.stats_csv);
+  expand_home("stats_csv", run.stats_csv);
+  if (run.stats_csv != "none" && !run.stats_csv.empty() && run.stats_csv.front() != '/')
+  {
+    try
+    {
+      relativePathUnder(run.q_table_dir, run.stats_csv);
+    }
+    catch (const FileError& e)
+    {
+      priv.fail("stats_csv", "'" + run.stats_csv + "'", e.what());
+    }
+  }
+  priv.read("run_id", run.run_id);
+  // Set by the controller itself, for a respawn of it to find its run.
+  priv.know("run/id");
+  priv.know("run/launcher");
+  priv.know("run/folder");
+  priv.read("evaluation_episodes", run.evaluation_episodes, 0);
+  // What the sim poses as (evaluate.launch suite_case:=NAME), for the verdict to say.
+  if (const auto found = readSuiteCase(priv, settings.training))
+  {
+    const auto& [suite, suite_case] = *found;
+    if (run.learning)
+      priv.fail("suite_case", "'" + suite_case.name + "'", "only with mode evaluate: the verdict says the case");
+    if (source.keysUnder("evaluation_episodes").empty())
+      run.evaluation_episodes = suite.episodes;
+    run.evaluation_case = "case " + suite_case.name + " of " + suite.origin;
+    // The case's pass count, for as many episodes as the verdict comes after (rounded up).
+    run.evaluation_pass = (suite_case.pass * run.evaluation_episodes + suite.episodes - 1) / suite.episodes;
+  }
+  priv.read("checkpoint_every", run.checkpoint_every, 0);
+  priv.read("save_on_shutdown", run.save_on_shutdown);
+  priv.read("shutdown_when_finished", settings.shutdown_when_finished);
+  priv.readAtLeast("sim_timeout", settings.sim_timeout, 0.0, true);
+  priv.read("reset_service", settings.reset_service);
+
+  ControllerProtocolParams& protocol = settings.protocol;
+  protocol.reset_service = !settings.reset_service.empty();
+  std::array<double, kStateDimensions> region{};
+  region.fill(settings.training.start_state_bound);
+  priv.readDimensions("start_region", region, false);
+  for (std::size_t i = 0; i < kStateDimensions; ++i)
+  {
+    if (!(std::isfinite(region[i]) && region[i] > 0.0))
+      priv.fail("start_region", SectionReader::listText({region.begin(), region.end()}),
+                "must be 4 finite values > 0: |x|, |x_dot|, |theta|, |theta_dot| bounds");
+    protocol.start_region[i] = region[i];
+  }
+  readRobotInterface(priv, settings.training.physics.tau, settings.robot);
+  priv.readChoice("reset_service_type", settings.reset_service_type,
+                  {"cartpole_qlearning/Reset", "std_srvs/Empty", "std_srvs/Trigger"});
+  protocol.reset_starts_in_region = settings.reset_service_type != "cartpole_qlearning/Reset";
+  readRobots(source, priv, context, settings.robots);
+  priv.read("sync", settings.sync);
+  priv.read("trace", run.trace);
+  run.suite_folders = context.suite_folders;
+  if (run.trace && settings.training.agent.features == FeatureKind::Tiles)
+    priv.fail("trace", "true", "the trace shows one table row per state: learning/features bins only");
+  for (const std::string& key : context.other_keys)
+    priv.know(key);
+  priv.refuseUnknown();
+  protocol.limits = settings.training.limits;
+  return settings;
+}
+
+SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource& source)
+{
+  SimSettings settings;
+  readPhysics(shared, settings.physics, settings.start_state_bound);
+
+  // The same reader and checks as the shared sections; a key it does not know (a typo such as
+  // lockstep_timout) stops the node instead of being ignored.
+  SectionReader priv(source, "");
+  std::string mode = "realtime";
+  priv.readChoice("mode", mode, {"realtime", "lockstep"});
+  settings.mode = mode == "lockstep" ? SimMode::Lockstep : SimMode::Realtime;
+  priv.read("seed", settings.seed, 0);
+  settings.perturbations = readPerturbations(shared);
+  // A suite case's physics, start region and perturbations replace the shared ones, as
+  // train_headless --evaluate TABLE --suite FILE runs it; its seed is the suite's unless ~seed is set.
+  TrainingConfig base;
+  base.physics = settings.physics;
+  base.start_state_bound = settings.start_state_bound;
+  if (const auto found = readSuiteCase(priv, base))
+  {
+    const auto& [suite, suite_case] = *found;
+    settings.suite = suite.origin;
+    settings.suite_case = suite_case.name;
+    settings.physics = suite_case.physics;
+    settings.start_state_bound = suite_case.start_state_bound;
+    settings.perturbations = suite_case.perturbations;
+    if (source.keysUnder("seed").empty())
+      settings.seed = suite.seed;
+  }
+  priv.readAtLeast("command_timeout", settings.command_timeout, 0.0, true);
+  priv.readAtLeast("lockstep_timeout", settings.lockstep_timeout, 0.0, true);
+  priv.readAtLeast("tf_rate", settings.tf_rate, 0.0, true);
+  settings.effort_limit = settings.physics.force_mag;
+  priv.readAtLeast("effort_limit", settings.effort_limit, 0.0, true);
+  if (settings.effort_limit > settings.physics.force_mag)
+    priv.fail("effort_limit", SectionReader::numberText(settings.effort_limit),
+              "must be <= physics/force_mag = " + SectionReader::numberText(settings.physics.force_mag));
+  // The sim's own noise keys gave way to the core's model, which train_headless shares.
+  for (const auto& [name, instead] :
+       {std::pair<const char*, const char*>{"position_noise_std", "noise_std: [x, x_dot, theta, theta_dot]"},
+        {"velocity_noise_std", "noise_std and noise_fraction: [x, x_dot, theta, theta_dot]"},
+        {"effort_noise_std",
+         "motor: [low, high] (the motor's strength per episode), push_probability and "
+         "push_force"}})
+  {
+    if (source.keysUnder(name).empty())
+      continue;
+    std::string value;
+    try
+    {
+      double number = 0.0;
+      source.get(name, number);
+      value = SectionReader::numberText(number);
+    }
+    catch (const ConfigError&)
+    {
+      value = anyValueText(source, name);
+    }
+    priv.fail(name, value,
+              std::string("replaced by the shared perturbations section, as in config/cartpole.yaml: perturbations/") +
+                  instead);
+  }
+  RobotInterfaceParams& pose = settings.pose;
+  for (const auto& [name, joint] :
+       {std::pair<const char*, std::string*>{"cart_joint", &pose.cart_joint}, {"pole_joint", &pose.pole_joint}})
+  {
+    priv.read(name, *joint);
+    if (joint->empty())
+      priv.fail(name, "''", "must not be empty");
+  }
+  readFinite(priv, "cart_zero", pose.cart_zero);
+  readFinite(priv, "pole_upright", pose.pole_upright);
+  readSign(priv, "cart_sign", pose.cart_sign);
+  readSign(priv, "pole_angle_sign", pose.pole_angle_sign);
+  readSign(priv, "effort_sign", pose.effort_sign);
+  settings.publish_period = settings.physics.tau;
+  priv.read("publish_period", settings.publish_period);
+  // A stamp step of at least a microsecond; a second apart is no joint_states stream to pose as.
+  if (!source.keysUnder("publish_period").empty() &&
+      !(settings.publish_period >= 1e-6 && settings.publish_period <= 1.0))
+    priv.fail("publish_period", SectionReader::numberText(settings.publish_period), "must be in [1e-06, 1] s");
+  priv.read("group_effort_index", settings.group_effort_index, 0);
+  std::int64_t turns = 0;
+  priv.read("pole_turns", turns);
+  if (turns < -1000 || turns > 1000)
+    priv.fail("pole_turns", std::to_string(turns), "must be a whole number in [-1000, 1000]");
+  settings.pole_turns = static_cast<int>(turns);
+  priv.read("publish_velocities", settings.publish_velocities);
+  priv.read("publish_clock", settings.publish_clock);
+  priv.read("publish_tf", settings.publish_tf);
+  priv.read("track_y", settings.track_y);
+  if (!std::isfinite(settings.track_y))
+    priv.fail("track_y", SectionReader::numberText(settings.track_y), "must be finite");
+  for (const auto& [name, frame] : {std::pair<const char*, std::string*>{"world_frame", &settings.world_frame},
+                                    {"cart_frame", &settings.cart_frame},
+                                    {"pole_frame", &settings.pole_frame}})
+  {
+    priv.read(name, *frame);
+    if (frame->empty())
+      priv.fail(name, "''", "frame names must not be empty");
+  }
+  priv.refuseUnknown();
+  if (settings.publish_clock && settings.mode != SimMode::Lockstep)
+    priv.fail("publish_clock", "true", "only in lockstep mode: in realtime the wall clock is the clock");
+  return settings;
+}
+
+std::string controllerStartText(const ControllerSettings& settings, const QTable& table,
+                                const std::string& table_directory, const std::string& served)
+{
+  const FeatureParams& features = table.features();
+  const std::string rows = features.kind == FeatureKind::Tiles ? std::to_string(features.tilings) + " tilings, " +
+                                                                     std::to_string(table.stateCount()) + " tiles"
+                                                               : std::to_string(table.stateCount()) + " states";
+  std::string text = std::string(settings.run.learning ? "training" : "evaluating (greedy, no learning)") + ", seed " +
+                     std::to_string(settings.run.seed) + ", " + rows + " x " + std::to_string(table.actionCount()) +
+                     " actions, tables under " + table_directory + "; serving " + served;
+  if (settings.robots.size() > 1)
+    text += settings.sync ? " in lockstep rounds" : ", each as its states come";
+  return text + "; " +
+         (settings.protocol.reset_service ? "resets by ~" + settings.reset_service
+                                          : "no reset service: episodes start when the state is in ~start_region");
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,89 @@
+#include "cartpole_qlearning/learning/cartpole_task.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace cartpole_qlearning
+{
+RewardScheme rewardSchemeFromString(const std::string& name)
+{
+  if (name == "gymnasium")
+    return RewardScheme::Gymnasium;
+  if (name == "seed")
+    return RewardScheme::Seed;
+  if (name == "sutton_barto")
+    return RewardScheme::SuttonBarto;
+  throw std::invalid_argument("unknown reward scheme '" + name + "' (allowed: gymnasium, seed, sutton_barto)");
+}
+
+std::string toString(RewardScheme scheme)
+{
+  switch (scheme)
+  {
+    case RewardScheme::Gymnasium:
+      return "gymnasium";
+    case RewardScheme::Seed:
+      return "seed";
+    case RewardScheme::SuttonBarto:
+      return "sutton_barto";
+  }
+  return "unknown";
+}
+
+double TaskParams::thetaThresholdRad() const
+{
+  return theta_threshold_deg * 2.0 * M_PI / 360.0;
+}
+
+std::string TaskParams::validate() const
+{
+  std::ostringstream out;
+  if (!(std::isfinite(x_threshold) && x_threshold > 0.0))
+    out << "x_threshold = " << x_threshold << " is not allowed (must be finite and > 0)";
+  else if (!(std::isfinite(theta_threshold_deg) && theta_threshold_deg > 0.0 && theta_threshold_deg < 90.0))
+    out << "theta_threshold_deg = " << theta_threshold_deg << " is not allowed (must be in (0, 90))";
+  else if (max_episode_steps == 0)
+    out << "max_episode_steps = 0 is not allowed (must be >= 1)";
+  else if (!std::isfinite(solved_mean_return))
+    out << "solved_mean_return = " << solved_mean_return << " is not allowed (must be finite)";
+  else if (solved_window == 0)
+    out << "solved_window = 0 is not allowed (must be >= 1)";
+  return out.str();
+}
+
+CartPoleTask::CartPoleTask(const TaskParams& params) : params_(params), theta_threshold_rad_(params.thetaThresholdRad())
+{
+  const std::string error = params_.validate();
+  if (!error.empty())
+    throw std::invalid_argument(error);
+}
+
+bool CartPoleTask::isTerminal(const CartPoleState& state) const
+{
+  return state[0] < -params_.x_threshold || state[0] > params_.x_threshold || state[2] < -theta_threshold_rad_ ||
+         state[2] > theta_threshold_rad_;
+}
+
+StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned steps_taken) const
+{
+  StepOutcome outcome;
+  outcome.terminated = isTerminal(new_state);
+  // A step that both falls and hits the limit counts as a fall: there is no future to bootstrap on.
+  outcome.truncated = !outcome.terminated && steps_taken >= params_.max_episode_steps;
+  switch (params_.reward)
+  {
+    case RewardScheme::Gymnasium:
+      outcome.reward = 1.0;
+      break;
+    case RewardScheme::Seed:
+      outcome.reward = outcome.terminated ? -1.0 : 1.0;
+      break;
+    case RewardScheme::SuttonBarto:
+      outcome.reward = outcome.terminated ? -1.0 : 0.0;
+      break;
+  }
+  return outcome;
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,119 @@
+#include "cartpole_qlearning/learning/features.h"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace cartpole_qlearning
+{
+FeatureKind featureKindFromString(const std::string& name)
+{
+  if (name == "bins")
+    return FeatureKind::Bins;
+  if (name == "tiles")
+    return FeatureKind::Tiles;
+  throw std::invalid_argument("allowed: bins, tiles");
+}
+
+std::string toString(FeatureKind kind)
+{
+  return kind == FeatureKind::Tiles ? "tiles" : "bins";
+}
+
+TileCoderParams FeatureParams::tileCoder() const
+{
+  TileCoderParams coder;
+  coder.tilings = tilings;
+  coder.tiles = tiles;
+  coder.lower = discretiser.lower;
+  coder.upper = discretiser.upper;
+  return coder;
+}
+
+std::string FeatureParams::validate() const
+{
+  return kind == FeatureKind::Tiles ? tileCoder().validate() : discretiser.validate();
+}
+
+std::size_t FeatureParams::stateRowCount() const
+{
+  return kind == FeatureKind::Tiles ? TileCoder(tileCoder()).tileCount() : Discretiser(discretiser).stateCount();
+}
+
+std::size_t FeatureParams::rowCount(std::size_t actions) const
+{
+  return stateRowCount() * blocks(actions);
+}
+
+namespace
+{
+template <typename Container>
+std::string listText(const Container& values)
+{
+  std::ostringstream out;
+  out.precision(17);
+  out << "[";
+  bool first = true;
+  for (const auto& v : values)
+  {
+    out << (first ? "" : ", ") << v;
+    first = false;
+  }
+  out << "]";
+  return out.str();
+}
+
+std::string boundsText(const DiscretiserParams& d)
+{
+  return "lower " + listText(d.lower) + " upper " + listText(d.upper);
+}
+}  // namespace
+
+std::string FeatureParams::mismatch(const FeatureParams& other) const
+{
+  if (kind != other.kind)
+    return "features " + toString(other.kind) + " differ from " + toString(kind);
+  if (previous_action != other.previous_action)
+    return std::string("previous_action ") + (other.previous_action ? "true" : "false") + " differs from " +
+           (previous_action ? "true" : "false");
+  if (kind == FeatureKind::Bins)
+  {
+    if (discretiser.bins != other.discretiser.bins)
+      return "bins " + listText(other.discretiser.bins) + " differ from " + listText(discretiser.bins);
+    if (!(discretiser == other.discretiser))
+      return "bin bounds " + boundsText(other.discretiser) + " differ from " + boundsText(discretiser);
+    return "";
+  }
+  if (tilings != other.tilings)
+    return "tilings " + std::to_string(other.tilings) + " differ from " + std::to_string(tilings);
+  if (tiles != other.tiles)
+    return "tiles " + listText(other.tiles) + " differ from " + listText(tiles);
+  if (!(tileCoder() == other.tileCoder()))
+    return "tile bounds " + boundsText(other.discretiser) + " differ from " + boundsText(discretiser);
+  return "";
+}
+
+namespace
+{
+const FeatureParams& checked(const FeatureParams& params)
+{
+  const std::string error = params.validate();
+  if (!error.empty())
+    throw std::invalid_argument(error);
+  return params;
+}
+}  // namespace
+
+FeatureMap::FeatureMap(const FeatureParams& params, std::size_t actions)
+  : params_(checked(params)),
+    discretiser_(params.kind == FeatureKind::Bins ? params.discretiser : DiscretiserParams()),
+    state_rows_(discretiser_.stateCount())
+{
+  if (params_.kind == FeatureKind::Tiles)
+  {
+    tile_coder_.emplace(params_.tileCoder());
+    state_rows_ = tile_coder_->tileCount();
+  }
+  row_count_ = state_rows_ * params_.blocks(actions);
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,247 @@
+#include "cartpole_qlearning/learning/q_learning_agent.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace cartpole_qlearning
+{
+ScheduleParams AgentParams::defaultEpsilon()
+{
+  ScheduleParams schedule;
+  schedule.type = ScheduleType::Linear;
+  schedule.start = 1.0;
+  schedule.min = 0.03;
+  schedule.decay_episodes = 150.0;
+  schedule.log_divisor = 25.0;
+  return schedule;
+}
+
+ScheduleParams AgentParams::defaultAlpha()
+{
+  ScheduleParams schedule;
+  schedule.type = ScheduleType::Log;
+  schedule.start = 1.0;
+  schedule.min = 0.05;
+  schedule.log_divisor = 15.0;
+  return schedule;
+}
+
+namespace
+{
+// Names must tell the rows apart in the trace and in a replay file, each on one line.
+std::string stateNamesError(const std::vector<std::string>& names, const DiscretiserParams& discretiser)
+{
+  if (names.empty())
+    return "";
+  std::size_t states = 1;
+  for (const unsigned b : discretiser.bins)
+    states *= b;
+  std::ostringstream out;
+  if (names.size() != states + 1)
+  {
+    out << "state_names lists " << names.size() << " names, which is not allowed (must be " << states + 1
+        << ": one per table row (the bins give " << states << "), then the terminal state's)";
+    return out.str();
+  }
+  for (std::size_t i = 0; i < names.size(); ++i)
+  {
+    const std::string& name = names[i];
+    if (name.empty() || name.find_first_of("\n\r\t") != std::string::npos || name.front() == ' ' || name.back() == ' ')
+    {
+      out << "state_names[" << i << "] = '" << name
+          << "' is not allowed (must be a non-empty name on one line, without leading or trailing spaces)";
+      return out.str();
+    }
+    for (std::size_t j = 0; j < i; ++j)
+    {
+      if (names[j] == name)
+      {
+        out << "state_names[" << i << "] = '" << name << "' is not allowed (state_names[" << j
+            << "] has that name already)";
+        return out.str();
+      }
+    }
+  }
+  return "";
+}
+}  // namespace
+
+FeatureParams AgentParams::featureParams() const
+{
+  FeatureParams params;
+  params.kind = features;
+  params.discretiser = discretiser;
+  params.tilings = tilings;
+  params.tiles = tiles;
+  params.previous_action = previous_action;
+  return params;
+}
+
+std::string AgentParams::validate() const
+{
+  std::ostringstream out;
+  std::string error = featureParams().validate();
+  if (!error.empty())
+    return error;
+  if (actions.empty())
+    return "actions = [] is not allowed (must list at least one effort)";
+  if (actions.size() > kMaxActions)
+    return "actions lists " + std::to_string(actions.size()) + " efforts, which is not allowed (at most " +
+           std::to_string(kMaxActions) + ")";
+  for (std::size_t i = 0; i < actions.size(); ++i)
+  {
+    if (!std::isfinite(actions[i]))
+    {
+      out << "actions[" << i << "] = " << actions[i] << " is not allowed (must be finite)";
+      return out.str();
+    }
+  }
+  if (!(gamma >= 0.0 && gamma <= 1.0))
+  {
+    out << "gamma = " << gamma << " is not allowed (must be in [0, 1])";
+    return out.str();
+  }
+  // Names label table rows, one per state: tiles have no such rows.
+  error = features == FeatureKind::Tiles && !state_names.empty()
+              ? "state_names is not allowed with features tiles (it names the rows of bins, one per state)"
+          : previous_action && !state_names.empty()
+              ? "state_names is not allowed with previous_action (the rows repeat per previous action)"
+              : stateNamesError(state_names, discretiser);
+  if (!error.empty())
+    return error;
+  error = epsilon.validate();
+  if (!error.empty())
+    return "epsilon/" + error;
+  error = alpha.validate();
+  if (!error.empty())
+    return "alpha/" + error;
+  return "";
+}
+
+namespace
+{
+const AgentParams& checked(const AgentParams& params)
+{
+  const std::string error = params.validate();
+  if (!error.empty())
+    throw std::invalid_argument(error);
+  return params;
+}
+}  // namespace
+
+QLearningAgent::QLearningAgent(const AgentParams& params, std::uint64_t seed)
+  : params_(checked(params)),
+    features_(params.featureParams(), params.actions.size()),
+    epsilon_(params.epsilon),
+    alpha_(params.alpha),
+    table_(params.featureParams(), params.actions),
+    rng_(seed, kAgentStream)
+{
+}
+
+double QLearningAgent::value(const ActiveRows& state, std::size_t action) const
+{
+  double q = table_.at(state.rows[0], action);
+  for (unsigned i = 1; i < state.count; ++i)
+    q += table_.at(state.rows[i], action);
+  return q;
+}
+
+std::size_t QLearningAgent::greedyAction(const ActiveRows& state, double* best_q) const
+{
+  const std::size_t actions = table_.actionCount();
+  // Row by row, all actions at once: each row's weights are contiguous.
+  std::array<double, kMaxActions> q;
+  const double* const values = table_.values().data();
+  const double* first = values + state.rows[0] * actions;
+  std::copy(first, first + actions, q.begin());
+  for (unsigned i = 1; i < state.count; ++i)
+  {
+    const double* row = values + state.rows[i] * actions;
+    for (std::size_t a = 0; a < actions; ++a)
+      q[a] += row[a];
+  }
+  std::size_t best = 0;
+  for (std::size_t a = 1; a < actions; ++a)
+  {
+    if (q[a] > q[best])
+      best = a;
+  }
+  if (best_q != nullptr)
+    *best_q = q[best];
+  return best;
+}
+
+std::size_t QLearningAgent::greedyAction(const ActiveRows& state) const
+{
+  if (state.count == 1)
+    return table_.argmax(state.rows[0]);
+  return greedyAction(state, nullptr);
+}
+
+double QLearningAgent::maxValue(const ActiveRows& state) const
+{
+  if (state.count == 1)
+    return table_.max(state.rows[0]);
+  double best_q = 0.0;
+  greedyAction(state, &best_q);
+  return best_q;
+}
+
+std::size_t QLearningAgent::selectAction(const ActiveRows& state, double epsilon)
+{
+  if (rng_.uniform01() < epsilon)
+    return static_cast<std::size_t>(rng_.uniformIndex(table_.actionCount()));
+  return greedyAction(state);
+}
+
+QUpdate QLearningAgent::update(const ActiveRows& state, std::size_t action, double reward, const ActiveRows& next_state,
+                               bool next_is_terminal, double alpha)
+{
+  QUpdate done;
+  done.next_max = next_is_terminal ? 0.0 : maxValue(next_state);
+  done.target = next_is_terminal ? reward : reward + params_.gamma * done.next_max;
+  if (state.count == 1)
+  {
+    // Bins: one row, the arithmetic in the order it always had (a seed's table stays the same).
+    double& q = table_.at(state.rows[0], action);
+    done.old_value = q;
+    q += alpha * (done.target - q);
+    done.new_value = q;
+    return done;
+  }
+  done.old_value = value(state, action);
+  const double step = alpha / state.count * (done.target - done.old_value);
+  for (unsigned i = 0; i < state.count; ++i)
+    table_.at(state.rows[i], action) += step;
+  done.new_value = value(state, action);
+  return done;
+}
+
+std::string QLearningAgent::setLearning(double gamma, const ScheduleParams& epsilon, const ScheduleParams& alpha)
+{
+  AgentParams candidate = params_;
+  candidate.gamma = gamma;
+  candidate.epsilon = epsilon;
+  candidate.alpha = alpha;
+  const std::string error = candidate.validate();
+  if (!error.empty())
+    return error;
+  params_ = std::move(candidate);
+  epsilon_ = Schedule(epsilon);
+  alpha_ = Schedule(alpha);
+  return "";
+}
+
+std::string QLearningAgent::replaceTable(QTable table)
+{
+  const std::string mismatch = table_.shapeMismatch(table);
+  if (mismatch.empty())
+    table_ = std::move(table);
+  return mismatch;
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,84 @@
+#include "cartpole_qlearning/learning/q_table.h"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+FeatureParams binsOf(const DiscretiserParams& discretiser)
+{
+  FeatureParams features;
+  features.discretiser = discretiser;
+  return features;
+}
+}  // namespace
+
+QTable::QTable(const DiscretiserParams& discretiser, const std::vector<double>& actions)
+  : QTable(binsOf(discretiser), actions)
+{
+}
+
+QTable::QTable(const FeatureParams& features, const std::vector<double>& actions)
+  : features_(features), actions_(actions), state_count_(FeatureMap(features, actions.size()).rowCount())
+{
+  if (actions_.empty())
+    throw std::invalid_argument("a Q-table needs at least one action");
+  values_.assign(state_count_ * actions_.size(), 0.0);
+}
+
+std::size_t QTable::argmax(std::size_t state) const
+{
+  const double* row = &values_[state * actions_.size()];
+  std::size_t best = 0;
+  for (std::size_t a = 1; a < actions_.size(); ++a)
+  {
+    if (row[a] > row[best])
+      best = a;
+  }
+  return best;
+}
+
+double QTable::max(std::size_t state) const
+{
+  return at(state, argmax(state));
+}
+
+void QTable::setValues(std::vector<double> values)
+{
+  if (values.size() != values_.size())
+  {
+    std::ostringstream out;
+    out << "expected " << values_.size() << " values (" << state_count_ << " states x " << actions_.size()
+        << " actions), got " << values.size();
+    throw std::invalid_argument(out.str());
+  }
+  values_ = std::move(values);
+}
+
+std::string QTable::shapeMismatch(const QTable& other) const
+{
+  const std::string features = features_.mismatch(other.features_);
+  if (!features.empty())
+    return features;
+  if (actions_ != other.actions_)
+  {
+    std::ostringstream out;
+    out.precision(17);
+    const auto list = [&out](const std::vector<double>& values) {
+      out << "[";
+      for (std::size_t i = 0; i < values.size(); ++i)
+        out << (i ? ", " : "") << values[i];
+      out << "]";
+    };
+    out << "actions ";
+    list(other.actions_);
+    out << " differ from ";
+    list(actions_);
+    return out.str();
+  }
+  return "";
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,383 @@
+#include "cartpole_qlearning/learning/training_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+std::vector<std::string> splitKey(const std::string& key)
+{
+  std::vector<std::string> parts;
+  std::stringstream in(key);
+  std::string part;
+  while (std::getline(in, part, '/'))
+    parts.push_back(part);
+  return parts;
+}
+
+class YamlParameters : public ParameterSource
+{
+public:
+  YamlParameters(YAML::Node root, std::string origin) : root_(std::move(root)), origin_(std::move(origin)) {}
+
+  bool get(const std::string& key, double& value) const override
+  {
+    return scalar(key, value, "a number");
+  }
+  bool get(const std::string& key, std::int64_t& value) const override
+  {
+    return scalar(key, value, "a whole number");
+  }
+  bool get(const std::string& key, bool& value) const override
+  {
+    return scalar(key, value, "true or false");
+  }
+  bool get(const std::string& key, std::string& value) const override
+  {
+    return scalar(key, value, "a string");
+  }
+  bool get(const std::string& key, std::vector<double>& value) const override
+  {
+    const YAML::Node node = find(key);
+    if (!node)
+      return false;
+    if (!node.IsSequence())
+      throw ConfigError(origin_ + ": " + key + " must be a list of numbers");
+    value.clear();
+    for (std::size_t i = 0; i < node.size(); ++i)
+    {
+      try
+      {
+        value.push_back(node[i].as<double>());
+      }
+      catch (const YAML::Exception&)
+      {
+        throw ConfigError(origin_ + ": " + key + "[" + std::to_string(i) + "] = '" + text(node[i]) +
+                          "' is not allowed (must be a number)");
+      }
+    }
+    return true;
+  }
+
+  bool get(const std::string& key, std::vector<std::string>& value) const override
+  {
+    const YAML::Node node = find(key);
+    if (!node)
+      return false;
+    if (!node.IsSequence())
+      throw ConfigError(origin_ + ": " + key + " must be a list of strings");
+    value.clear();
+    for (std::size_t i = 0; i < node.size(); ++i)
+    {
+      if (!node[i].IsScalar())
+        throw ConfigError(origin_ + ": " + key + "[" + std::to_string(i) + "] = '" + text(node[i]) +
+                          "' is not allowed (must be a string)");
+      value.push_back(node[i].Scalar());
+    }
+    return true;
+  }
+
+  std::vector<std::string> keysUnder(const std::string& section) const override
+  {
+    std::vector<std::string> keys;
+    const YAML::Node node = find(section);
+    if (node)
+      collect(node, section, keys);
+    return keys;
+  }
+
+  std::string origin() const override
+  {
+    return origin_;
+  }
+
+private:
+  YAML::Node find(const std::string& key) const
+  {
+    // reset() rebinds; plain assignment between yaml-cpp nodes would overwrite the tree itself.
+    YAML::Node node;
+    node.reset(root_);
+    for (const std::string& part : splitKey(key))
+    {
+      if (part.empty())
+        continue;
+      if (!node.IsMap())
+        return YAML::Node(YAML::NodeType::Undefined);
+      const YAML::Node& parent = node;
+      const YAML::Node child = parent[part];  // const lookup: does not insert the key
+      if (!child)
+        return child;
+      node.reset(child);
+    }
+    return node;
+  }
+
+  template <typename T>
+  bool scalar(const std::string& key, T& value, const char* expected) const
+  {
+    const YAML::Node node = find(key);
+    if (!node)
+      return false;
+    try
+    {
+      if (!node.IsScalar())
+        throw YAML::Exception(YAML::Mark::null_mark(), "not a scalar");
+      value = node.as<T>();
+    }
+    catch (const YAML::Exception&)
+    {
+      throw ConfigError(origin_ + ": " + key + " = '" + text(node) + "' is not allowed (must be " + expected + ")");
+    }
+    return true;
+  }
+
+  static std::string text(const YAML::Node& node)
+  {
+    if (node.IsScalar())
+      return node.Scalar();
+    YAML::Emitter out;
+    out << YAML::Flow << node;
+    return out.c_str();
+  }
+
+  void collect(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& keys) const
+  {
+    if (!node.IsMap())
+    {
+      keys.push_back(prefix);
+      return;
+    }
+    for (const auto& entry : node)
+    {
+      // A key that is not a plain scalar (a list, a map, a null) names no parameter (found by
+      // test/fuzz/config_fuzzer.cpp: it used to escape as a YAML exception).
+      if (!entry.first.IsScalar())
+        throw ConfigError(origin_ + ": a key under '" + (prefix.empty() ? "/" : prefix) + "' is not a plain name");
+      collect(entry.second, (prefix.empty() ? "" : prefix + "/") + entry.first.Scalar(), keys);
+    }
+  }
+
+  YAML::Node root_;
+  std::string origin_;
+};
+
+template <typename Enum, typename Parse>
+void readEnum(SectionReader& reader, const std::string& name, Enum& value, Parse parse)
+{
+  std::string text = toString(value);
+  reader.read(name, text);
+  try
+  {
+    value = parse(text);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    reader.fail(name, "'" + text + "'", e.what());
+  }
+}
+
+void readSchedule(SectionReader& reader, const std::string& name, ScheduleParams& schedule)
+{
+  readEnum(reader, name + "/schedule", schedule.type, scheduleTypeFromString);
+  reader.read(name + "/start", schedule.start);
+  reader.read(name + "/min", schedule.min);
+  reader.read(name + "/decay_episodes", schedule.decay_episodes);
+  reader.read(name + "/decay_rate", schedule.decay_rate);
+  reader.read(name + "/log_divisor", schedule.log_divisor);
+}
+
+}  // namespace
+
+std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin)
+{
+  YAML::Node root;
+  try
+  {
+    root = YAML::Load(text);
+  }
+  catch (const YAML::Exception& e)
+  {
+    throw ConfigError(origin + ": not valid YAML: " + e.what());
+  }
+  if (root.IsNull())
+    root = YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap())
+    throw ConfigError(origin + ": must be a YAML mapping of sections (physics, task, learning, training)");
+  return std::make_unique<YamlParameters>(root, origin);
+}
+
+void refuseUnknownSections(const ParameterSource& source)
+{
+  static const std::set<std::string> sections{"physics", "perturbations", "task", "learning", "training"};
+  for (const std::string& key : source.keysUnder(""))
+  {
+    const std::string section = key.substr(0, key.find('/'));
+    if (sections.count(section) == 0 || key == section)
+      throw ConfigError(source.origin() + ": unknown key " + key +
+                        " (the file holds the sections physics, perturbations, task, learning and training)");
+  }
+}
+
+std::unique_ptr<ParameterSource> loadYamlParameters(const std::string& path)
+{
+  std::ifstream in(path);
+  if (!in)
+    throw ConfigError(path + ": cannot be read");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseYamlParameters(text.str(), path);
+}
+
+void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound)
+{
+  SectionReader reader(source, "physics");
+  reader.read("gravity", physics.gravity);
+  reader.read("mass_cart", physics.mass_cart);
+  reader.read("mass_pole", physics.mass_pole);
+  reader.read("half_length", physics.half_length);
+  reader.read("force_mag", physics.force_mag);
+  reader.read("tau", physics.tau);
+  readEnum(reader, "integrator", physics.integrator, integratorFromString);
+  reader.read("cart_friction", physics.cart_friction);
+  reader.read("pole_friction", physics.pole_friction);
+  reader.read("start_state_bound", start_state_bound);
+  reader.refuseUnknown();
+  reader.check(physics.validate());
+  if (!(std::isfinite(start_state_bound) && start_state_bound >= 0.0))
+    reader.fail("start_state_bound", std::to_string(start_state_bound), "must be finite and >= 0");
+}
+
+PerturbationParams readPerturbations(const ParameterSource& source)
+{
+  PerturbationParams p;
+  SectionReader reader(source, "perturbations");
+  // One number of steps, or [low, high]: drawn per episode.
+  reader.know("delay_steps");
+  const char* const allowed = "must be a whole number of steps in [0, 1000], or [low, high] of them";
+  std::int64_t steps = 0;
+  bool single = false;
+  try
+  {
+    single = source.get(reader.key("delay_steps"), steps);
+  }
+  catch (const ConfigError&)
+  {
+    std::vector<double> delay;
+    source.get(reader.key("delay_steps"), delay);  // not a list either: throws naming the key
+    if (delay.size() != 2 || delay[0] != std::floor(delay[0]) || delay[1] != std::floor(delay[1]) || delay[0] < 0 ||
+        delay[1] < delay[0] || delay[1] > 1000)
+      reader.fail("delay_steps", SectionReader::listText(delay), allowed);
+    p.delay_steps = static_cast<unsigned>(delay[0]);
+    p.delay_steps_max = static_cast<unsigned>(delay[1]);
+  }
+  if (single)
+  {
+    if (steps < 0 || steps > 1000)
+      reader.fail("delay_steps", std::to_string(steps), allowed);
+    p.delay_steps = p.delay_steps_max = static_cast<unsigned>(steps);
+  }
+  reader.readDimensions("noise_std", p.noise_std, false);
+  reader.readDimensions("noise_fraction", p.noise_fraction, false);
+  for (const auto& [name, range] : {std::pair<const char*, ScaleRange*>{"mass_cart", &p.mass_cart},
+                                    {"mass_pole", &p.mass_pole},
+                                    {"half_length", &p.half_length},
+                                    {"motor", &p.motor}})
+  {
+    std::vector<double> bounds;
+    reader.know(name);
+    if (!source.get(reader.key(name), bounds))
+      continue;
+    if (bounds.size() != 2)
+      reader.fail(name, SectionReader::listText(bounds), "must list 2 factors: [low, high]");
+    range->low = bounds[0];
+    range->high = bounds[1];
+  }
+  reader.read("push_probability", p.push_probability);
+  reader.read("push_force", p.push_force);
+  reader.refuseUnknown();
+  reader.check(p.validate());
+  return p;
+}
+
+TaskParams readTask(const ParameterSource& source)
+{
+  TaskParams task;
+  SectionReader reader(source, "task");
+  reader.read("x_threshold", task.x_threshold);
+  reader.read("theta_threshold_deg", task.theta_threshold_deg);
+  reader.read("max_episode_steps", task.max_episode_steps, 1, std::numeric_limits<int>::max());
+  readEnum(reader, "reward", task.reward, rewardSchemeFromString);
+  reader.read("solved_mean_return", task.solved_mean_return);
+  reader.read("solved_window", task.solved_window, 1, 1000000);
+  reader.refuseUnknown();
+  reader.check(task.validate());
+  return task;
+}
+
+AgentParams readAgent(const ParameterSource& source)
+{
+  AgentParams agent;
+  SectionReader reader(source, "learning");
+  reader.read("gamma", agent.gamma);
+  reader.read("actions", agent.actions);
+  readEnum(reader, "features", agent.features, featureKindFromString);
+  reader.readDimensions("bins", agent.discretiser.bins, true);
+  reader.read("tilings", agent.tilings, 1, kMaxTilings);
+  reader.readDimensions("tiles", agent.tiles, true);
+  reader.read("previous_action", agent.previous_action);
+  reader.readDimensions("lower_bounds", agent.discretiser.lower, false);
+  reader.readDimensions("upper_bounds", agent.discretiser.upper, false);
+  readSchedule(reader, "epsilon", agent.epsilon);
+  readSchedule(reader, "alpha", agent.alpha);
+  reader.read("state_names", agent.state_names);
+  reader.refuseUnknown();
+  reader.check(agent.validate());
+  return agent;
+}
+
+TrainingLimits readLimits(const ParameterSource& source)
+{
+  TrainingLimits limits;
+  SectionReader reader(source, "training");
+  reader.read("max_episodes", limits.max_episodes, 1);
+  reader.read("stop_when_solved", limits.stop_when_solved);
+  reader.read("progress_every", limits.progress_every, 0);
+  reader.read("suite", limits.suite);
+  if (limits.suite.empty())
+    reader.fail("suite", "''", "a suite file, or none");
+  reader.read("suite_every", limits.suite_every, 0);
+  std::string until = limits.until == TrainUntil::Solved ? "solved" : "suite_passes";
+  reader.readChoice("until", until, {"solved", "suite_passes"});
+  limits.until = until == "solved" ? TrainUntil::Solved : TrainUntil::SuitePasses;
+  if (limits.until == TrainUntil::SuitePasses && (limits.suite_every == 0 || limits.suite == "none"))
+    reader.fail("until", "suite_passes",
+                "needs training/suite_every > 0 and a training/suite: the suite is evaluated during training");
+  reader.refuseUnknown();
+  return limits;
+}
+
+TrainingConfig readTrainingConfig(const ParameterSource& source)
+{
+  TrainingConfig config;
+  readPhysics(source, config.physics, config.start_state_bound);
+  config.perturbations = readPerturbations(source);
+  config.task = readTask(source);
+  config.agent = readAgent(source);
+  config.limits = readLimits(source);
+  for (const double effort : config.agent.actions)
+  {
+    if (std::fabs(effort) > config.physics.force_mag)
+      throw ConfigError(source.origin() + ": learning/actions contains " + std::to_string(effort) +
+                        ", which is not allowed (|effort| must be <= physics/force_mag = " +
+                        std::to_string(config.physics.force_mag) + ")");
+  }
+  return config;
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,164 @@
+#include "cartpole_qlearning/learning/training_session.h"
+
+#include <cstdio>
+#include <stdexcept>
+
+namespace cartpole_qlearning
+{
+std::string progressLine(const EpisodeSummary& s, unsigned window, double steps_per_second, double elapsed_s)
+{
+  char line[160];
+  std::snprintf(line, sizeof line,
+                "episode %6llu  mean_return_%u %7.2f  epsilon %.3f  alpha %.3f  steps/s %9.0f  time %.2f s",
+                static_cast<unsigned long long>(s.episode), window, s.mean_return_window, s.epsilon, s.alpha,
+                steps_per_second, elapsed_s);
+  return line;
+}
+
+void ReturnWindow::push(double value)
+{
+  values_.push_back(value);
+  sum_ += value;
+  if (values_.size() > size_)
+  {
+    sum_ -= values_.front();
+    values_.pop_front();
+  }
+}
+
+TrainingSession::TrainingSession(const TaskParams& task, const AgentParams& agent, std::uint64_t seed, bool learning,
+                                 std::size_t robots)
+  : task_(task),
+    agent_(agent, seed),
+    learning_settings_(LearningSettings::of(agent)),
+    learning_(learning),
+    returns_(task.solved_window)
+{
+  if (robots < 1)
+    throw std::invalid_argument("TrainingSession: at least one robot");
+  episodes_.assign(robots, Episode(task.solved_window));
+}
+
+std::size_t TrainingSession::chooseAction(const ActiveRows& state, double epsilon)
+{
+  return learning_ ? agent_.selectAction(state, epsilon) : agent_.greedyAction(state);
+}
+
+double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size_t robot)
+{
+  Episode& e = episodes_.at(robot);
+  // Schedules count every episode the table has seen, so a loaded table resumes where it was.
+  const std::uint64_t episode = agent_.table().episodes;
+  e.epsilon = learning_ ? agent_.epsilon(episode) : 0.0;
+  e.alpha = learning_ ? agent_.alpha(episode) : 0.0;
+  e.running = true;
+  e.number = episodes_.size() == 1 ? last_.episode + 1 : e.ended + 1;
+  e.steps = 0;
+  e.episode_return = 0.0;
+  agent_.activeRows(start_state, e.rows[e.current]);
+  e.action = chooseAction(e.state(), e.epsilon);
+  return agent_.table().actions()[e.action];
+}
+
+Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
+{
+  Episode& e = episodes_.at(robot);
+  Decision decision;
+  ++e.steps;
+  decision.outcome = task_.evaluate(state, e.steps);
+  e.episode_return += decision.outcome.reward;
+  // The action just taken: with previous_action, part of what the learner sees of this state.
+  agent_.activeRows(state, e.next(), e.action + 1);
+  if (learning_)
+  {
+    const QUpdate update =
+        agent_.update(e.state(), e.action, decision.outcome.reward, e.next(), decision.outcome.terminated, e.alpha);
+    ++agent_.table().steps;
+    if (trace_)
+    {
+      TraceStep step;
+      step.episode = e.number;
+      step.step = e.steps;
+      // One row per state: the trace is for bins (features tiles refuse it, see traceRefusal).
+      step.state = e.state().rows[0];
+      step.action = e.action;
+      step.reward = decision.outcome.reward;
+      step.next_state = e.next().rows[0];
+      step.terminal = decision.outcome.terminated;
+      step.truncated = decision.outcome.truncated;
+      step.alpha = e.alpha;
+      step.gamma = agent_.params().gamma;
+      step.update = update;
+      trace_(robot, step);
+    }
+  }
+
+  if (!decision.outcome.done())
+  {
+    e.current ^= 1;
+    e.action = chooseAction(e.state(), e.epsilon);
+    decision.action = e.action;
+    decision.effort = agent_.table().actions()[e.action];
+    return decision;
+  }
+
+  decision.episode_over = true;
+  e.running = false;
+  if (learning_)
+    ++agent_.table().episodes;
+  returns_.push(e.episode_return);
+  e.returns.push(e.episode_return);
+  ++e.ended;
+  e.total_steps += e.steps;
+
+  last_.episode += 1;
+  last_.steps = e.steps;
+  last_.episode_return = e.episode_return;
+  last_.mean_return_window = returns_.mean();
+  last_.epsilon = e.epsilon;
+  last_.alpha = e.alpha;
+  last_.gamma = agent_.params().gamma;
+  last_.terminated = decision.outcome.terminated;
+  last_.truncated = decision.outcome.truncated;
+  last_.solved = returns_.full() && last_.mean_return_window >= task_.params().solved_mean_return;
+  last_.total_steps += e.steps;
+  last_.robot = robot;
+  last_.robot_episode = e.ended;
+  last_.robot_mean_return_window = e.returns.mean();
+  last_.robot_total_steps = e.total_steps;
+  return decision;
+}
+
+std::string TrainingSession::setLearning(const LearningSettings& settings)
+{
+  std::string error = settings.validate();
+  if (error.empty())
+    error = agent_.setLearning(settings.gamma, settings.effectiveEpsilon(), settings.effectiveAlpha());
+  if (error.empty())
+    learning_settings_ = settings;
+  return error;
+}
+
+std::string TrainingSession::replaceTable(QTable table)
+{
+  return agent_.replaceTable(std::move(table));
+}
+
+std::string TrainingSession::resume(QTable table, const std::vector<double>& recent_returns)
+{
+  const std::uint64_t episodes = table.episodes;
+  const std::uint64_t steps = table.steps;
+  const std::string mismatch = replaceTable(std::move(table));
+  if (!mismatch.empty())
+    return mismatch;
+  last_ = EpisodeSummary();
+  last_.episode = episodes;
+  last_.total_steps = steps;
+  returns_ = ReturnWindow(task_.params().solved_window);
+  for (double value : recent_returns)
+    returns_.push(value);
+  last_.mean_return_window = returns_.mean();
+  return "";
+}
+
+}  // namespace cartpole_qlearning

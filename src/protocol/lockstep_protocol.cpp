@@ -1,0 +1,333 @@
+#include "cartpole_qlearning/protocol/lockstep_protocol.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace cartpole_qlearning
+{
+Stamp tickOf(double tau_s)
+{
+  const double ns = std::round(tau_s * 1e9);
+  if (!(std::isfinite(ns) && ns >= 1.0 && ns < 1e18))
+    throw std::invalid_argument("tau = " + std::to_string(tau_s) + " s is not a usable tick (at least 1 ns)");
+  return static_cast<Stamp>(ns);
+}
+
+// --- The sim's side ---------------------------------------------------------------------------
+
+SimProtocol::SimProtocol(Stamp tick, WallClock::duration repeat_after) : tick_(tick), repeat_after_(repeat_after)
+{
+  if (tick_ == 0)
+    throw std::invalid_argument("SimProtocol: the tick must be at least 1 ns");
+}
+
+Stamp SimProtocol::advance(WallClock::time_point now)
+{
+  pending_ += tick_;
+  published_at_ = now;
+  return pending_;
+}
+
+Stamp SimProtocol::start(WallClock::time_point now)
+{
+  pending_ = 0;
+  last_stepped_ = 0;
+  return advance(now);
+}
+
+SimProtocol::Verdict SimProtocol::onCommand(Stamp answers, WallClock::time_point now)
+{
+  if (answers == 0)
+  {
+    ++counts_.unstamped;
+    return Verdict::Unstamped;
+  }
+  if (answers == pending_)
+    return onUnstampedCommand(now);
+  if (answers == last_stepped_)
+  {
+    ++counts_.duplicate;
+    return Verdict::Duplicate;
+  }
+  if (answers < pending_)
+  {
+    ++counts_.stale;
+    return Verdict::Stale;
+  }
+  ++counts_.future;
+  return Verdict::Future;
+}
+
+SimProtocol::Verdict SimProtocol::onUnstampedCommand(WallClock::time_point now)
+{
+  last_stepped_ = pending_;
+  ++counts_.steps;
+  advance(now);
+  return Verdict::Step;
+}
+
+Stamp SimProtocol::onReset(WallClock::time_point now)
+{
+  ++counts_.resets;
+  return advance(now);
+}
+
+Stamp SimProtocol::onResetTimeBack(WallClock::time_point now)
+{
+  ++counts_.resets;
+  return start(now);
+}
+
+bool SimProtocol::repeatDue(WallClock::time_point now)
+{
+  if (now - published_at_ < repeat_after_)
+    return false;
+  published_at_ = now;
+  ++counts_.repeats;
+  return true;
+}
+
+const char* describe(SimProtocol::Verdict verdict)
+{
+  switch (verdict)
+  {
+    case SimProtocol::Verdict::Step:
+      return "";
+    case SimProtocol::Verdict::Stale:
+      return "it answers an older state (or one a reset replaced)";
+    case SimProtocol::Verdict::Duplicate:
+      return "it is a second answer to a state already stepped on";
+    case SimProtocol::Verdict::Future:
+      return "its stamp is later than any state published";
+    case SimProtocol::Verdict::Unstamped:
+      return "it has no stamp (stamp it with the state's stamp, or publish on cart_effort)";
+  }
+  return "";
+}
+
+CommandHold::CommandHold(WallClock::duration timeout) : timeout_(timeout) {}
+
+bool CommandHold::set(double effort, Stamp stamp, WallClock::time_point now)
+{
+  if (stamp != 0 && stamp < stamp_)
+    return false;
+  if (stamp != 0)
+    stamp_ = stamp;
+  effort_ = effort;
+  since_ = now;
+  return true;
+}
+
+double CommandHold::effort(WallClock::time_point now) const
+{
+  return since_ && now - *since_ <= timeout_ ? effort_ : 0.0;
+}
+
+// --- The controller's side --------------------------------------------------------------------
+
+ControllerProtocol::ControllerProtocol(TrainingSession& session, const ControllerProtocolParams& params)
+  : session_(session), params_(params)
+{
+}
+
+bool ControllerProtocol::inStartRegion(const CartPoleState& state) const
+{
+  return (state.array().abs() <= params_.start_region.array()).all();
+}
+
+void ControllerProtocol::answer(Reaction& reaction, double effort)
+{
+  reaction.answer = true;
+  reaction.effort = effort;
+  last_effort_ = effort;
+}
+
+void ControllerProtocol::begin(Reaction& reaction, const CartPoleState& state)
+{
+  reaction.episode_began = true;
+  phase_ = Phase::InEpisode;
+  answer(reaction, session_.beginEpisode(state, params_.robot));
+}
+
+bool ControllerProtocol::takesAsNew(Stamp stamp) const
+{
+  if (phase_ == Phase::Finished)
+    return false;
+  if (stamp == 0)
+    return !have_stamp_;
+  if (have_stamp_ && stamp == last_)
+    return false;
+  if (have_stamp_ && stamp < last_)
+    return older_seen_ == stamp;
+  return true;
+}
+
+Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
+{
+  Reaction reaction;
+  reaction.stamp = stamp;
+  if (phase_ == Phase::Finished)
+  {
+    reaction.kind = Reaction::Kind::Finished;
+    return reaction;
+  }
+
+  if (stamp == 0)
+  {
+    if (have_stamp_)
+    {
+      ++counts_.stray;
+      reaction.kind = Reaction::Kind::Stray;
+      return reaction;
+    }
+    reaction.first_unstamped = !unstamped_stream_;
+    unstamped_stream_ = true;
+    return onNewState(reaction, state);
+  }
+
+  if (have_stamp_ && stamp == last_)
+  {
+    ++counts_.repeats;
+    reaction.kind = Reaction::Kind::Repeat;
+    if (phase_ == Phase::InEpisode || phase_ == Phase::WaitingForPerson)
+      answer(reaction, last_effort_);
+    return reaction;
+  }
+
+  if (have_stamp_ && stamp < last_)
+  {
+    // Time going on from an older stamp for kTimeSetBack states (Gazebo's reset_simulation sets
+    // time back) is a restart too; fewer are replayed or reordered messages.
+    older_run_ = older_seen_ && stamp > *older_seen_ ? older_run_ + 1 : 1;
+    if (older_seen_ != stamp && older_run_ < kTimeSetBack)
+    {
+      older_seen_ = stamp;
+      ++counts_.stale;
+      reaction.kind = Reaction::Kind::Stale;
+      return reaction;
+    }
+    // The same older state twice (a restarted sim repeating its first state), or time set back.
+    ++counts_.restarts;
+    reaction.sim_restarted = true;
+    session_.abortEpisode(params_.robot);
+    phase_ = Phase::WaitingForStart;
+  }
+  return onNewState(reaction, state);
+}
+
+Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& state)
+{
+  reaction.kind = Reaction::Kind::New;
+  ++counts_.states;
+  older_seen_.reset();
+  older_run_ = 0;
+  if (reaction.stamp != 0)
+  {
+    last_ = reaction.stamp;
+    have_stamp_ = true;
+  }
+  const bool terminal = session_.task().isTerminal(state);
+
+  switch (phase_)
+  {
+    case Phase::Finished:
+      break;
+    case Phase::AwaitingReset:
+      // States that come before the reset is served (realtime) are past the fall. A start drawn
+      // past the fall (a start region wider than the fall's 12 degrees: config/robust.yaml's) is
+      // an episode of one step, as train_headless has it; without this the lockstep sim would
+      // wait on it for ever. The fallen states of a realtime sim still falling before its reset
+      // is served lie outside such a region but for the rare one falling slowly near its edge.
+      if (params_.reset_starts_in_region ? !terminal && inStartRegion(state) : !terminal || inStartRegion(state))
+        begin(reaction, state);
+      else if (params_.reset_starts_in_region)
+        answer(reaction, 0.0);
+      break;
+    case Phase::WaitingForStart:
+    case Phase::WaitingForPerson:
+      if (!params_.reset_service)
+      {
+        if (!terminal && inStartRegion(state))
+        {
+          begin(reaction, state);
+          break;
+        }
+        reaction.waiting_for_start = phase_ != Phase::WaitingForPerson;
+        phase_ = Phase::WaitingForPerson;
+        answer(reaction, 0.0);
+        break;
+      }
+      if (terminal && !inStartRegion(state))
+      {
+        // Joining a sim that waits on a fallen pole: nothing to learn from, ask for a start.
+        reaction.request_reset = true;
+        phase_ = Phase::AwaitingReset;
+        break;
+      }
+      begin(reaction, state);
+      break;
+    case Phase::InEpisode: {
+      const Decision decision = session_.observe(state, params_.robot);
+      reaction.learned = session_.learning();
+      if (!decision.episode_over)
+      {
+        answer(reaction, decision.effort);
+        break;
+      }
+      reaction.episode_ended = true;
+      const EpisodeSummary& summary = session_.lastEpisode();
+      if (session_.learning() && params_.limits.reached(summary.episode, summary.solved))
+      {
+        reaction.training_finished = true;
+        phase_ = Phase::Finished;
+        break;
+      }
+      if (params_.reset_service)
+      {
+        reaction.request_reset = true;
+        phase_ = Phase::AwaitingReset;
+        break;
+      }
+      reaction.waiting_for_start = true;
+      phase_ = Phase::WaitingForPerson;
+      answer(reaction, 0.0);
+      break;
+    }
+  }
+  return reaction;
+}
+
+LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts& c, const std::string& robot,
+                    double stamp_s, const std::function<bool()>& dropped_ready,
+                    const std::function<bool()>& restart_ready)
+{
+  using Level = LogLine::Level;
+  const auto count = [](std::uint64_t n) { return static_cast<unsigned long long>(n); };
+  LogLines log;
+  if (reaction.kind == Reaction::Kind::Stale && dropped_ready())
+    log.push_back(
+        {Level::Warn, formatText("dropped joint_states on %s stamped %.6f, older than the last state (a "
+                                 "replayed or reordered message; a restarted sim is recognised when it "
+                                 "sends its state again, time set back when it goes on). Dropped so far: %llu",
+                                 robot.c_str(), stamp_s, count(c.stale))});
+  if (reaction.kind == Reaction::Kind::Stray && dropped_ready())
+    log.push_back({Level::Warn, formatText("dropped joint_states on %s without a stamp among stamped ones. Dropped so "
+                                            "far: %llu",
+                                            robot.c_str(), count(c.stray))});
+  if (reaction.first_unstamped)
+    log.push_back({Level::Warn, formatText("joint_states on %s carry no stamp (0): every message is taken as a new "
+                                            "state, and commands go out unstamped",
+                                            robot.c_str())});
+  if (reaction.sim_restarted && restart_ready())
+    log.push_back({Level::Warn, formatText("%s: time went back to %.3f s: the sim restarted (or was reset); starting "
+                                            "a new episode. Restarts so far: %llu",
+                                            robot.c_str(), stamp_s, count(c.restarts))});
+  if (reaction.waiting_for_start)
+    log.push_back({Level::Info, formatText("%s: episode over; no reset service, so commanding 0 until the state is "
+                                            "back inside ~start_region (stand the pole up)",
+                                            robot.c_str())});
+  return log;
+}
+
+}  // namespace cartpole_qlearning

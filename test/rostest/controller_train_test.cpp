@@ -1,0 +1,168 @@
+// train.launch's nodes, lockstep, seed 0: the controller solves CartPole-v1 over ROS topics,
+// writes the same table as train_headless, and a fresh greedy controller balances with it.
+// With ~config (controller_train_tiles.test: tiles.yaml) the same over that config.
+#include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/learning/q_table_file.h"
+
+#include "ros_test_support.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using cartpole_qlearning::EpisodeStats;
+
+using cartpole_qlearning::test::fileText;
+using cartpole_qlearning::test::spinUntil;
+
+namespace
+{
+std::string qTableDir()
+{
+  std::string dir;
+  ros::param::get("~q_table_dir", dir);
+  return dir;
+}
+
+// The config file loaded over cartpole.yaml in the controller's namespace.
+std::string configFile()
+{
+  std::string file = "cartpole.yaml";
+  ros::param::get("~config", file);
+  return file;
+}
+}  // namespace
+
+class ControllerTrainTest : public ::testing::Test
+{
+protected:
+  static std::vector<EpisodeStats> stats_;
+  static ros::Subscriber sub_;
+
+  static void SetUpTestSuite()
+  {
+    ros::NodeHandle nh;
+    sub_ = nh.subscribe<EpisodeStats>(
+        "/cartpole/episode_stats", 1000,
+        boost::function<void(const cartpole_qlearning::EpisodeStatsConstPtr&)>(
+            [](const cartpole_qlearning::EpisodeStatsConstPtr& m) { stats_.push_back(*m); }));
+  }
+  // Released while roscpp is up: a ros::Subscriber destroyed among the static objects at exit
+  // reads roscpp's strings after they were freed (ASan: heap-use-after-free).
+  static void TearDownTestSuite()
+  {
+    sub_ = ros::Subscriber();
+  }
+};
+std::vector<EpisodeStats> ControllerTrainTest::stats_;
+ros::Subscriber ControllerTrainTest::sub_;
+
+TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
+{
+  // 1. Training over ROS reaches solved (mean return of the last 100 >= 475).
+  ASSERT_TRUE(spinUntil([] { return !stats_.empty() && stats_.back().solved; }, 200.0))
+      << "no solved episode; episodes seen: " << stats_.size();
+  const EpisodeStats& solved = stats_.back();
+  EXPECT_GE(solved.mean_return_100, 475.0);
+  EXPECT_GE(solved.episode, 100u);
+  // Episodes are numbered one after the other and none was lost (early ones may end before
+  // this test node has subscribed).
+  for (std::size_t i = 1; i < stats_.size(); ++i)
+    ASSERT_EQ(stats_[i - 1].episode + 1, stats_[i].episode);
+
+  // 2. The controller saved the table on solving, and it is train_headless's, byte for byte.
+  const std::string trained = qTableDir() + "/trained.yaml";
+  ASSERT_TRUE(spinUntil([&] { return fs::exists(trained); }, 10.0)) << trained;
+  const cartpole_qlearning::QTable table = cartpole_qlearning::loadQTableFile(trained);
+  EXPECT_EQ(solved.episode, table.episodes);
+  EXPECT_EQ(solved.total_steps, table.steps);
+  const std::string headless = qTableDir() + "/headless.yaml";
+  const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " + CARTPOLE_CONFIG_DIR "/" +
+                              configFile() + " --no-run-folder --save " + headless;
+  ASSERT_EQ(0, std::system(command.c_str())) << command;
+  EXPECT_EQ(fileText(headless), fileText(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
+  // The table is of the features the config asks for, as the test names them.
+  std::string features;
+  ros::param::get("~features", features);
+  EXPECT_EQ(features, toString(table.features().kind));
+  const auto source = cartpole_qlearning::loadYamlParameters(CARTPOLE_CONFIG_DIR "/" + configFile());
+  EXPECT_EQ("", cartpole_qlearning::QTable(cartpole_qlearning::readAgent(*source).featureParams(), table.actions())
+                    .shapeMismatch(table));
+
+  // 3. The run's learning curve: episodes.csv beside its checkpoint, a header and one row per
+  //    episode, each the episode_stats message of that episode.
+  std::vector<fs::path> runs;
+  for (const auto& entry : fs::directory_iterator(qTableDir() + "/runs"))
+    runs.push_back(entry.path());
+  ASSERT_EQ(1u, runs.size());
+  std::istringstream csv(fileText((runs.front() / "episodes.csv").string()));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line)) << "no episodes.csv in " << runs.front();
+  EXPECT_EQ(0u, line.find("episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,"));
+  std::vector<std::string> rows;
+  while (std::getline(csv, line))
+    rows.push_back(line);
+  ASSERT_EQ(solved.episode, rows.size()) << "one row per episode";
+  for (const EpisodeStats& m : stats_)
+  {
+    std::ostringstream expected;
+    expected << m.episode << ",," << m.steps << "," << m.steps << ",";
+    EXPECT_EQ(0u, rows.at(m.episode - 1).find(expected.str())) << rows.at(m.episode - 1);
+  }
+  const auto flag = [](bool value) { return std::string(value ? "true" : "false"); };
+  EXPECT_NE(std::string::npos, rows.back().find("," + flag(solved.terminated) + "," + flag(solved.truncated) +
+                                                ",true," + std::to_string(solved.total_steps) + ","))
+      << "the last row is not the solved episode: " << rows.back();
+
+  // 4. A fresh controller in evaluate mode loads the table and balances a full 500-step episode.
+  const std::size_t before = stats_.size();
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0)
+  {
+    const std::string load = "_load_on_start:=trained.yaml";
+    const std::string dir = "_q_table_dir:=" + qTableDir();
+    ::execl(QLEARNING_CONTROLLER, QLEARNING_CONTROLLER, "__ns:=/cartpole", "__name:=evaluator", "_mode:=evaluate",
+            load.c_str(), dir.c_str(), "_save_on_shutdown:=false", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const bool balanced = spinUntil(
+      [&] {
+        for (std::size_t i = before; i < stats_.size(); ++i)
+        {
+          if (stats_[i].steps == 500 && stats_[i].truncated && !stats_[i].terminated)
+            return true;
+        }
+        return false;
+      },
+      60.0);
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(balanced) << "the evaluator ran " << stats_.size() - before << " episodes, none of 500 steps";
+  for (std::size_t i = before; i < stats_.size(); ++i)
+    EXPECT_EQ(0.0, stats_[i].epsilon) << "evaluation must be greedy";
+}
+
+int main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "controller_train_test");
+  ros::NodeHandle nh;
+  const int result = RUN_ALL_TESTS();
+  fs::remove_all(qTableDir());
+  return result;
+}

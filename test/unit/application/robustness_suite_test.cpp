@@ -1,0 +1,167 @@
+// The robustness suite (robustness_suite.h): read from its file, run greedily, judged per case.
+#include "cartpole_qlearning/application/headless_trainer.h"
+#include "cartpole_qlearning/application/robustness_suite.h"
+#include "cartpole_qlearning/common/log_line.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+using namespace cartpole_qlearning;
+
+namespace
+{
+const std::string kSuite = std::string(CARTPOLE_CONFIG_DIR) + "/robust_suite.yaml";
+
+std::string suiteError(const std::string& yaml)
+{
+  try
+  {
+    parseRobustnessSuite(yaml, "suite.yaml", TrainingConfig());
+  }
+  catch (const ConfigError& e)
+  {
+    return e.what();
+  }
+  return "";
+}
+
+QTable trainedTable(std::uint64_t seed)
+{
+  HeadlessTrainer trainer(TrainingConfig(), seed);
+  trainer.run();
+  return trainer.session().table();
+}
+}  // namespace
+
+TEST(RobustnessSuite, TheShippedSuiteHoldsTheCasesOfARealCartPole)
+{
+  const RobustnessSuite suite = loadRobustnessSuite(kSuite, TrainingConfig());
+  EXPECT_EQ(suite.episodes, 100u);
+  EXPECT_EQ(suite.seed, 1000u);
+  ASSERT_EQ(suite.cases.size(), 8u);
+  EXPECT_EQ(suite.cases[0].name, "nominal");
+  EXPECT_FALSE(suite.cases[0].perturbations.any());
+  EXPECT_EQ(suite.cases[1].perturbations.delay_steps, 1u);
+  EXPECT_TRUE(suite.cases[2].perturbations.noisy());
+  EXPECT_EQ(suite.cases[4].perturbations.motor.low, 0.8);
+  EXPECT_EQ(suite.cases[6].start_state_bound, 0.1);
+  const SuiteCase& all = suite.cases.back();
+  EXPECT_EQ(all.name, "all_at_once");
+  EXPECT_EQ(all.pass, 90u);
+  EXPECT_EQ(all.start_state_bound, 0.1);
+  EXPECT_EQ(all.perturbations.delay_steps, 1u);
+  EXPECT_TRUE(all.perturbations.noisy());
+  EXPECT_TRUE(all.perturbations.mass_pole.varies());
+  EXPECT_EQ(all.perturbations.push_force, 2.0);
+  // The configuration's physics stay under the cases' own keys.
+  TrainingConfig heavy;
+  heavy.physics.mass_cart = 2.0;
+  EXPECT_EQ(loadRobustnessSuite(kSuite, heavy).cases[3].physics.mass_cart, 2.0);
+}
+
+TEST(RobustnessSuite, BadSuitesAreRefusedNamingTheCaseAndTheKey)
+{
+  EXPECT_NE(suiteError("cases: [{name: a, perturbations: {delay: 1}}]").find("case a: unknown key perturbations/delay"),
+            std::string::npos);
+  EXPECT_NE(suiteError("cases: [{name: a, pass: 101}]").find("case a: pass = 101"), std::string::npos);
+  EXPECT_NE(suiteError("cases: [{name: a}, {name: a}]").find("the name a is used twice"), std::string::npos);
+  EXPECT_NE(suiteError("cases: [{pass: 3}]").find("cases[0] must be a map with a name"), std::string::npos);
+  EXPECT_NE(suiteError("cases: []").find("cases must be a list"), std::string::npos);
+  EXPECT_NE(suiteError("episodes: 0\ncases: [{name: a}]").find("episodes = 0"), std::string::npos);
+  EXPECT_NE(suiteError("runs: 3\ncases: [{name: a}]").find("unknown key runs"), std::string::npos);
+  EXPECT_NE(suiteError("cases: [{name: a, physics: {mass_cart: -1}}]").find("physics/mass_cart = -1"),
+            std::string::npos);
+  EXPECT_NE(suiteError("cases: [{name: a, colour: red}]").find("case a: unknown key colour"), std::string::npos);
+  EXPECT_NE(suiteError("max_episode_steps: 0\ncases: [{name: a}]").find("max_episode_steps = 0"), std::string::npos);
+  EXPECT_NE(suiteError("start_state_bound: -1\ncases: [{name: a}]").find("start_state_bound = '-1'"),
+            std::string::npos);
+}
+
+TEST(RobustnessSuite, TheCriterionIsTheSuitesWhateverTheTrainingConfigUses)
+{
+  // A table trained on 200-step episodes from starts in +-0.1 is still judged at 500 steps from
+  // starts in +-0.05 (the suite's defaults), or at what the suite file says.
+  TrainingConfig short_wide;
+  short_wide.task.max_episode_steps = 200;
+  short_wide.start_state_bound = 0.1;
+  const RobustnessSuite suite = parseRobustnessSuite("cases: [{name: a}, {name: b, physics: {start_state_bound: 0.2}}]",
+                                                     "suite.yaml", short_wide);
+  EXPECT_EQ(suite.max_episode_steps, 500u);
+  EXPECT_EQ(suite.cases[0].start_state_bound, 0.05);
+  EXPECT_EQ(suite.cases[1].start_state_bound, 0.2);
+  const RobustnessSuite own = parseRobustnessSuite("max_episode_steps: 50\nstart_state_bound: 0.02\ncases: [{name: a}]",
+                                                   "suite.yaml", short_wide);
+  EXPECT_EQ(own.max_episode_steps, 50u);
+  EXPECT_EQ(own.cases[0].start_state_bound, 0.02);
+
+  RobustnessSuite one = loadRobustnessSuite(kSuite, short_wide);
+  one.episodes = 20;
+  one.cases.resize(1);
+  const QTable table = trainedTable(1);
+  const SuiteResult at_500 = evaluateSuite(table, short_wide, one);
+  EXPECT_GE(at_500.cases[0].balanced, 18u);
+  EXPECT_GT(at_500.cases[0].mean_return, 450.0);  // gymnasium reward: the steps, up to 500, not 200
+  one.max_episode_steps = 50;
+  EXPECT_LE(evaluateSuite(table, short_wide, one).cases[0].mean_return, 50.0);
+}
+
+TEST(RobustnessSuite, ATableOfZerosFallsAndATrainedOneBalancesTheNominalCase)
+{
+  const RobustnessSuite suite = loadRobustnessSuite(kSuite, TrainingConfig());
+  const TrainingConfig config;
+  const QTable zeros(config.agent.featureParams(), config.agent.actions);
+  const CaseResult fallen = evaluateCase(zeros, config, suite.cases[0], 20, suite.seed);
+  EXPECT_EQ(fallen.balanced, 0u);
+  EXPECT_FALSE(fallen.passed());
+  const QTable trained = trainedTable(1);
+  const CaseResult nominal = evaluateCase(trained, config, suite.cases[0], 100, suite.seed);
+  EXPECT_GE(nominal.balanced, 95u);
+  EXPECT_EQ(nominal.mean_return > 475.0, true);
+  // The same table, case and seed: the same verdict.
+  EXPECT_EQ(evaluateCase(trained, config, suite.cases[0], 100, suite.seed).balanced, nominal.balanced);
+}
+
+TEST(RobustnessSuite, TheSuiteTellsATableThatOnlyBalancesTheModel)
+{
+  // Seed 0's default table (what train.launch saves) balances the model and not a motor that
+  // answers one step late: the suite must say so.
+  const RobustnessSuite suite = loadRobustnessSuite(kSuite, TrainingConfig());
+  const SuiteResult result = evaluateSuite(trainedTable(0), TrainingConfig(), suite);
+  ASSERT_EQ(result.cases.size(), suite.cases.size());
+  EXPECT_GE(result.cases[0].balanced, 90u);
+  EXPECT_LT(result.cases[1].balanced, 10u);
+  EXPECT_FALSE(result.passed());
+  EXPECT_LT(result.worstBalanced(), 10u);
+  const std::string summary = result.summary();
+  EXPECT_NE(summary.find("one_step_late " + std::to_string(result.cases[1].balanced) + "/100"), std::string::npos);
+  EXPECT_NE(summary.find(": FAILED"), std::string::npos);
+  const std::string table = result.table();
+  EXPECT_NE(table.find("one_step_late"), std::string::npos);
+  EXPECT_NE(table.find("FAIL"), std::string::npos);
+}
+
+TEST(RobustnessSuite, ATableForOtherFeaturesIsRefused)
+{
+  const RobustnessSuite suite = loadRobustnessSuite(kSuite, TrainingConfig());
+  TrainingConfig tiles;
+  tiles.agent.features = FeatureKind::Tiles;
+  EXPECT_THROW(evaluateCase(trainedTable(1), tiles, suite.cases[0], 1, 0), ConfigError);
+}
+
+TEST(RobustnessSuite, AMeanReturnThatRoundsToZeroPrintsWithoutASign)
+{
+  // Under sutton_barto (0 a step, -1 on the fall) a case where 2 of 100 fell has a mean return of
+  // -0.02: the table shows 0.0, never "-0.0"; a mean that does not round to zero keeps its sign.
+  SuiteResult result;
+  result.cases.push_back({"few_falls", 100, 98, 95, -0.02});
+  result.cases.push_back({"many_falls", 100, 40, 95, -0.6});
+  const std::string table = result.table();
+  EXPECT_EQ(table.find("-0.0"), std::string::npos) << table;
+  EXPECT_NE(table.find("98/100      95          0.0  pass"), std::string::npos) << table;
+  EXPECT_NE(table.find("40/100      95         -0.6  FAIL"), std::string::npos) << table;
+  EXPECT_EQ(formatText("%.1f", shownReturn(-0.04, 1)), "0.0");
+  EXPECT_EQ(formatText("%.2f", shownReturn(-0.004, 2)), "0.00");
+  EXPECT_EQ(formatText("%.1f", shownReturn(-0.06, 1)), "-0.1");
+  EXPECT_EQ(formatText("%.3f", shownReturn(475.25, 3)), "475.250");
+}

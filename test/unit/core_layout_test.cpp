@@ -1,0 +1,212 @@
+// The core's layers (src/<layer>/, include/cartpole_qlearning/<layer>/) build without ROS: a core
+// file may include the standard library, POSIX, Eigen, yaml-cpp and the headers of its own layer
+// and of the layers below it, and nothing else. Debian installs the ROS headers on the default
+// include path, so a stray #include <ros/ros.h> would still compile; this test is what stops it.
+// (The link lines stop a call into a layer above: each layer is a library linked with
+// -Wl,--no-undefined against the ones below. A header-only use would pass them: this test does not.)
+#include "text_match.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+namespace fs = std::filesystem;
+namespace text_match = cartpole_qlearning::test::text_match;
+
+const fs::path kSource = CARTPOLE_SOURCE_DIR;
+
+// From the bottom (CMakeLists.txt's CORE_LAYERS): a layer may include its own and those before it.
+const std::vector<std::string> kLayers = {"common", "io", "simulation", "learning", "protocol", "application"};
+
+std::size_t layerRank(const std::string& layer)
+{
+  return static_cast<std::size_t>(std::find(kLayers.begin(), kLayers.end(), layer) - kLayers.begin());
+}
+
+// The #include lines of a file's text that the core may not have, as "line N: #include ...".
+// core_header(name) tells whether "cartpole_qlearning/name" is a core header.
+template <typename CoreHeader>
+std::vector<std::string> foreignIncludes(const std::string& text, CoreHeader core_header)
+{
+  // <vector>, <cstdint>; <unistd.h>, <sys/stat.h>; <Eigen/Core>; <yaml-cpp/yaml.h>
+  static const std::string allowed_system =
+      R"(<([a-z_]+|[a-z_]+\.h|sys/[a-z_]+\.h|Eigen/[A-Za-z]+|yaml-cpp/[a-z_/]+\.h)>)";
+  static const std::string include = R"re(^\s*#\s*include\s*([<"][^>"]*[>"]))re";
+  static const std::string own = R"re("cartpole_qlearning/([a-z0-9_]+/[a-z0-9_]+\.h)")re";
+  std::vector<std::string> foreign;
+  std::istringstream lines(text);
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number)
+  {
+    text_match::Groups m;
+    if (!text_match::contains(line, include, &m))
+      continue;
+    const std::string target = m[1];
+    text_match::Groups o;
+    const bool ok = text_match::matchesWhole(target, allowed_system) ||
+                    (text_match::matchesWhole(target, own, &o) && core_header(o[1]));
+    if (!ok)
+      foreign.push_back("line " + std::to_string(number) + ": " + line);
+  }
+  return foreign;
+}
+
+// Whether "cartpole_qlearning/<layer>/<file>.h" is a header of the core in a layer a file of
+// `layer` may include (its own or one below).
+bool isHeaderAtOrBelow(const std::string& layer, const std::string& name)
+{
+  const std::string header_layer = name.substr(0, name.find('/'));
+  return layerRank(header_layer) <= layerRank(layer) && layerRank(header_layer) < kLayers.size() &&
+         fs::is_regular_file(kSource / "include" / "cartpole_qlearning" / name);
+}
+
+std::string readText(const fs::path& path)
+{
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+TEST(CoreLayoutTest, TheCheckRefusesRosHeadersAndGeneratedMessages)
+{
+  const auto core = [](const std::string& name) { return name == "learning/q_table.h"; };
+  EXPECT_TRUE(foreignIncludes("#include <vector>\n#include <Eigen/Core>\n#include \"cartpole_qlearning/learning/q_table.h\"\n"
+                              "#include <sys/stat.h>\n#include <yaml-cpp/yaml.h>\n",
+                              core)
+                  .empty());
+  EXPECT_EQ(foreignIncludes("#include <vector>\n#include <ros/ros.h>\n", core),
+            std::vector<std::string>{"line 2: #include <ros/ros.h>"});
+  EXPECT_EQ(foreignIncludes("#include <sensor_msgs/JointState.h>\n", core).size(), 1u);
+  EXPECT_EQ(foreignIncludes("#include \"cartpole_qlearning/EpisodeStats.h\"\n", core).size(), 1u);
+  EXPECT_EQ(foreignIncludes("#include \"cartpole_qlearning/ros/start_up.h\"\n", core).size(), 1u);
+  EXPECT_EQ(foreignIncludes("  #  include <boost/thread.hpp>\n", core).size(), 1u);
+}
+
+TEST(CoreLayoutTest, ALayerMayIncludeItsOwnAndTheLayersBelowOnly)
+{
+  EXPECT_TRUE(isHeaderAtOrBelow("learning", "learning/q_table.h"));
+  EXPECT_TRUE(isHeaderAtOrBelow("learning", "simulation/cartpole_dynamics.h"));
+  EXPECT_FALSE(isHeaderAtOrBelow("learning", "protocol/lockstep_protocol.h"));
+  EXPECT_FALSE(isHeaderAtOrBelow("common", "io/file_access.h"));
+  EXPECT_FALSE(isHeaderAtOrBelow("application", "ros/start_up.h"));
+  EXPECT_FALSE(isHeaderAtOrBelow("learning", "learning/no_such_header.h"));
+}
+
+TEST(CoreLayoutTest, NoCoreFileIncludesAHeaderFromOutsideTheCoreOrFromALayerAbove)
+{
+  std::size_t files = 0;
+  for (const std::string& layer : kLayers)
+  {
+    for (const fs::path& folder : {kSource / "src" / layer, kSource / "include" / "cartpole_qlearning" / layer})
+    {
+      ASSERT_TRUE(fs::is_directory(folder)) << folder;
+      for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+      {
+        ASSERT_TRUE(entry.is_regular_file()) << entry.path() << ": a layer's folder holds files only";
+        ++files;
+        const auto allowed = [&layer](const std::string& name) { return isHeaderAtOrBelow(layer, name); };
+        for (const std::string& line : foreignIncludes(readText(entry.path()), allowed))
+          ADD_FAILURE() << entry.path().string() << " " << line << ": the " << layer
+                        << " layer includes the standard library, POSIX, Eigen, yaml-cpp and the headers of its own "
+                           "layer and of those below it only";
+      }
+    }
+  }
+  EXPECT_GT(files, 40u) << "the core's files were not found under " << kSource;
+  // Nothing of the core lies outside its layers.
+  for (const fs::path& folder : {kSource / "src", kSource / "include" / "cartpole_qlearning"})
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+      EXPECT_FALSE(entry.is_regular_file()) << entry.path() << " lies outside the layers' folders";
+}
+
+// The names in backquotes in the Layout row (of docs/design.md) that starts with `first_cell`,
+// leaving out paths and patterns (they name folders, not files). tools/readme_layout.py writes
+// the table.
+std::set<std::string> layoutNames(const std::string& page, const std::string& first_cell)
+{
+  const std::size_t layout = page.find("## Layout\n");
+  const std::size_t row = page.find("\n| " + first_cell + " |", layout);
+  std::set<std::string> names;
+  if (layout == std::string::npos || row == std::string::npos)
+    return names;
+  const std::string line = page.substr(row + 1, page.find('\n', row + 1) - row - 1);
+  const std::string cells = line.substr(first_cell.size() + 4);
+  for (const text_match::Groups& quoted : text_match::allMatches(cells, "`([^`]+)`"))
+  {
+    const std::string& name = quoted[1];
+    if (name.find('/') == std::string::npos && name.find('*') == std::string::npos)
+      names.insert(name);
+  }
+  return names;
+}
+
+// The files of folders (stems: the name without its extension, for a header and source pair).
+std::set<std::string> filesIn(const std::vector<fs::path>& folders, bool stems)
+{
+  std::set<std::string> names;
+  for (const fs::path& folder : folders)
+  {
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+    {
+      if (entry.is_regular_file())
+        names.insert(stems ? entry.path().stem().string() : entry.path().filename().string());
+    }
+  }
+  return names;
+}
+
+TEST(CoreLayoutTest, TheLayoutTableListsTheTreeAsItIs)
+{
+  const std::string design = readText(kSource / "docs" / "design.md");
+  const fs::path include = kSource / "include" / "cartpole_qlearning";
+  struct Row
+  {
+    std::string first_cell;
+    std::vector<fs::path> folders;
+    bool stems;
+  };
+  const Row rows[] = {
+      {"`include/cartpole_qlearning/common/`, `src/common/`", {include / "common", kSource / "src" / "common"}, true},
+      {"`include/cartpole_qlearning/io/`, `src/io/`", {include / "io", kSource / "src" / "io"}, true},
+      {"`include/cartpole_qlearning/simulation/`, `src/simulation/`",
+       {include / "simulation", kSource / "src" / "simulation"},
+       true},
+      {"`include/cartpole_qlearning/learning/`, `src/learning/`",
+       {include / "learning", kSource / "src" / "learning"},
+       true},
+      {"`include/cartpole_qlearning/protocol/`, `src/protocol/`",
+       {include / "protocol", kSource / "src" / "protocol"},
+       true},
+      {"`include/cartpole_qlearning/application/`, `src/application/`",
+       {include / "application", kSource / "src" / "application"},
+       true},
+      {"`include/cartpole_qlearning/ros/`, `src/ros/`", {include / "ros", kSource / "src" / "ros"}, true},
+      {"`src/cli/`", {kSource / "src" / "cli"}, true},
+      {"`config/`", {kSource / "config"}, false},
+      {"`launch/`", {kSource / "launch"}, false},
+      {"`scripts/`", {kSource / "scripts"}, false},
+      {"`tools/`", {kSource / "tools"}, false},
+  };
+  for (const Row& row : rows)
+  {
+    const std::set<std::string> listed = layoutNames(design, row.first_cell);
+    const std::set<std::string> present = filesIn(row.folders, row.stems);
+    for (const std::string& name : present)
+      EXPECT_EQ(listed.count(name), 1u) << name << " is in the tree but not in docs/design.md's Layout row "
+                                        << row.first_cell;
+    for (const std::string& name : listed)
+      EXPECT_EQ(present.count(name), 1u) << name << " is in docs/design.md's Layout row " << row.first_cell
+                                         << " but not in the tree";
+  }
+}
+
+}  // namespace

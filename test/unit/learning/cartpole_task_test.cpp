@@ -1,0 +1,87 @@
+#include "cartpole_qlearning/learning/cartpole_task.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using cartpole_qlearning::CartPoleState;
+using cartpole_qlearning::CartPoleTask;
+using cartpole_qlearning::RewardScheme;
+using cartpole_qlearning::StepOutcome;
+using cartpole_qlearning::TaskParams;
+
+namespace
+{
+const double kThetaLimit = 12.0 * 2.0 * M_PI / 360.0;
+
+CartPoleTask taskWith(RewardScheme reward)
+{
+  TaskParams params;
+  params.reward = reward;
+  return CartPoleTask(params);
+}
+}  // namespace
+
+TEST(CartPoleTask, TerminatesStrictlyBeyondTheThresholds)
+{
+  const CartPoleTask task;
+  EXPECT_FALSE(task.isTerminal(CartPoleState(2.4, 0, 0, 0)));
+  EXPECT_FALSE(task.isTerminal(CartPoleState(-2.4, 0, 0, 0)));
+  EXPECT_TRUE(task.isTerminal(CartPoleState(std::nextafter(2.4, 3.0), 0, 0, 0)));
+  EXPECT_TRUE(task.isTerminal(CartPoleState(std::nextafter(-2.4, -3.0), 0, 0, 0)));
+  EXPECT_FALSE(task.isTerminal(CartPoleState(0, 0, kThetaLimit, 0)));
+  EXPECT_FALSE(task.isTerminal(CartPoleState(0, 0, -kThetaLimit, 0)));
+  EXPECT_TRUE(task.isTerminal(CartPoleState(0, 0, std::nextafter(kThetaLimit, 1.0), 0)));
+  EXPECT_TRUE(task.isTerminal(CartPoleState(0, 0, std::nextafter(-kThetaLimit, -1.0), 0)));
+  // Velocities never end an episode.
+  EXPECT_FALSE(task.isTerminal(CartPoleState(0, 100, 0, -100)));
+}
+
+TEST(CartPoleTask, TruncatesAtTheStepLimitNotBefore)
+{
+  const CartPoleTask task;
+  const CartPoleState upright = CartPoleState::Zero();
+  EXPECT_FALSE(task.evaluate(upright, 499).done());
+  const StepOutcome last = task.evaluate(upright, 500);
+  EXPECT_TRUE(last.truncated);
+  EXPECT_FALSE(last.terminated);
+  // Falling on the last step is a fall: no bootstrapping on it.
+  const StepOutcome fall = task.evaluate(CartPoleState(0, 0, 0.5, 0), 500);
+  EXPECT_TRUE(fall.terminated);
+  EXPECT_FALSE(fall.truncated);
+}
+
+TEST(CartPoleTask, GymnasiumRewardIsOneEveryStepIncludingTheFall)
+{
+  const CartPoleTask task = taskWith(RewardScheme::Gymnasium);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1).reward);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState(3, 0, 0, 0), 7).reward);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 500).reward);
+}
+
+TEST(CartPoleTask, SeedRewardIsMinusOneOnTheFall)
+{
+  const CartPoleTask task = taskWith(RewardScheme::Seed);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1).reward);
+  EXPECT_EQ(-1.0, task.evaluate(CartPoleState(0, 0, -0.3, 0), 9).reward);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 500).reward);  // truncation is no fall
+}
+
+TEST(CartPoleTask, SuttonBartoRewardIsZeroUntilTheFall)
+{
+  const CartPoleTask task = taskWith(RewardScheme::SuttonBarto);
+  EXPECT_EQ(0.0, task.evaluate(CartPoleState::Zero(), 1).reward);
+  EXPECT_EQ(-1.0, task.evaluate(CartPoleState(-2.5, 0, 0, 0), 3).reward);
+  EXPECT_EQ(0.0, task.evaluate(CartPoleState::Zero(), 500).reward);
+}
+
+TEST(CartPoleTask, BadParametersAreRefused)
+{
+  TaskParams params;
+  params.max_episode_steps = 0;
+  EXPECT_THROW(CartPoleTask task(params), std::invalid_argument);
+  params = TaskParams();
+  params.theta_threshold_deg = 95.0;
+  EXPECT_NE(std::string::npos, params.validate().find("theta_threshold_deg = 95")) << params.validate();
+  EXPECT_THROW(cartpole_qlearning::rewardSchemeFromString("shaped"), std::invalid_argument);
+}

@@ -1,0 +1,238 @@
+#include "cartpole_qlearning/learning/q_learning_agent.h"
+#include "cartpole_qlearning/learning/tile_coder.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+using namespace cartpole_qlearning;
+
+namespace
+{
+// Tiles along theta_dot only, over [lower, upper], the other dimensions ignored.
+TileCoderParams thetaDotOnly(unsigned tilings, unsigned tiles, double lower, double upper)
+{
+  TileCoderParams p;
+  p.tilings = tilings;
+  p.tiles = {{1, 1, 1, tiles}};
+  p.lower[3] = lower;
+  p.upper[3] = upper;
+  return p;
+}
+
+std::vector<std::uint32_t> active(const TileCoder& coder, const CartPoleState& state)
+{
+  std::vector<std::uint32_t> tiles(coder.tilings());
+  coder.activeTiles(state, tiles.data());
+  return tiles;
+}
+
+std::vector<std::uint32_t> activeAt(const TileCoder& coder, double theta_dot)
+{
+  return active(coder, CartPoleState(0.0, 0.0, 0.0, theta_dot));
+}
+
+using Tiles = std::vector<std::uint32_t>;
+}  // namespace
+
+// Two tilings of two tiles over [-1, 1]: tiling 0's edges at -1, 0, 1; tiling 1 displaced by
+// half a tile towards lower values, edges at -1.5, -0.5, 0.5. Each tiling has three tiles along
+// the dimension (rows 0-2 and 3-5).
+TEST(TileCoder, ValuesOnAnEdgeGoToTheTileThatStartsThere)
+{
+  const TileCoder coder(thetaDotOnly(2, 2, -1.0, 1.0));
+  ASSERT_EQ(3u, coder.tilesPerTiling());
+  ASSERT_EQ(6u, coder.tileCount());
+  EXPECT_EQ((Tiles{0, 3}), activeAt(coder, -1.0));
+  EXPECT_EQ((Tiles{0, 3}), activeAt(coder, std::nextafter(-0.5, -1.0)));
+  EXPECT_EQ((Tiles{0, 4}), activeAt(coder, -0.5));
+  EXPECT_EQ((Tiles{0, 4}), activeAt(coder, std::nextafter(0.0, -1.0)));
+  EXPECT_EQ((Tiles{1, 4}), activeAt(coder, 0.0));
+  EXPECT_EQ((Tiles{1, 4}), activeAt(coder, std::nextafter(0.5, 0.0)));
+  EXPECT_EQ((Tiles{1, 5}), activeAt(coder, 0.5));
+  EXPECT_EQ((Tiles{1, 5}), activeAt(coder, std::nextafter(1.0, 0.0)));
+}
+
+TEST(TileCoder, ValuesOutsideTheBoundsAreClippedToTheEdgeTiles)
+{
+  const TileCoder coder(thetaDotOnly(2, 2, -1.0, 1.0));
+  EXPECT_EQ((Tiles{0, 3}), activeAt(coder, -1.5));
+  EXPECT_EQ((Tiles{0, 3}), activeAt(coder, -1e300));
+  EXPECT_EQ((Tiles{0, 3}), activeAt(coder, -std::numeric_limits<double>::infinity()));
+  EXPECT_EQ((Tiles{0, 3}), activeAt(coder, std::numeric_limits<double>::quiet_NaN()));
+  // At and above upper: the tile holding the values just below it, in every tiling (tiling 0's
+  // extra tile, row 2, is never used).
+  EXPECT_EQ((Tiles{1, 5}), activeAt(coder, 1.0));
+  EXPECT_EQ((Tiles{1, 5}), activeAt(coder, 7.0));
+  EXPECT_EQ((Tiles{1, 5}), activeAt(coder, std::numeric_limits<double>::infinity()));
+}
+
+// Sutton and Barto's asymmetric offsets: along the k-th used dimension tiling i is displaced by
+// i * (2k + 1) / tilings of a tile (modulo a tile), so the tilings' edges spread evenly and
+// differently in each dimension. Over [0, 8] with 2 tiles of 4 and 4 tilings, a displacement of
+// o quarters moves tiling i's middle edge from 4 to 4 - o.
+TEST(TileCoder, EachTilingIsDisplacedByItsOddMultipleOfAFractionOfATile)
+{
+  TileCoderParams p;
+  p.tilings = 4;
+  p.tiles = {{1, 1, 2, 2}};
+  p.lower = {{0.0, 0.0, 0.0, 0.0}};
+  p.upper = {{1.0, 1.0, 8.0, 8.0}};
+  const TileCoder coder(p);
+  const unsigned theta_offsets[] = {0, 1, 2, 3};      // i * 1 mod 4
+  const unsigned theta_dot_offsets[] = {0, 3, 2, 1};  // i * 3 mod 4
+  for (unsigned i = 0; i < 4; ++i)
+  {
+    EXPECT_EQ(theta_offsets[i], coder.offset(i, 2)) << "tiling " << i;
+    EXPECT_EQ(theta_dot_offsets[i], coder.offset(i, 3)) << "tiling " << i;
+    EXPECT_EQ(0u, coder.offset(i, 0)) << "an ignored dimension has no offset";
+  }
+  const std::size_t per_tiling = coder.tilesPerTiling();
+  ASSERT_EQ(9u, per_tiling);  // 3 x 3: one tile more than 2 along each used dimension
+  for (unsigned i = 0; i < 4; ++i)
+  {
+    // The edge along theta (theta_dot held at 0.5, inside its first tile in every tiling).
+    const double theta_edge = 4.0 - theta_offsets[i];
+    const std::uint32_t below = active(coder, CartPoleState(0, 0, std::nextafter(theta_edge, 0.0), 0.5))[i];
+    const std::uint32_t at = active(coder, CartPoleState(0, 0, theta_edge, 0.5))[i];
+    EXPECT_EQ(below + 3, at) << "tiling " << i << ": theta's edge is not at " << theta_edge;  // stride of theta: 3
+    // The edge along theta_dot.
+    const double theta_dot_edge = 4.0 - theta_dot_offsets[i];
+    const std::uint32_t below_dot = active(coder, CartPoleState(0, 0, 0.5, std::nextafter(theta_dot_edge, 0.0)))[i];
+    const std::uint32_t at_dot = active(coder, CartPoleState(0, 0, 0.5, theta_dot_edge))[i];
+    EXPECT_EQ(below_dot + 1, at_dot) << "tiling " << i << ": theta_dot's edge is not at " << theta_dot_edge;
+    // Each tiling's tiles are its own rows.
+    EXPECT_GE(at, i * per_tiling);
+    EXPECT_LT(at, (i + 1) * per_tiling);
+  }
+}
+
+TEST(TileCoder, TheOddNumbersFollowTheUsedDimensionsInOrder)
+{
+  TileCoderParams p;
+  p.tilings = 8;
+  p.tiles = {{2, 2, 6, 12}};
+  const TileCoder coder(p);
+  for (unsigned i = 0; i < 8; ++i)
+  {
+    EXPECT_EQ(i * 1 % 8, coder.offset(i, 0));
+    EXPECT_EQ(i * 3 % 8, coder.offset(i, 1));
+    EXPECT_EQ(i * 5 % 8, coder.offset(i, 2));
+    EXPECT_EQ(i * 7 % 8, coder.offset(i, 3));
+  }
+  EXPECT_EQ(3u * 3u * 7u * 13u, coder.tilesPerTiling());
+  EXPECT_EQ(8u * 3u * 3u * 7u * 13u, coder.tileCount());
+}
+
+TEST(TileCoder, AnIgnoredDimensionChangesNothingAndNearbyStatesShareTiles)
+{
+  const TileCoder coder;  // 8 tilings of [1, 1, 6, 12]
+  const Tiles here = active(coder, CartPoleState(0.0, 0.0, 0.01, 0.1));
+  EXPECT_EQ(here, active(coder, CartPoleState(100.0, -50.0, 0.01, 0.1)));
+  // A small step changes the tile of only some tilings: that is the generalisation.
+  const Tiles near = active(coder, CartPoleState(0.0, 0.0, 0.01 + 0.07 / 8, 0.1));
+  std::size_t shared = 0;
+  for (std::size_t i = 0; i < here.size(); ++i)
+    shared += here[i] == near[i];
+  EXPECT_GT(shared, 0u);
+  EXPECT_LT(shared, here.size());
+}
+
+TEST(TileCoder, BadParametersAreRefusedWithTheField)
+{
+  TileCoderParams p;
+  p.tilings = 0;
+  EXPECT_NE(std::string::npos, p.validate().find("tilings = 0")) << p.validate();
+  p.tilings = kMaxTilings + 1;
+  EXPECT_NE(std::string::npos, p.validate().find("tilings = 65")) << p.validate();
+  p = TileCoderParams();
+  p.tiles[2] = 0;
+  EXPECT_NE(std::string::npos, p.validate().find("tiles[2] (theta) = 0")) << p.validate();
+  p = TileCoderParams();
+  p.lower[3] = p.upper[3];
+  EXPECT_NE(std::string::npos, p.validate().find("lower_bounds[3]")) << p.validate();
+  p = TileCoderParams();
+  p.tilings = 64;
+  p.tiles = {{20, 20, 20, 20}};
+  EXPECT_NE(std::string::npos, p.validate().find("more than the 10000000 allowed")) << p.validate();
+  EXPECT_THROW(TileCoder{p}, std::invalid_argument);
+}
+
+namespace
+{
+// Two tilings of two tiles of theta_dot over [-1, 1] (as above), 2 actions, gamma 0.9.
+AgentParams twoTilings()
+{
+  AgentParams p;
+  p.features = FeatureKind::Tiles;
+  p.tilings = 2;
+  p.tiles = {{1, 1, 1, 2}};
+  p.discretiser.lower[3] = -1.0;
+  p.discretiser.upper[3] = 1.0;
+  p.gamma = 0.9;
+  return p;
+}
+}  // namespace
+
+TEST(TileCodedAgent, QIsTheSumOfTheActiveTilesWeights)
+{
+  QLearningAgent agent(twoTilings(), 0);
+  ASSERT_EQ(6u, agent.table().stateCount());
+  agent.table().at(1, 0) = 1.5;  // tiling 0, tile 1
+  agent.table().at(4, 0) = 2.0;  // tiling 1, tile 1
+  agent.table().at(1, 1) = -1.0;
+  agent.table().at(4, 1) = 0.25;
+  agent.table().at(5, 1) = 10.0;  // not active at 0.25
+  ActiveRows s;
+  agent.activeRows(CartPoleState(0.0, 0.0, 0.0, 0.25), s);
+  ASSERT_EQ(2u, s.count);
+  EXPECT_EQ(1u, s.rows[0]);
+  EXPECT_EQ(4u, s.rows[1]);
+  EXPECT_EQ(3.5, agent.value(s, 0));
+  EXPECT_EQ(-0.75, agent.value(s, 1));
+  EXPECT_EQ(0u, agent.greedyAction(s));
+  agent.table().at(4, 1) = 4.75;  // Q(s, 1) = 3.75 > 3.5
+  EXPECT_EQ(1u, agent.greedyAction(s));
+}
+
+// Q(s,a0) = 1.5 + 2.0 = 3.5 over rows 1 and 4; s' (theta_dot 0.75) activates rows 1 and 5 with
+// Q(s',a0) = 1.5 + 0.5 = 2 and Q(s',a1) = -1 + 4 = 3. Target 1 + 0.9 * 3 = 3.7, error 0.2:
+// alpha 0.5 spread over 2 tilings moves rows 1 and 4 of a0 by 0.25 * 0.2 = 0.05 each, Q(s,a0)
+// by alpha * error = 0.1.
+TEST(TileCodedAgent, AnUpdateSpreadsAlphaOverTheTilings)
+{
+  QLearningAgent agent(twoTilings(), 0);
+  agent.table().at(1, 0) = 1.5;
+  agent.table().at(4, 0) = 2.0;
+  agent.table().at(5, 0) = 0.5;
+  agent.table().at(1, 1) = -1.0;
+  agent.table().at(5, 1) = 4.0;
+  const std::vector<double> before = agent.table().values();
+  ActiveRows s, next;
+  agent.activeRows(CartPoleState(0.0, 0.0, 0.0, 0.25), s);
+  agent.activeRows(CartPoleState(0.0, 0.0, 0.0, 0.75), next);
+  ASSERT_EQ(1u, next.rows[0]);
+  ASSERT_EQ(5u, next.rows[1]);
+
+  const cartpole_qlearning::QUpdate u = agent.update(s, 0, 1.0, next, false, 0.5);
+  EXPECT_DOUBLE_EQ(3.5, u.old_value);
+  EXPECT_DOUBLE_EQ(3.7, u.target);
+  EXPECT_DOUBLE_EQ(3.6, u.new_value);
+  EXPECT_DOUBLE_EQ(3.6, agent.value(s, 0));
+  EXPECT_DOUBLE_EQ(1.55, agent.table().at(1, 0));
+  EXPECT_DOUBLE_EQ(2.05, agent.table().at(4, 0));
+  for (std::size_t i = 0; i < before.size(); ++i)
+  {
+    if (i != 1 * 2 + 0 && i != 4 * 2 + 0)
+    {
+      EXPECT_EQ(before[i], agent.table().values()[i]) << "weight " << i << " is not active for (s, a0)";
+    }
+  }
+
+  // A fall does not bootstrap: target = reward = 1, error 1 - 3.6.
+  const cartpole_qlearning::QUpdate fall = agent.update(s, 0, 1.0, next, true, 0.5);
+  EXPECT_DOUBLE_EQ(1.0, fall.target);
+  EXPECT_DOUBLE_EQ(3.6 + 0.5 * (1.0 - 3.6), fall.new_value);
+}

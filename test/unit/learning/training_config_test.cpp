@@ -1,0 +1,159 @@
+#include "cartpole_qlearning/learning/training_config.h"
+
+#include <gtest/gtest.h>
+
+using namespace cartpole_qlearning;
+
+namespace
+{
+TrainingConfig parse(const std::string& yaml)
+{
+  const auto source = parseYamlParameters(yaml, "test.yaml");
+  refuseUnknownSections(*source);
+  return readTrainingConfig(*source);
+}
+
+// The message of the ConfigError that parsing throws, or "" when it does not throw.
+std::string errorOf(const std::string& yaml)
+{
+  try
+  {
+    parse(yaml);
+  }
+  catch (const ConfigError& e)
+  {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(Config, ShippedFileLoadsWithTheDocumentedDefaults)
+{
+  const auto source = loadYamlParameters(CARTPOLE_CONFIG_DIR "/cartpole.yaml");
+  refuseUnknownSections(*source);
+  const TrainingConfig config = readTrainingConfig(*source);
+  // The file spells out the built-in defaults, so both must agree.
+  const TrainingConfig defaults = parse("");
+  EXPECT_EQ(defaults.physics.gravity, config.physics.gravity);
+  EXPECT_EQ(defaults.physics.tau, config.physics.tau);
+  EXPECT_EQ(defaults.physics.integrator, config.physics.integrator);
+  EXPECT_EQ(defaults.start_state_bound, config.start_state_bound);
+  EXPECT_EQ(defaults.task.max_episode_steps, config.task.max_episode_steps);
+  EXPECT_EQ(defaults.task.reward, config.task.reward);
+  EXPECT_EQ(defaults.agent.gamma, config.agent.gamma);
+  EXPECT_EQ(defaults.agent.actions, config.agent.actions);
+  EXPECT_TRUE(defaults.agent.discretiser == config.agent.discretiser);
+  EXPECT_EQ(defaults.agent.epsilon.type, config.agent.epsilon.type);
+  EXPECT_EQ(defaults.agent.epsilon.start, config.agent.epsilon.start);
+  EXPECT_EQ(defaults.agent.epsilon.min, config.agent.epsilon.min);
+  EXPECT_EQ(defaults.agent.epsilon.decay_episodes, config.agent.epsilon.decay_episodes);
+  EXPECT_EQ(defaults.agent.epsilon.log_divisor, config.agent.epsilon.log_divisor);
+  EXPECT_EQ(defaults.agent.alpha.type, config.agent.alpha.type);
+  EXPECT_EQ(defaults.agent.alpha.min, config.agent.alpha.min);
+  EXPECT_EQ(defaults.agent.alpha.log_divisor, config.agent.alpha.log_divisor);
+  EXPECT_EQ(defaults.limits.max_episodes, config.limits.max_episodes);
+  EXPECT_EQ(12u, config.agent.discretiser.bins[3]);
+}
+
+TEST(Config, ValuesOverrideDefaults)
+{
+  const TrainingConfig c = parse(
+      "physics: {tau: 0.01, integrator: rk4}\n"
+      "task: {reward: seed, max_episode_steps: 200}\n"
+      "learning:\n  gamma: 0.9\n  bins: [1, 1, 3, 4]\n  epsilon: {schedule: exponential, decay_rate: 0.9}\n"
+      "training: {max_episodes: 7, stop_when_solved: false}\n");
+  EXPECT_EQ(0.01, c.physics.tau);
+  EXPECT_EQ(Integrator::Rk4, c.physics.integrator);
+  EXPECT_EQ(RewardScheme::Seed, c.task.reward);
+  EXPECT_EQ(200u, c.task.max_episode_steps);
+  EXPECT_EQ(0.9, c.agent.gamma);
+  EXPECT_EQ(3u, c.agent.discretiser.bins[2]);
+  EXPECT_EQ(ScheduleType::Exponential, c.agent.epsilon.type);
+  EXPECT_EQ(0.9, c.agent.epsilon.decay_rate);
+  EXPECT_EQ(7u, c.limits.max_episodes);
+  EXPECT_FALSE(c.limits.stop_when_solved);
+}
+
+TEST(Config, BadValuesNameTheKeyTheValueAndTheRange)
+{
+  EXPECT_NE(std::string::npos,
+            errorOf("learning: {gamma: 1.5}").find("learning/gamma = 1.5 is not allowed (must be in [0, 1])"));
+  EXPECT_NE(std::string::npos, errorOf("physics: {mass_pole: -1}").find("physics/mass_pole = -1"));
+  // Too many bins: refused with the value given (checked before any conversion), and too many
+  // states in all before anything is allocated.
+  const std::string huge_bins = errorOf("learning: {bins: [10000000000, 1, 1, 1]}");
+  EXPECT_NE(std::string::npos, huge_bins.find("1e+10")) << huge_bins;
+  EXPECT_NE(std::string::npos, huge_bins.find("[1, 1000]")) << huge_bins;
+  // A key that is not a plain name (found by test/fuzz/config_fuzzer.cpp: a YAML exception
+  // escaped the reader).
+  EXPECT_FALSE(errorOf("learning: {bins: [1, 1, 3, 4], ! ctions: [-1,10 00 ,]}\ntask: {reward: dees}\n").empty());
+  EXPECT_FALSE(errorOf("learning: {[1, 2]: 3}").empty());
+  const std::string many_states = errorOf("learning: {bins: [1000, 1000, 1000, 1000]}");
+  EXPECT_NE(std::string::npos, many_states.find("1000000000000 states")) << many_states;
+  EXPECT_NE(std::string::npos, errorOf("physics: {integrator: verlet}").find("physics/integrator = 'verlet'"));
+  EXPECT_NE(std::string::npos, errorOf("task: {max_episode_steps: 0}").find("task/max_episode_steps = 0"));
+  EXPECT_NE(std::string::npos, errorOf("learning: {bins: [1, 1, 6]}").find("learning/bins"));
+  EXPECT_NE(std::string::npos, errorOf("learning: {bins: [1, 1, 6, 2.5]}").find("whole numbers"));
+  EXPECT_NE(std::string::npos, errorOf("learning: {epsilon: {min: 3}}").find("learning/epsilon/min = 3"));
+  EXPECT_NE(std::string::npos, errorOf("learning: {actions: [-20, 20]}").find("physics/force_mag"));
+  EXPECT_NE(std::string::npos, errorOf("training: {max_episodes: 0}").find("training/max_episodes = 0"));
+  EXPECT_NE(std::string::npos, errorOf("training: {until: forever}").find("training/until = 'forever'"));
+  EXPECT_NE(std::string::npos, errorOf("training: {until: suite_passes}").find("needs training/suite_every > 0"));
+  EXPECT_NE(std::string::npos,
+            errorOf("training: {until: suite_passes, suite_every: 5, suite: none}").find("needs training/suite_every"));
+}
+
+TEST(Config, TileCodingKeys)
+{
+  EXPECT_EQ(FeatureKind::Bins, parse("").agent.features);  // the default
+  const TrainingConfig c = parse(
+      "learning:\n  features: tiles\n  tilings: 4\n  tiles: [1, 2, 6, 12]\n"
+      "  lower_bounds: [-2.4, -2.0, -0.2, -1.0]\n  upper_bounds: [2.4, 2.0, 0.2, 1.0]\n");
+  EXPECT_EQ(FeatureKind::Tiles, c.agent.features);
+  EXPECT_EQ(4u, c.agent.tilings);
+  EXPECT_EQ(2u, c.agent.tiles[1]);
+  EXPECT_EQ(-2.0, c.agent.featureParams().tileCoder().lower[1]);  // the bounds are the bins' keys
+  EXPECT_EQ(1.0, c.agent.featureParams().tileCoder().upper[3]);
+
+  const std::string kind = errorOf("learning: {features: tile}");
+  EXPECT_NE(std::string::npos, kind.find("learning/features = 'tile' is not allowed (allowed: bins, tiles)")) << kind;
+  const std::string tilings = errorOf("learning: {features: tiles, tilings: 0}");
+  EXPECT_NE(std::string::npos, tilings.find("learning/tilings = 0 is not allowed (must be a whole number in [1, 64])"))
+      << tilings;
+  EXPECT_NE(std::string::npos, errorOf("learning: {tilings: 65}").find("learning/tilings = 65")) << tilings;
+  EXPECT_NE(std::string::npos, errorOf("learning: {tiles: [1, 1, 6]}").find("learning/tiles")) << tilings;
+  EXPECT_NE(std::string::npos, errorOf("learning: {tiles: [1, 1, 0, 6]}").find("learning/tiles = [1, 1, 0, 6]"));
+  // Too many tiles in all: refused before anything is allocated, naming the key.
+  const std::string many = errorOf("learning: {features: tiles, tilings: 64, tiles: [20, 20, 20, 20]}");
+  EXPECT_NE(std::string::npos, many.find("learning/tiles give 12446784 tiles")) << many;
+  // Bounds a used tile dimension needs, checked only when tiles are in use.
+  const std::string bounds = "lower_bounds: [0, 0, 0, 1]\n  upper_bounds: [1, 1, 1, 1]\n  bins: [1, 1, 2, 1]\n";
+  EXPECT_EQ("", errorOf("learning:\n  tiles: [1, 1, 1, 2]\n  " + bounds));
+  const std::string tile_bounds = errorOf("learning:\n  features: tiles\n  tiles: [1, 1, 1, 2]\n  " + bounds);
+  EXPECT_NE(std::string::npos, tile_bounds.find("learning/lower_bounds[3], upper_bounds[3] (theta_dot) = 1, 1"))
+      << tile_bounds;
+}
+
+TEST(Config, WrongTypesAreRefused)
+{
+  EXPECT_NE(std::string::npos, errorOf("physics: {gravity: strong}").find("physics/gravity = 'strong'"));
+  EXPECT_NE(std::string::npos, errorOf("physics: {gravity: [1, 2]}").find("physics/gravity"));
+  EXPECT_NE(std::string::npos, errorOf("learning: {actions: 10}").find("learning/actions must be a list"));
+  EXPECT_NE(std::string::npos, errorOf("training: {stop_when_solved: maybe}").find("training/stop_when_solved"));
+}
+
+TEST(Config, UnknownKeysAndSectionsAreRefused)
+{
+  const std::string typo = errorOf("learning: {gama: 0.9}");
+  EXPECT_NE(std::string::npos, typo.find("unknown key learning/gama")) << typo;
+  EXPECT_NE(std::string::npos, typo.find("gamma")) << typo;  // lists what is known
+  EXPECT_NE(std::string::npos, errorOf("learnin: {gamma: 0.9}").find("unknown key learnin/gamma"));
+  EXPECT_NE(std::string::npos, errorOf("learning: {epsilon: {mn: 0.1}}").find("learning/epsilon/mn"));
+}
+
+TEST(Config, InvalidYamlAndMissingFilesAreRefused)
+{
+  EXPECT_NE(std::string::npos, errorOf("physics: [unclosed").find("not valid YAML"));
+  EXPECT_THROW(loadYamlParameters("/nonexistent/cartpole.yaml"), ConfigError);
+}

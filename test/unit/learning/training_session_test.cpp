@@ -1,0 +1,216 @@
+#include "test_support.h"
+#include "cartpole_qlearning/application/headless_trainer.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+
+using cartpole_qlearning::test::bitIdentical;
+using namespace cartpole_qlearning;
+
+namespace
+{
+TrainingConfig shippedConfig()
+{
+  return readTrainingConfig(*loadYamlParameters(CARTPOLE_CONFIG_DIR "/cartpole.yaml"));
+}
+
+}  // namespace
+
+TEST(HeadlessTrainer, DefaultConfigSolvesCartPoleOnSeedsZeroToNineInAMedianOfAtMost300Episodes)
+{
+  // Deterministic per seed, and milliseconds per run, so the whole promise is checked here.
+  std::vector<std::uint64_t> episodes;
+  for (std::uint64_t seed = 0; seed < 10; ++seed)
+  {
+    HeadlessTrainer trainer(shippedConfig(), seed);
+    const TrainingResult result = trainer.run();
+    EXPECT_TRUE(result.solved) << "seed " << seed;
+    EXPECT_GE(trainer.session().lastEpisode().mean_return_window, 475.0) << "seed " << seed;
+    EXPECT_EQ(result.episodes, trainer.session().table().episodes);
+    EXPECT_EQ(result.steps, trainer.session().table().steps);
+    episodes.push_back(result.episodes);
+  }
+  std::sort(episodes.begin(), episodes.end());
+  const double median = (episodes[4] + episodes[5]) / 2.0;
+  EXPECT_LE(median, 300.0);
+}
+
+TEST(HeadlessTrainer, TilesConfigSolvesSeedsZeroToNineInAMedianOfAtMost150Episodes)
+{
+  const TrainingConfig config = readTrainingConfig(*loadYamlParameters(CARTPOLE_CONFIG_DIR "/tiles.yaml"));
+  ASSERT_EQ(FeatureKind::Tiles, config.agent.features);
+  std::vector<std::uint64_t> episodes;
+  for (std::uint64_t seed = 0; seed < 10; ++seed)
+  {
+    HeadlessTrainer trainer(config, seed);
+    const TrainingResult result = trainer.run();
+    EXPECT_TRUE(result.solved) << "seed " << seed;
+    EXPECT_EQ(FeatureKind::Tiles, trainer.session().table().features().kind);
+    episodes.push_back(result.episodes);
+  }
+  std::sort(episodes.begin(), episodes.end());
+  EXPECT_LE((episodes[4] + episodes[5]) / 2.0, 150.0);
+}
+
+TEST(HeadlessTrainer, SameSeedGivesTheSameTableBitForBit)
+{
+  TrainingConfig config = shippedConfig();
+  config.limits.max_episodes = 150;
+  HeadlessTrainer a(config, 7);
+  HeadlessTrainer b(config, 7);
+  HeadlessTrainer c(config, 8);
+  const TrainingResult ra = a.run();
+  const TrainingResult rb = b.run();
+  c.run();
+  EXPECT_EQ(ra.steps, rb.steps);
+  EXPECT_TRUE(bitIdentical(a.session().table().values(), b.session().table().values()));
+  EXPECT_FALSE(bitIdentical(a.session().table().values(), c.session().table().values()));
+}
+
+TEST(HeadlessTrainer, EpisodeStatisticsAddUp)
+{
+  TrainingConfig config = shippedConfig();
+  config.task.solved_window = 5;
+  config.limits.max_episodes = 12;
+  config.limits.stop_when_solved = false;
+  HeadlessTrainer trainer(config, 1);
+  std::vector<EpisodeSummary> episodes;
+  trainer.run([&](const EpisodeSummary& s) { episodes.push_back(s); });
+  ASSERT_EQ(12u, episodes.size());
+  std::uint64_t total = 0;
+  for (std::size_t i = 0; i < episodes.size(); ++i)
+  {
+    total += episodes[i].steps;
+    EXPECT_EQ(i + 1, episodes[i].episode);
+    EXPECT_EQ(total, episodes[i].total_steps);
+    EXPECT_EQ(static_cast<double>(episodes[i].steps), episodes[i].episode_return);  // +1 per step
+    EXPECT_NE(episodes[i].terminated, episodes[i].truncated);
+    double sum = 0;
+    const std::size_t first = i + 1 >= 5 ? i + 1 - 5 : 0;
+    for (std::size_t j = first; j <= i; ++j)
+      sum += episodes[j].episode_return;
+    EXPECT_DOUBLE_EQ(sum / static_cast<double>(i + 1 - first), episodes[i].mean_return_window);
+  }
+}
+
+TEST(HeadlessTrainer, RunUntilEndsWhereTheCallerSaysOrAtOnceWhenStopped)
+{
+  TrainingConfig config = shippedConfig();
+  config.limits.max_episodes = 3;  // runUntil leaves the limits to the caller
+  HeadlessTrainer trainer(config, 2);
+  std::uint64_t seen = 0;
+  const TrainingResult result = trainer.runUntil([&](const EpisodeSummary& s) {
+    ++seen;
+    return s.episode == 7;
+  });
+  EXPECT_EQ(7u, seen);
+  EXPECT_EQ(7u, result.episodes);
+  EXPECT_EQ(7u, trainer.session().table().episodes);
+
+  // Stopped (Ctrl-C): no further episode ends, and the table keeps its counters.
+  const std::atomic<bool> stop{true};
+  const TrainingResult stopped = trainer.runUntil([](const EpisodeSummary&) { return false; }, &stop);
+  EXPECT_EQ(0u, stopped.episodes);
+  EXPECT_EQ(7u, trainer.session().table().episodes);
+}
+
+TEST(HeadlessTrainer, AnEvaluatingTrainerLearnsNothing)
+{
+  TrainingConfig config = shippedConfig();
+  HeadlessTrainer evaluator(config, 0, 2, false);
+  const std::vector<double> before = evaluator.session().table().values();
+  evaluator.runUntil([](const EpisodeSummary& s) { return s.episode == 4; });
+  EXPECT_TRUE(bitIdentical(before, evaluator.session().table().values()));
+  EXPECT_EQ(4u, evaluator.session().episodesEnded());
+}
+
+TEST(TrainingSession, TruncationBootstrapsAndAFallDoesNot)
+{
+  TaskParams task;
+  task.max_episode_steps = 1;
+  AgentParams agent;
+  agent.gamma = 0.5;
+  agent.epsilon.type = ScheduleType::Constant;
+  agent.epsilon.start = agent.epsilon.min = 0.0;
+  agent.alpha.type = ScheduleType::Constant;
+  agent.alpha.start = agent.alpha.min = 1.0;
+  TrainingSession session(task, agent, 0);
+
+  const Discretiser& d = session.agent().discretiser();
+  const CartPoleState upright = CartPoleState::Zero();
+  const CartPoleState fallen(0.0, 0.0, 0.5, 0.0);
+  QTable table(agent.discretiser, agent.actions);
+  table.at(d.index(upright), 0) = 8.0;  // so that the bootstrap term is visible
+  table.at(d.index(fallen), 0) = 8.0;
+  ASSERT_EQ("", session.replaceTable(table));
+
+  // Upright -> upright, truncated after one step: Q = 1 + 0.5 * 8.
+  EXPECT_EQ(-10.0, session.beginEpisode(upright));
+  Decision decision = session.observe(upright);
+  EXPECT_TRUE(decision.episode_over);
+  EXPECT_TRUE(decision.outcome.truncated);
+  EXPECT_DOUBLE_EQ(1.0 + 0.5 * 8.0, session.table().at(d.index(upright), 0));
+
+  // Upright -> fallen: Q = 1, no bootstrap on the fallen state's 8.
+  session.beginEpisode(upright);
+  decision = session.observe(fallen);
+  EXPECT_TRUE(decision.outcome.terminated);
+  EXPECT_DOUBLE_EQ(1.0, session.table().at(d.index(upright), 0));
+  EXPECT_EQ(2u, session.table().episodes);
+}
+
+TEST(TrainingSession, EvaluationActsGreedilyAndLearnsNothing)
+{
+  TrainingConfig config = shippedConfig();
+  HeadlessTrainer trainer(config, 0);
+  trainer.run();
+  TrainingSession evaluator(config.task, config.agent, 0, false);
+  ASSERT_EQ("", evaluator.replaceTable(trainer.session().table()));
+  const std::vector<double> before = evaluator.table().values();
+
+  CartPoleSimulation sim(config.physics, config.start_state_bound, 99);
+  double effort = evaluator.beginEpisode(sim.resetRandom());
+  Decision decision;
+  do
+  {
+    decision = evaluator.observe(sim.step(effort));
+    effort = decision.effort;
+  } while (!decision.episode_over);
+  EXPECT_TRUE(bitIdentical(before, evaluator.table().values()));
+  EXPECT_EQ(0.0, evaluator.lastEpisode().epsilon);
+  EXPECT_GT(evaluator.lastEpisode().steps, 100u);  // a solved table balances a fresh start for long
+}
+
+TEST(TrainingSession, ALoadedTableResumesItsSchedules)
+{
+  const AgentParams agent;
+  TrainingSession session(TaskParams(), agent, 0);
+  QTable table(agent.discretiser, agent.actions);
+  table.episodes = 400;
+  ASSERT_EQ("", session.replaceTable(table));
+  session.beginEpisode(CartPoleState::Zero());
+  Decision d;
+  do
+    d = session.observe(CartPoleState(0.0, 0.0, 1.0, 0.0));
+  while (!d.episode_over);
+  EXPECT_DOUBLE_EQ(session.agent().epsilon(400), session.lastEpisode().epsilon);
+  EXPECT_DOUBLE_EQ(agent.epsilon.min, session.lastEpisode().epsilon);  // the floor, not a fresh start
+  EXPECT_EQ(401u, session.table().episodes);
+}
+
+TEST(CartPoleSimulation, RandomStartsStayWithinTheBoundAndFollowTheSeed)
+{
+  CartPoleSimulation a(CartPoleParams(), 0.05, 5);
+  CartPoleSimulation b(CartPoleParams(), 0.05, 5);
+  for (int i = 0; i < 1000; ++i)
+  {
+    const CartPoleState s = a.resetRandom();
+    EXPECT_EQ(s, b.resetRandom());
+    EXPECT_LE(s.cwiseAbs().maxCoeff(), 0.05);
+  }
+  a.reset(CartPoleState(0, 0, 0, 0));
+  a.step(25.0);
+  EXPECT_EQ(10.0, a.appliedForce());
+}
