@@ -6,6 +6,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -129,7 +134,7 @@ RobustnessSuite loadRobustnessSuite(const std::string& path, const TrainingConfi
 }
 
 CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
-                        std::uint64_t episodes, std::uint64_t seed)
+                        std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided)
 {
   TrainingSession session(config.task, config.agent, seed, false);
   const std::string mismatch = session.replaceTable(table);
@@ -139,6 +144,9 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
   CaseResult result;
   result.name = suite_case.name;
   result.pass = suite_case.pass;
+  result.episodes = episodes;
+  // Decided once pass episodes balanced, or once more fell than the case allows.
+  const std::uint64_t falls_to_fail = episodes >= suite_case.pass ? episodes - suite_case.pass + 1 : 0;
   double returns = 0.0;
   for (std::uint64_t e = 0; e < episodes; ++e)
   {
@@ -155,20 +163,98 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
     const EpisodeSummary& s = session.lastEpisode();
     result.balanced += s.truncated && !s.terminated;
     returns += s.episode_return;
+    result.run = e + 1;
+    if (stop_when_decided && (result.balanced >= suite_case.pass || result.run - result.balanced >= falls_to_fail))
+      break;
   }
-  result.episodes = episodes;
-  result.mean_return = episodes > 0 ? returns / static_cast<double>(episodes) : 0.0;
+  result.mean_return = result.run > 0 ? returns / static_cast<double>(result.run) : 0.0;
   return result;
 }
 
-SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite)
+SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite,
+                          const SuiteRun& how)
 {
   TrainingConfig judged = config;
   judged.task.max_episode_steps = suite.max_episode_steps;
+  std::vector<std::size_t> order = how.order;
+  if (order.empty())
+    for (std::size_t i = 0; i < suite.cases.size(); ++i)
+      order.push_back(i);
+  if (order.size() != suite.cases.size() ||
+      std::set<std::size_t>(order.begin(), order.end()).size() != order.size() ||
+      *std::max_element(order.begin(), order.end()) >= suite.cases.size())
+    throw std::invalid_argument("evaluateSuite: the order must name each of the suite's cases once");
+
+  // Positions are taken in order, so when the case at position p fails every position before p
+  // has been taken and runs to its end: the cases kept (up to the first failure) are the same
+  // whatever the number of threads.
+  std::vector<CaseResult> results(order.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::size_t> first_failure{order.size()};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  const auto work = [&]() {
+    for (std::size_t p = next++; p < order.size(); p = next++)
+    {
+      if (how.stop_at_first_failure && p > first_failure.load())
+        return;
+      try
+      {
+        results[p] = evaluateCase(table, judged, suite.cases[order[p]], suite.episodes, suite.seed,
+                                  how.stop_cases_when_decided);
+      }
+      catch (...)
+      {
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error)
+          error = std::current_exception();
+        first_failure = 0;
+        return;
+      }
+      if (!results[p].passed())
+      {
+        std::size_t seen = first_failure.load();
+        while (p < seen && !first_failure.compare_exchange_weak(seen, p))
+        {
+        }
+      }
+    }
+  };
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t threads = std::min<std::size_t>(how.threads > 0 ? how.threads : cores, order.size());
+  std::vector<std::thread> helpers;
+  for (std::size_t t = 1; t < threads; ++t)
+    helpers.emplace_back(work);
+  work();
+  for (std::thread& helper : helpers)
+    helper.join();
+  if (error)
+    std::rethrow_exception(error);
+
   SuiteResult result;
-  for (const SuiteCase& c : suite.cases)
-    result.cases.push_back(evaluateCase(table, judged, c, suite.episodes, suite.seed));
+  result.cases_in_suite = suite.cases.size();
+  const std::size_t kept = how.stop_at_first_failure ? std::min(first_failure.load() + 1, order.size()) : order.size();
+  for (std::size_t p = 0; p < kept; ++p)
+    result.cases.push_back(results[p]);
   return result;
+}
+
+void failedCaseFirst(std::vector<std::size_t>& order, const SuiteResult& result, const RobustnessSuite& suite)
+{
+  for (const CaseResult& c : result.cases)
+  {
+    if (c.passed())
+      continue;
+    for (std::size_t p = 0; p < order.size(); ++p)
+    {
+      if (order[p] < suite.cases.size() && suite.cases[order[p]].name == c.name)
+      {
+        std::rotate(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(p),
+                    order.begin() + static_cast<std::ptrdiff_t>(p) + 1);
+        return;
+      }
+    }
+  }
 }
 
 double shownReturn(double value, int decimals)
@@ -180,7 +266,7 @@ double shownReturn(double value, int decimals)
 
 bool SuiteResult::passed() const
 {
-  return std::all_of(cases.begin(), cases.end(), [](const CaseResult& c) { return c.passed(); });
+  return !stoppedEarly() && std::all_of(cases.begin(), cases.end(), [](const CaseResult& c) { return c.passed(); });
 }
 
 std::uint64_t SuiteResult::worstBalanced() const
@@ -195,8 +281,17 @@ std::string SuiteResult::summary() const
 {
   std::string text;
   for (const CaseResult& c : cases)
-    text += (text.empty() ? "" : ", ") + c.name + " " + std::to_string(c.balanced) + "/" + std::to_string(c.episodes);
-  return text + ": " + (passed() ? "PASSED" : "FAILED");
+  {
+    text += (text.empty() ? "" : ", ") + c.name + " " + std::to_string(c.balanced) + "/" + std::to_string(c.run);
+    if (c.cutShort())
+      text += " (stopped at " + std::to_string(c.run) + " of " + std::to_string(c.episodes) + ": " +
+              (c.passed() ? "passes" : "fails") + ")";
+  }
+  text += std::string(": ") + (passed() ? "PASSED" : "FAILED");
+  if (stoppedEarly())
+    text += " (stopped at " + (cases.empty() ? std::string("the start") : cases.back().name) + ", " +
+            std::to_string(cases_in_suite - cases.size()) + " of " + std::to_string(cases_in_suite) + " cases not run)";
+  return text;
 }
 
 std::string SuiteResult::table() const
@@ -211,7 +306,7 @@ std::string SuiteResult::table() const
   out << line;
   for (const CaseResult& c : cases)
   {
-    const std::string balanced = std::to_string(c.balanced) + "/" + std::to_string(c.episodes);
+    const std::string balanced = std::to_string(c.balanced) + "/" + std::to_string(c.run);
     std::snprintf(line, sizeof line, "%-*s  %8s  %6llu  %11.1f  %s\n", static_cast<int>(width), c.name.c_str(),
                   balanced.c_str(), static_cast<unsigned long long>(c.pass), shownReturn(c.mean_return, 1),
                   c.passed() ? "pass" : "FAIL");

@@ -8,8 +8,10 @@
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/learning/q_table.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cartpole_qlearning
@@ -46,23 +48,66 @@ RobustnessSuite loadRobustnessSuite(const std::string& path, const TrainingConfi
 struct CaseResult
 {
   std::string name;
-  std::uint64_t episodes = 0;
+  std::uint64_t episodes = 0;  // the case's episodes (the suite's)
+  std::uint64_t run = 0;       // of which were run: fewer when the case stopped once decided
   std::uint64_t balanced = 0;  // reached the task's step limit without falling
   std::uint64_t pass = 0;
-  double mean_return = 0.0;
+  double mean_return = 0.0;  // over the episodes run
   bool passed() const
   {
     return balanced >= pass;
+  }
+  bool cutShort() const
+  {
+    return run < episodes;
+  }
+};
+
+// How a suite is run. The verdict (passed or not) is the same whatever these say: the episodes of
+// a case are drawn from its own stream, in order, so stopping early only leaves out episodes that
+// could not change it, and a case's result does not depend on which thread ran it.
+struct SuiteRun
+{
+  // A case stops at its deciding episode: its (episodes - pass + 1)-th fall, or its pass-th
+  // balanced episode.
+  bool stop_cases_when_decided = false;
+  // The suite stops at its first failing case, in `order`; the cases after it are not run.
+  bool stop_at_first_failure = false;
+  // The cases' indices in the order to run them (each once); empty: as the suite lists them.
+  std::vector<std::size_t> order;
+  // Cases run side by side on this many threads (0: one per core).
+  unsigned threads = 0;
+
+  // The complete verdict: every case to its last episode.
+  static SuiteRun complete()
+  {
+    return SuiteRun();
+  }
+  // During training: only whether the table passes, as soon as that is known.
+  static SuiteRun untilDecided(std::vector<std::size_t> order)
+  {
+    SuiteRun run;
+    run.stop_cases_when_decided = true;
+    run.stop_at_first_failure = true;
+    run.order = std::move(order);
+    return run;
   }
 };
 
 struct SuiteResult
 {
-  std::vector<CaseResult> cases;
+  std::vector<CaseResult> cases;  // in the order run; a suite stopped at a failure lists the cases run
+  std::size_t cases_in_suite = 0;
   bool passed() const;
+  // The suite stopped at a failing case before running them all.
+  bool stoppedEarly() const
+  {
+    return cases.size() < cases_in_suite;
+  }
   // The fewest balanced episodes of any case, and that case's name.
   std::uint64_t worstBalanced() const;
-  // "nominal 100/100, one_step_late 97/100, ... : PASSED" on one line.
+  // "nominal 100/100, one_step_late 97/100, ... : PASSED" on one line; a case cut short reads
+  // "one_step_late 3/9 (stopped: failed)", a suite stopped early ends "FAILED (stopped at one_step_late)".
   std::string summary() const;
   // One line per case, aligned, then the verdict: for a console.
   std::string table() const;
@@ -73,8 +118,13 @@ struct SuiteResult
 // evaluateSuite runs each case with the suite's step limit in place of the task's.
 // Throws ConfigError when the table does not fit the configuration.
 CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
-                        std::uint64_t episodes, std::uint64_t seed);
-SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite);
+                        std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided = false);
+SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite,
+                          const SuiteRun& how = SuiteRun::complete());
+
+// The order for the next evaluation during training: the case that failed last comes first (the
+// likeliest to fail again), the others keep their order. order: the indices of the suite's cases.
+void failedCaseFirst(std::vector<std::size_t>& order, const SuiteResult& result, const RobustnessSuite& suite);
 
 // A mean return as printed with this many decimals: rounded there, a zero without its sign.
 // Under sutton_barto a case where 2 of 100 fell has a mean of -0.02, which "%.1f" prints as

@@ -154,8 +154,8 @@ TEST(RobustnessSuite, AMeanReturnThatRoundsToZeroPrintsWithoutASign)
   // Under sutton_barto (0 a step, -1 on the fall) a case where 2 of 100 fell has a mean return of
   // -0.02: the table shows 0.0, never "-0.0"; a mean that does not round to zero keeps its sign.
   SuiteResult result;
-  result.cases.push_back({"few_falls", 100, 98, 95, -0.02});
-  result.cases.push_back({"many_falls", 100, 40, 95, -0.6});
+  result.cases.push_back({"few_falls", 100, 100, 98, 95, -0.02});
+  result.cases.push_back({"many_falls", 100, 100, 40, 95, -0.6});
   const std::string table = result.table();
   EXPECT_EQ(table.find("-0.0"), std::string::npos) << table;
   EXPECT_NE(table.find("98/100      95          0.0  pass"), std::string::npos) << table;
@@ -164,4 +164,179 @@ TEST(RobustnessSuite, AMeanReturnThatRoundsToZeroPrintsWithoutASign)
   EXPECT_EQ(formatText("%.2f", shownReturn(-0.004, 2)), "0.00");
   EXPECT_EQ(formatText("%.1f", shownReturn(-0.06, 1)), "-0.1");
   EXPECT_EQ(formatText("%.3f", shownReturn(475.25, 3)), "475.250");
+}
+
+namespace
+{
+// Tables from no learning to solved: trained for more and more episodes on seeds 0-2.
+std::vector<QTable> tablesAlongTraining()
+{
+  std::vector<QTable> tables;
+  for (std::uint64_t seed = 0; seed < 3; ++seed)
+  {
+    for (std::uint64_t episodes : {0u, 60u, 150u, 400u})
+    {
+      TrainingConfig config;
+      config.limits.max_episodes = episodes;
+      config.limits.stop_when_solved = false;
+      HeadlessTrainer trainer(config, seed);
+      if (episodes > 0)
+        trainer.run();
+      tables.push_back(trainer.session().table());
+    }
+  }
+  tables.push_back(trainedTable(7));
+  return tables;
+}
+
+// The shipped suite, cut to `episodes` per case so that the test stays short.
+RobustnessSuite shortSuite(std::uint64_t episodes, std::uint64_t seed)
+{
+  RobustnessSuite suite = loadRobustnessSuite(kSuite, TrainingConfig());
+  suite.episodes = episodes;
+  suite.seed = seed;
+  suite.max_episode_steps = 300;
+  for (SuiteCase& c : suite.cases)
+    c.pass = episodes * 9 / 10;
+  return suite;
+}
+
+bool sameCase(const CaseResult& a, const CaseResult& b)
+{
+  return a.name == b.name && a.run == b.run && a.balanced == b.balanced && a.pass == b.pass &&
+         a.mean_return == b.mean_return && a.episodes == b.episodes;
+}
+}  // namespace
+
+TEST(RobustnessSuite, ACaseStoppedWhenDecidedGivesTheFullVerdictAlsoAtTheThreshold)
+{
+  const std::vector<QTable> tables = tablesAlongTraining();
+  TrainingConfig config;
+  int cut_short = 0;
+  int decided_by_one = 0;
+  for (std::uint64_t seed : {1000u, 3u})
+  {
+    const RobustnessSuite suite = shortSuite(20, seed);
+    for (std::size_t t = 0; t < tables.size(); ++t)
+    {
+      for (const SuiteCase& original : suite.cases)
+      {
+        const CaseResult full = evaluateCase(tables[t], config, original, suite.episodes, suite.seed);
+        ASSERT_EQ(full.run, suite.episodes);
+        // Thresholds around what the table does: at it (passes by nothing) and one over (fails by one).
+        for (std::uint64_t pass : {full.balanced, full.balanced + 1, std::uint64_t{0}, suite.episodes, full.balanced / 2})
+        {
+          if (pass > suite.episodes)
+            continue;
+          SuiteCase c = original;
+          c.pass = pass;
+          const CaseResult whole = evaluateCase(tables[t], config, c, suite.episodes, suite.seed);
+          const CaseResult stopped = evaluateCase(tables[t], config, c, suite.episodes, suite.seed, true);
+          ASSERT_EQ(whole.passed(), stopped.passed())
+              << "table " << t << ", case " << c.name << ", pass " << pass << ", seed " << seed << ": stopped at "
+              << stopped.run << " with " << stopped.balanced << " balanced; the whole case balanced " << whole.balanced;
+          EXPECT_LE(stopped.balanced, whole.balanced);
+          EXPECT_LE(stopped.run, whole.run);
+          cut_short += stopped.cutShort() ? 1 : 0;
+          decided_by_one += (pass == whole.balanced || pass == whole.balanced + 1) ? 1 : 0;
+        }
+      }
+    }
+  }
+  EXPECT_GT(cut_short, 100) << "the stop must save episodes, else this test shows nothing";
+  EXPECT_GT(decided_by_one, 100);
+}
+
+TEST(RobustnessSuite, TheThreadCountChangesNoVerdictAndNoCount)
+{
+  const std::vector<QTable> tables = tablesAlongTraining();
+  const RobustnessSuite suite = shortSuite(12, 1000);
+  std::vector<std::size_t> order{7, 1, 0, 2, 3, 4, 5, 6};
+  int stopped_early = 0;
+  for (const QTable& table : tables)
+  {
+    for (const SuiteRun& how : {SuiteRun::complete(), SuiteRun::untilDecided(order)})
+    {
+      SuiteRun one = how;
+      one.threads = 1;
+      const SuiteResult reference = evaluateSuite(table, TrainingConfig(), suite, one);
+      stopped_early += reference.stoppedEarly() ? 1 : 0;
+      for (unsigned threads : {2u, 3u, 8u, 0u})
+      {
+        SuiteRun many = how;
+        many.threads = threads;
+        const SuiteResult result = evaluateSuite(table, TrainingConfig(), suite, many);
+        ASSERT_EQ(reference.passed(), result.passed());
+        ASSERT_EQ(reference.summary(), result.summary()) << threads << " threads";
+        ASSERT_EQ(reference.cases.size(), result.cases.size());
+        for (std::size_t i = 0; i < result.cases.size(); ++i)
+          EXPECT_TRUE(sameCase(reference.cases[i], result.cases[i])) << threads << " threads, " << result.cases[i].name;
+      }
+    }
+  }
+  EXPECT_GT(stopped_early, 0) << "some table must fail before the last case";
+}
+
+TEST(RobustnessSuite, StoppedAtTheFirstFailureTheVerdictIsTheCompleteOnesAndSaysWhereItStopped)
+{
+  const std::vector<QTable> tables = tablesAlongTraining();
+  const RobustnessSuite suite = shortSuite(12, 1000);
+  std::vector<std::size_t> order{7, 6, 5, 4, 3, 2, 1, 0};
+  for (const QTable& table : tables)
+  {
+    const SuiteResult complete = evaluateSuite(table, TrainingConfig(), suite);
+    const SuiteResult quick = evaluateSuite(table, TrainingConfig(), suite, SuiteRun::untilDecided(order));
+    ASSERT_EQ(complete.passed(), quick.passed()) << complete.summary() << " | " << quick.summary();
+    ASSERT_EQ(complete.cases.size(), suite.cases.size());
+    EXPECT_FALSE(complete.stoppedEarly());
+    if (quick.passed())
+      continue;
+    // The cases run are those of `order` up to the first failing one, which failed.
+    ASSERT_FALSE(quick.cases.empty());
+    EXPECT_FALSE(quick.cases.back().passed());
+    for (std::size_t p = 0; p < quick.cases.size(); ++p)
+      EXPECT_EQ(quick.cases[p].name, suite.cases[order[p]].name);
+    if (quick.stoppedEarly())
+    {
+      EXPECT_NE(std::string::npos, quick.summary().find("cases not run")) << quick.summary();
+    }
+    if (quick.cases.back().cutShort())
+    {
+      EXPECT_NE(std::string::npos, quick.summary().find("(stopped at ")) << quick.summary();
+    }
+  }
+}
+
+TEST(RobustnessSuite, TheCaseThatFailedLastIsTriedFirstNextTime)
+{
+  const RobustnessSuite suite = shortSuite(12, 1000);
+  std::vector<std::size_t> order{0, 1, 2, 3, 4, 5, 6, 7};
+  SuiteResult result;
+  result.cases_in_suite = 8;
+  CaseResult passed;
+  passed.name = "nominal";
+  passed.pass = 1;
+  passed.balanced = 1;
+  CaseResult failed;
+  failed.name = "pushes";
+  failed.pass = 5;
+  failed.balanced = 2;
+  result.cases = {passed, failed};
+  failedCaseFirst(order, result, suite);
+  EXPECT_EQ((std::vector<std::size_t>{5, 0, 1, 2, 3, 4, 6, 7}), order);
+  failedCaseFirst(order, result, suite);
+  EXPECT_EQ((std::vector<std::size_t>{5, 0, 1, 2, 3, 4, 6, 7}), order) << "already first";
+  result.cases = {passed};
+  failedCaseFirst(order, result, suite);
+  EXPECT_EQ((std::vector<std::size_t>{5, 0, 1, 2, 3, 4, 6, 7}), order) << "nothing failed: nothing moves";
+}
+
+TEST(RobustnessSuite, AnOrderThatDoesNotNameEachCaseOnceIsRefused)
+{
+  const RobustnessSuite suite = shortSuite(2, 1000);
+  SuiteRun how;
+  how.order = {0, 0, 1, 2, 3, 4, 5, 6};
+  EXPECT_THROW(evaluateSuite(QTable(), TrainingConfig(), suite, how), std::invalid_argument);
+  how.order = {0, 1};
+  EXPECT_THROW(evaluateSuite(QTable(), TrainingConfig(), suite, how), std::invalid_argument);
 }
