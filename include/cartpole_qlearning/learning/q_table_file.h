@@ -9,21 +9,18 @@
 
 namespace cartpole_qlearning
 {
-// Anything wrong with a path or a table file; the message says what, and nothing was changed.
-using FileError = FileError;
-
 // Version 2 says which features number the rows (bins or tiles, with their parameters);
 // version 1 (bins only) is still read, as bins.
 constexpr int kQTableFormatVersion = 2;
 
 // Saves atomically (see file_access.h: the target is either the old file or the complete new
-// one, whatever happens). Creates missing parent directories. Throws QTableFileError.
+// one, whatever happens). Creates missing parent directories. Throws FileError (io/file_access.h: what is wrong, and nothing was changed).
 void saveQTableFile(const QTable& table, const std::string& path);
 // The same for a path under a directory, as services take it: no links, no "..".
 void saveQTableUnder(const QTable& table, const std::string& directory, const std::string& path);
 
 // Reads and checks a file: format name, version, shape, counts, finite values and checksum.
-// Throws QTableFileError saying what is wrong. Whether it fits a given agent is the caller's
+// Throws FileError (io/file_access.h: what is wrong, and nothing was changed) saying what is wrong. Whether it fits a given agent is the caller's
 // check (QTable::shapeMismatch), made before the live table is replaced.
 QTable loadQTableFile(const std::string& path);
 QTable loadQTableUnder(const std::string& directory, const std::string& path);
