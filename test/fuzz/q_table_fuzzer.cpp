@@ -1,5 +1,5 @@
 // libFuzzer target: the Q-table file parser. Whatever the bytes, parseQTable returns a table or
-// throws QTableFileError; any other exception, a crash or a sanitizer report is a bug. A table
+// throws FileError; any other exception, a crash or a sanitizer report is a bug. A table
 // it accepts must write back to text that parses to the same table (a version 1 table is
 // written back as version 2; bins and tiles alike: shapeMismatch compares the features). The
 // corpus holds both versions and both kinds of features.
