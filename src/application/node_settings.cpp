@@ -194,7 +194,8 @@ void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& r
   robot.command_index = static_cast<std::size_t>(index);
   robot.command_size = static_cast<std::size_t>(size);
   robot.decision_period = tau;
-  priv.readAtLeast("decision_period", robot.decision_period, 0.0, false);
+  // Over a second the pole has fallen between two decisions.
+  priv.readSeconds("decision_period", robot.decision_period, 0.0, 1.0, false);
 }
 }  // namespace
 
@@ -282,7 +283,7 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   priv.read("checkpoint_every", run.checkpoint_every, 0);
   priv.read("save_on_shutdown", run.save_on_shutdown);
   priv.read("shutdown_when_finished", settings.shutdown_when_finished);
-  priv.readAtLeast("sim_timeout", settings.sim_timeout, 0.0, true);
+  priv.readSeconds("sim_timeout", settings.sim_timeout, 0.0, 3600.0, true);
   priv.read("reset_service", settings.reset_service);
 
   ControllerProtocolParams& protocol = settings.protocol;
@@ -343,8 +344,8 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
     if (source.keysUnder("seed").empty())
       settings.seed = suite.seed;
   }
-  priv.readAtLeast("command_timeout", settings.command_timeout, 0.0, true);
-  priv.readAtLeast("lockstep_timeout", settings.lockstep_timeout, 0.0, true);
+  priv.readSeconds("command_timeout", settings.command_timeout, 0.0, 60.0, true);
+  priv.readSeconds("lockstep_timeout", settings.lockstep_timeout, 0.0, 3600.0, true);
   priv.readAtLeast("tf_rate", settings.tf_rate, 0.0, true);
   settings.effort_limit = settings.physics.force_mag;
   priv.readAtLeast("effort_limit", settings.effort_limit, 0.0, true);

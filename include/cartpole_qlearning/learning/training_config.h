@@ -93,6 +93,17 @@ public:
       fail(name, numberText(value), std::string("must be finite and ") + (strict ? "> " : ">= ") + numberText(min));
   }
 
+  // A duration in seconds in [min, max] ((min, max] when strict): the message names the unit, so
+  // that milliseconds typed as seconds (decision_period: 20) read as what they are.
+  void readSeconds(const std::string& name, double& value, double min, double max, bool strict)
+  {
+    read(name, value);
+    if (!(std::isfinite(value) && (strict ? value > min : value >= min) && value <= max))
+      fail(name, numberText(value),
+           std::string("must be in ") + (strict ? "(" : "[") + numberText(min) + ", " + numberText(max) +
+               "] seconds (20 ms is 0.02)");
+  }
+
   // One of the allowed strings.
   void readChoice(const std::string& name, std::string& value, const std::vector<std::string>& allowed)
   {

@@ -304,8 +304,8 @@ TEST(ControllerSettings, RefusesABadStartRegion)
 
 TEST(ControllerSettings, RefusesANonPositiveSimTimeout)
 {
-  EXPECT_SAYS(controllerError("sim_timeout: 0"), "sim_timeout = 0 is not allowed (must be finite and > 0)");
-  EXPECT_SAYS(controllerError("sim_timeout: .inf"), "sim_timeout = inf is not allowed (must be finite and > 0)");
+  EXPECT_SAYS(controllerError("sim_timeout: 0"), "sim_timeout = 0 is not allowed (must be in (0, 3600] seconds");
+  EXPECT_SAYS(controllerError("sim_timeout: .inf"), "sim_timeout = inf is not allowed (must be in (0, 3600] seconds");
 }
 
 TEST(ControllerSettings, RefusesAValueOfTheWrongType)
@@ -404,8 +404,9 @@ TEST(SimSettings, PublishesTheClockOnlyInLockstep)
 TEST(SimSettings, RefusesBadTimesRatesAndNoise)
 {
   EXPECT_SAYS(simError("seed: -3"), "seed = -3 is not allowed (must be a whole number >= 0)");
-  EXPECT_SAYS(simError("command_timeout: 0"), "command_timeout = 0 is not allowed (must be finite and > 0)");
-  EXPECT_SAYS(simError("lockstep_timeout: -1"), "lockstep_timeout = -1 is not allowed (must be finite and > 0)");
+  EXPECT_SAYS(simError("command_timeout: 0"), "command_timeout = 0 is not allowed (must be in (0, 60] seconds");
+  EXPECT_SAYS(simError("command_timeout: 500"), "command_timeout = 500 is not allowed (must be in (0, 60] seconds");
+  EXPECT_SAYS(simError("lockstep_timeout: -1"), "lockstep_timeout = -1 is not allowed (must be in (0, 3600] seconds");
   EXPECT_SAYS(simError("tf_rate: 0"), "tf_rate = 0 is not allowed (must be finite and > 0)");
 }
 
@@ -531,6 +532,10 @@ TEST(ControllerSettings, RefusesABadRobotInterface)
   EXPECT_SAYS(controllerError("pole_joint: cart_joint"), "pole_joint = 'cart_joint' is not allowed");
   EXPECT_SAYS(controllerError("state_topic: ''"), "state_topic = '' is not allowed (must not be empty)");
   EXPECT_SAYS(controllerError("decision_period: -0.1"), "decision_period = -0.1 is not allowed");
+  // Milliseconds typed as seconds: one decision, then its effort held until the pole fell.
+  EXPECT_SAYS(controllerError("decision_period: 20"),
+              "decision_period = 20 is not allowed (must be in [0, 1] seconds (20 ms is 0.02))");
+  EXPECT_SAYS(controllerError("decision_period: 1e9"), "decision_period = 1e+09 is not allowed");
   EXPECT_SAYS(controllerError("velocity_smoothing: 1"), "velocity_smoothing = 1 is not allowed");
   EXPECT_SAYS(controllerError("reset_service_type: std_srvs/SetBool"), "reset_service_type = 'std_srvs/SetBool'");
 }
