@@ -68,6 +68,18 @@ std::string checksumOf(const QTable& table)
   // Summed only when on, so that every other table keeps its checksum.
   if (f.previous_action)
     sum.add(std::uint64_t{1});
+  // Version 3's keys, summed only when present: a table without them keeps its checksum.
+  if (table.tau > 0.0)
+  {
+    sum.add(std::uint64_t{3});
+    sum.add(table.tau);
+  }
+  if (!table.trained_with.empty())
+  {
+    sum.add(std::uint64_t{table.trained_with.size()});
+    for (const char c : table.trained_with)
+      sum.add(static_cast<std::uint64_t>(static_cast<unsigned char>(c)));
+  }
   sum.add(table.episodes);
   sum.add(table.steps);
   for (double v : table.values())
@@ -105,6 +117,13 @@ std::string flowList(const Container& values)
     first = false;
   }
   return text + "]";
+}
+
+// Version 3 carries the step and the config; a table that knows neither is written as version 2,
+// byte for byte the file it always was.
+bool knowsHowToRun(const QTable& table)
+{
+  return table.tau > 0.0 || !table.trained_with.empty();
 }
 
 [[noreturn]] void refuse(const std::string& what)
@@ -178,7 +197,7 @@ std::string formatQTable(const QTable& table)
   out << "# Q-table of cartpole_qlearning. The checksum covers every number below: edit by hand and the\n"
       << "# file will be refused.\n"
       << "format: " << kFormatName << "\n"
-      << "version: " << kQTableFormatVersion << "\n";
+      << "version: " << (knowsHowToRun(table) ? kQTableFormatVersion : 2) << "\n";
   if (tiles)
     out << "# Features: tile coding. Each of the tilings is a grid of tiles over the bounds (one tile more\n"
         << "# than 'tiles' along a used dimension), tiling i displaced by i * (1, 3, 5, 7) / tilings of a\n"
@@ -201,7 +220,18 @@ std::string formatQTable(const QTable& table)
         << "# for each action in order; the learner sees the action it took last.\n"
         << "previous_action: true\n";
   out << "# The effort [N] of each action: one column of values per action.\n"
-      << "actions: " << flowList(table.actions()) << "\n"
+      << "actions: " << flowList(table.actions()) << "\n";
+  if (knowsHowToRun(table))
+    out << "# What it takes to run it: the step it learnt [s] and the configuration that trained it.\n";
+  if (table.tau > 0.0)
+    out << "tau: " << exact(table.tau) << "\n";
+  if (!table.trained_with.empty())
+  {
+    YAML::Emitter quoted;
+    quoted << YAML::DoubleQuoted << table.trained_with;
+    out << "trained_with: " << quoted.c_str() << "\n";
+  }
+  out
       << "# Training that produced this table.\n"
       << "episodes: " << table.episodes << "\n"
       << "steps: " << table.steps << "\n"
@@ -259,9 +289,10 @@ QTable parseQTable(const std::string& text)
     refuse("not a Q-table file (format is not '" + std::string(kFormatName) + "')");
   const YAML::Node version = required(root, "version");
   const bool version1 = version.IsScalar() && version.Scalar() == "1";
-  if (!version1 && !(version.IsScalar() && version.Scalar() == std::to_string(kQTableFormatVersion)))
+  const bool version3 = version.IsScalar() && version.Scalar() == "3";
+  if (!version1 && !version3 && !(version.IsScalar() && version.Scalar() == "2"))
     refuse("format version " + (version.IsScalar() ? version.Scalar() : std::string("?")) +
-           " is not supported (this build reads versions 1 and " + std::to_string(kQTableFormatVersion) + ")");
+           " is not supported (this build reads versions 1 to " + std::to_string(kQTableFormatVersion) + ")");
 
   // Version 1 had bins only and no 'features' key.
   FeatureParams features;
@@ -323,6 +354,23 @@ QTable parseQTable(const std::string& text)
   QTable table(features, actions);
   table.episodes = readCount(required(root, "episodes"), "episodes");
   table.steps = readCount(required(root, "steps"), "steps");
+  if (version3)
+  {
+    if (const YAML::Node tau = root["tau"])
+    {
+      table.tau = readNumber(tau, "tau");
+      if (!(table.tau > 0.0))
+        refuse("tau is not > 0");
+    }
+    if (const YAML::Node config = root["trained_with"])
+    {
+      if (!config.IsScalar())
+        refuse("trained_with is not a text");
+      table.trained_with = config.Scalar();
+    }
+    if (table.tau == 0.0 && table.trained_with.empty())
+      refuse("a version 3 file says tau or trained_with (or both)");
+  }
   std::vector<double> values;
   values.reserve(table.stateCount() * table.actionCount());
   for (std::size_t s = 0; s < rows.size(); ++s)

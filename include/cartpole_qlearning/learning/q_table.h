@@ -71,6 +71,11 @@ public:
   // Training that produced the table, so that a loaded table resumes its schedules.
   std::uint64_t episodes = 0;
   std::uint64_t steps = 0;
+  // What it takes to run the table besides its features and actions: the step it learnt [s]
+  // (0: not known, a file written before version 3) and the configuration that trained it, as
+  // its user named it ("": not known).
+  double tau = 0.0;
+  std::string trained_with;
 
   // Empty when the other table has the same features (kind, bins or tilings and tiles, bounds)
   // and actions, else what differs.

@@ -9,9 +9,11 @@
 
 namespace cartpole_qlearning
 {
-// Version 2 says which features number the rows (bins or tiles, with their parameters);
-// version 1 (bins only) is still read, as bins.
-constexpr int kQTableFormatVersion = 2;
+// Version 3 also says what it takes to run the table: the step it learnt (tau) and the
+// configuration that trained it (written as version 2 when the table knows neither). Version 2
+// says which features number the rows (bins or tiles, with their parameters); version 1 (bins
+// only) is still read, as bins.
+constexpr int kQTableFormatVersion = 3;
 
 // Saves atomically (see file_access.h: the target is either the old file or the complete new
 // one, whatever happens). Creates missing parent directories. Throws FileError (io/file_access.h: what is wrong, and nothing was changed).

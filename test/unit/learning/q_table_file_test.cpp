@@ -193,16 +193,17 @@ TEST_F(QTableFileTest, WrongVersionIsRefusedWithTheVersion)
 {
   saveQTableFile(awkwardTable(), path("t.yaml"));
   std::string text = readFile(path("t.yaml"));
-  text.replace(text.find("version: 2"), 10, "version: 3");
+  text.replace(text.find("version: 2"), 10, "version: 4");
   write(path("t.yaml"), text);
   try
   {
     loadQTableFile(path("t.yaml"));
-    FAIL() << "version 3 was accepted";
+    FAIL() << "version 4 was accepted";
   }
   catch (const FileError& e)
   {
-    EXPECT_NE(std::string::npos, std::string(e.what()).find("version 3 is not supported")) << e.what();
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("version 4 is not supported (this build reads versions 1 to 3)"))
+        << e.what();
   }
 }
 
@@ -491,4 +492,49 @@ TEST_F(QTableFileTest, APreviousActionTableSaysSoAndAnOlderFileLoadsWithout)
   TrainingSession with_session(TaskParams(), with, 0);
   EXPECT_EQ("previous_action false differs from true", loadInto(with_session, path("plain.yaml")));
   EXPECT_EQ("", loadInto(with_session, path("previous.yaml")));
+}
+
+TEST_F(QTableFileTest, ATableSaysTheStepItLearntAndTheConfigThatTrainedIt)
+{
+  QTable table = awkwardTable();
+  table.tau = 0.04;
+  table.trained_with = "/home/a user/configs/robust \"v2\": long.yaml";
+  saveQTableFile(table, path("t.yaml"));
+  const std::string text = readFile(path("t.yaml"));
+  EXPECT_NE(std::string::npos, text.find("version: 3\n")) << text;
+  EXPECT_NE(std::string::npos, text.find("tau: 0.04\n")) << text;
+  const QTable back = loadQTableFile(path("t.yaml"));
+  EXPECT_EQ(0.04, back.tau);
+  EXPECT_EQ(table.trained_with, back.trained_with);
+  EXPECT_TRUE(bitIdentical(table.values(), back.values()));
+  // The checksum covers them: another step or config is a corrupt file.
+  for (const auto& edit : {std::make_pair(std::string("tau: 0.04"), std::string("tau: 0.02")),
+                           std::make_pair(std::string("long.yaml"), std::string("short.yaml"))})
+  {
+    std::string edited = text;
+    edited.replace(edited.find(edit.first), edit.first.size(), edit.second);
+    write(path("edited.yaml"), edited);
+    EXPECT_THROW(loadQTableFile(path("edited.yaml")), FileError) << edit.second;
+  }
+  // Each alone is enough for version 3.
+  QTable only_tau = awkwardTable();
+  only_tau.tau = 0.02;
+  saveQTableFile(only_tau, path("tau.yaml"));
+  EXPECT_EQ(0.02, loadQTableFile(path("tau.yaml")).tau);
+  EXPECT_EQ("", loadQTableFile(path("tau.yaml")).trained_with);
+}
+
+TEST_F(QTableFileTest, ATableThatKnowsNeitherIsTheVersion2FileItAlwaysWas)
+{
+  saveQTableFile(awkwardTable(), path("t.yaml"));
+  const std::string text = readFile(path("t.yaml"));
+  EXPECT_NE(std::string::npos, text.find("version: 2\n")) << text;
+  EXPECT_EQ(std::string::npos, text.find("tau:")) << text;
+  EXPECT_EQ(std::string::npos, text.find("trained_with:")) << text;
+  EXPECT_EQ(0.0, loadQTableFile(path("t.yaml")).tau);
+  // A version 3 file without either is refused: something was cut out of it.
+  std::string v3 = text;
+  v3.replace(v3.find("version: 2"), 10, "version: 3");
+  write(path("v3.yaml"), v3);
+  EXPECT_THROW(loadQTableFile(path("v3.yaml")), FileError);
 }
