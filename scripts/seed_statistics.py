@@ -94,8 +94,14 @@ class Summary:
 
 
 def seed_range(text):
-    first, _, last = text.partition("-")
-    seeds = range(int(first), int(last or first) + 1)
+    """'0-99', '1,17,19' or both ('0-4,9'): the seeds in the order given."""
+    seeds = []
+    try:
+        for part in text.split(","):
+            first, _, last = part.strip().partition("-")
+            seeds.extend(range(int(first), int(last or first) + 1))
+    except ValueError:
+        raise argparse.ArgumentTypeError("%s is not a list of seeds such as 0-99 or 1,17,19" % text)
     if not seeds:
         raise argparse.ArgumentTypeError("%s is an empty range" % text)
     return seeds
@@ -201,7 +207,10 @@ def config_max_episodes(config):
 
 
 def describe_seeds(seeds):
-    return "%d-%d" % (seeds[0], seeds[-1]) if len(seeds) > 1 else "%d" % seeds[0]
+    """'0-9' for a run of consecutive seeds, else the list ('1,17,19')."""
+    if len(seeds) > 1 and list(seeds) == list(range(seeds[0], seeds[0] + len(seeds))):
+        return "%d-%d" % (seeds[0], seeds[-1])
+    return ",".join(str(seed) for seed in seeds)
 
 
 def print_summary(summary, seeds, timing_note):

@@ -4,7 +4,7 @@
 table it saved, the wall time, and the suite's per-case counts; then the median and worst seed
 of each column. The figures of docs/robust_tables.md come from one run of it:
 
-  python3 tools/robust_seeds.py --config config/robust.yaml --seeds 0-19
+  python3 tools/robust_seeds.py --config config/robust.yaml --seeds 0-19   (or --seeds 1,17,19)
 
 train_headless is found on PATH, else by catkin_find (source devel/setup.bash), or given with
 --train-headless.
@@ -20,8 +20,17 @@ import time
 
 
 def seeds(text):
-    low, _, high = text.partition('-')
-    return range(int(low), int(high or low) + 1)
+    """'0-19', '1,17,19' or both ('0-4,9'): the seeds in the order given."""
+    chosen = []
+    try:
+        for part in text.split(','):
+            low, _, high = part.strip().partition('-')
+            chosen.extend(range(int(low), int(high or low) + 1))
+    except ValueError:
+        raise argparse.ArgumentTypeError("%s is not a list of seeds such as 0-19 or 1,17,19" % text)
+    if not chosen:
+        raise argparse.ArgumentTypeError("%s names no seed" % text)
+    return chosen
 
 
 def find_train_headless():
