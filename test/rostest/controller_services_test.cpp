@@ -2,7 +2,7 @@
 // services; a refused load answered as such, the live table unchanged and training going on;
 // bad joint_states dropped; a silent sim reported. What a service decides (paths that escape the
 // table folder, bad files of every kind, which table a load leaves) is RunApplicationTest's,
-// FileAccessTest's and QTableFileTest's (core_tests).
+// FileAccessTest's and QTableFileTest's (application_tests, io_tests, learning_tests).
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/LoadQTable.h"
 #include "cartpole_qlearning/SaveQTable.h"

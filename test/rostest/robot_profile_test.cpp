@@ -1,4 +1,4 @@
-// A profile of config/robots/ on the graph, as a user runs it (test/robot_profile_*.test): the sim poses as that
+// A profile of config/robots/ on the graph, as a user runs it (test/rostest/robot_profile_*.test): the sim poses as that
 // cart-pole in lockstep; the controller started by robot.launch robot:=NAME (in the .test, with a table folder and
 // stop_when_solved) trains until solved; this node then runs `roslaunch cartpole_qlearning robot.launch robot:=NAME
 // mode:=evaluate load:=q_table.yaml` against the same sim, as the user's next command, and reads its verdict.

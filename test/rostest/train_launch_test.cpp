@@ -3,7 +3,7 @@
 // table written in its namespace's folder under ROS_HOME; kill -9 of the sim, of the controller
 // or of the nodelet manager does not end training: the node respawns and the controller goes on
 // from its run's last checkpoint. What the run decides (which save replaces the default table,
-// run folders, the record, the curve of a resumed run) is RunApplicationTest's (core_tests).
+// run folders, the record, the curve of a resumed run) is RunApplicationTest's (application_tests).
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
 #include "cartpole_qlearning/application/training_run.h"
