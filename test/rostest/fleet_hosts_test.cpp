@@ -90,11 +90,3 @@ TEST(FleetHosts, TheLearnerGoesOnWithoutALostRobotAndTakesItBack)
       spinUntil([&] { return episodes[0] > after[0] && episodes[1] > after[1] && episodes[2] > after[2]; }, 30.0))
       << "not all three robots train together again";
 }
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "fleet_hosts_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}

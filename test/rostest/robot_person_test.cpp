@@ -143,11 +143,3 @@ TEST(RobotPerson, EpisodesStartWhenThePersonStandsThePoleUpAndTheGapsTeachNothin
   EXPECT_EQ(episode_steps, table.steps) << "steps were learnt outside the episodes";
   EXPECT_EQ(stats.size(), table.episodes);
 }
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "robot_person_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}

@@ -8,6 +8,7 @@
 #include "cartpole_qlearning/learning/q_table_file.h"
 #include "cartpole_qlearning/application/training_run.h"
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -32,9 +33,12 @@ using cartpole_qlearning::test::spinUntil;
 
 namespace
 {
+const cartpole_qlearning::test::ScratchFolder kRosHome("ros_home",
+                                                       cartpole_qlearning::test::ScratchFolder::Make::beforeTheTests);
+
 std::string rosHome()
 {
-  return cartpole_qlearning::test::privateParam("ros_home");
+  return kRosHome.path();
 }
 
 // train.launch ARGS with this test's ROS_HOME, its output in ROS_HOME/NAME.log.
@@ -192,14 +196,3 @@ TEST(TrainLaunch, Kill9OfTheNodeletManagerDoesNotEndTraining)
 }
 
 }  // namespace
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "train_launch_test");
-  ros::NodeHandle nh;
-  fs::create_directories(rosHome());
-  const int result = RUN_ALL_TESTS();
-  fs::remove_all(rosHome());
-  return result;
-}

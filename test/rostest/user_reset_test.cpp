@@ -165,11 +165,3 @@ TEST(UserReset, EveryStepIsThePhysicsOfTheStateItsCommandWasStampedWith)
   EXPECT_EQ(0u, wrong) << wrong << " of " << checked
                        << " steps do not follow from their command: " << first_wrong.str();
 }
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "user_reset_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}
