@@ -7,6 +7,7 @@
 #include "cartpole_qlearning/EpisodeStats.h"
 
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -26,6 +27,8 @@ using cartpole_qlearning::test::uriOf;
 
 namespace
 {
+// The controller's table folder, which the .test file gives this node too.
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
 constexpr std::size_t kRobots = 3;
 
 ChildProcess startSim(std::size_t robot)

@@ -7,6 +7,7 @@
 #include "cartpole_qlearning/Reset.h"
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
 #include "ros_test_support.h"
+#include "rostest_main.h"
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -26,6 +27,8 @@ using cartpole_qlearning::test::spinUntil;
 
 namespace
 {
+// The controller's table folder, which the .test file gives this node too.
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
 constexpr std::uint64_t kTauNs = 20000000;  // config/cartpole.yaml: tau 0.02 s
 constexpr double kTolerance = 1e-9;
 
