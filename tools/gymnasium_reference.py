@@ -3,7 +3,7 @@
 
 The step below follows gymnasium/envs/classic_control/cartpole.py (CartPole-v1) operation for
 operation, in plain Python floats (IEEE double, as the state is held there), so the test
-test/cartpole_dynamics_test.cpp can compare the core against it without Gymnasium installed.
+test/unit/simulation/cartpole_dynamics_test.cpp can compare the core against it without Gymnasium installed.
 Run: tools/gymnasium_reference.py  (prints C++ initialisers)
 """
 import math

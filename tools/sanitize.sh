@@ -71,7 +71,7 @@ FLAGS="-O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefin
 # run four robot profiles and config/robust.yaml each train to solved; here they would go over
 # code that robot_profile_isaac, robot_group_command, robot_position_only, decision_period,
 # time_back, zero_effort* (Float64 commands, another state rate, offsets and signs, resets that
-# set time back) and core_tests (RunApplication: the suite judged during training, the best
+# set time back) and application_tests (RunApplication: the suite judged during training, the best
 # table kept) already take under the sanitizers, for minutes of CI's time.
 ARGS=(--build "$BUILD" -DCATKIN_DEVEL_PREFIX="$DEVEL" -DCMAKE_BUILD_TYPE=Sanitize "-DCMAKE_CXX_FLAGS=$FLAGS"
   -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE -DCARTPOLE_QLEARNING_LONG_TRAININGS=OFF)

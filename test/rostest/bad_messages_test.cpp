@@ -27,6 +27,7 @@
 #include "cartpole_qlearning/learning/q_table_file.h"
 
 #include "ros_test_support.h"
+#include "rostest_main.h"
 
 #include <gtest/gtest.h>
 #include <ros/callback_queue.h>
@@ -429,9 +430,11 @@ struct Delivery
   }
 };
 
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
+
 std::string tableDir()
 {
-  return cartpole_qlearning::test::privateParam("q_table_dir");
+  return kTableDir.path();
 }
 
 // Saves the controller's table through its service and loads it back with the core's loader.
@@ -927,14 +930,3 @@ TEST_F(BadMessagesTest, FloodAtTenTimesTheStepRate)
   expectHealthyAfter("flood", window, before, to_controller.sent, to_sim.sent);
 }
 }  // namespace
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "bad_messages_test");
-  ros::NodeHandle keep_node_up;
-  const int result = RUN_ALL_TESTS();
-  std::error_code ignored;
-  fs::remove_all(tableDir(), ignored);
-  return result;
-}

@@ -2,13 +2,14 @@
 // services; a refused load answered as such, the live table unchanged and training going on;
 // bad joint_states dropped; a silent sim reported. What a service decides (paths that escape the
 // table folder, bad files of every kind, which table a load leaves) is RunApplicationTest's,
-// FileAccessTest's and QTableFileTest's (core_tests).
+// FileAccessTest's and QTableFileTest's (application_tests, io_tests, learning_tests).
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/LoadQTable.h"
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
 
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -32,11 +33,11 @@ using cartpole_qlearning::test::spinUntil;
 
 namespace
 {
+const cartpole_qlearning::test::ScratchFolder kRoot("root");
+
 std::string root()
 {
-  std::string dir;
-  ros::param::get("~root", dir);
-  return dir;
+  return kRoot.path();
 }
 
 SaveQTable::Response save(const std::string& ns, const std::string& path)
@@ -277,14 +278,4 @@ TEST(ControllerServices, EachStateIsAnsweredWithItsOwnStampAndLearntFromOnce)
   ASSERT_TRUE(spinUntil([&] { return commands.size() == 4; }, 10.0)) << "the next state was not answered";
   EXPECT_EQ(ros::Time(100.02), commands.back().header.stamp);
   EXPECT_EQ(learnt + 1, steps("next_after.yaml")) << "the transition into the new state was not learnt once";
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "controller_services_test");
-  ros::NodeHandle nh;
-  const int result = RUN_ALL_TESTS();
-  fs::remove_all(root());
-  return result;
 }

@@ -3,6 +3,7 @@
 // the tutorial's arithmetic (new = old + alpha * (target - old), target = r + gamma * max
 // Q(next) unless the pole fell), and a table, equal to what the updates logged, ends each episode.
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 #include "trace_check.h"
 
@@ -18,9 +19,11 @@ using cartpole_qlearning::test::TraceReading;
 
 namespace
 {
+const cartpole_qlearning::test::ScratchFolder kRosHome("ros_home");
+
 std::string rosHome()
 {
-  return cartpole_qlearning::test::privateParam("ros_home");
+  return kRosHome.path();
 }
 
 // roslaunch train.launch ARGS to its end (at most 90 s; then Ctrl-C); its output, nodes included.
@@ -76,9 +79,4 @@ TEST(ControllerTrace, NoTraceUnlessAskedFor)
   const TraceReading trace(out, kTutorialNames);
   EXPECT_TRUE(trace.updates.empty()) << out;
   EXPECT_TRUE(trace.tables.empty()) << out;
-}
-
-int main(int argc, char** argv)
-{
-  return cartpole_qlearning::test::runTestsRemovingRosHome(argc, argv, "controller_trace_test");
 }

@@ -6,6 +6,7 @@
 #include "cartpole_qlearning/learning/q_table_file.h"
 
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -30,11 +31,11 @@ using cartpole_qlearning::test::spinUntil;
 
 namespace
 {
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
+
 std::string qTableDir()
 {
-  std::string dir;
-  ros::param::get("~q_table_dir", dir);
-  return dir;
+  return kTableDir.path();
 }
 
 // The config file loaded over cartpole.yaml in the controller's namespace.
@@ -155,14 +156,4 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
   ASSERT_TRUE(balanced) << "the evaluator ran " << stats_.size() - before << " episodes, none of 500 steps";
   for (std::size_t i = before; i < stats_.size(); ++i)
     EXPECT_EQ(0.0, stats_[i].epsilon) << "evaluation must be greedy";
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "controller_train_test");
-  ros::NodeHandle nh;
-  const int result = RUN_ALL_TESTS();
-  fs::remove_all(qTableDir());
-  return result;
 }

@@ -23,7 +23,7 @@ import numpy
 from PIL import Image
 
 PACKAGE = "cartpole_qlearning"
-PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PLOT_POLICY = os.path.join(PACKAGE_DIR, "scripts", "plot_policy")
 # docs/images/policy_*.png and nodes.png were drawn with Debian 12's matplotlib (CI's); another version lays
 # text out otherwise, so only there must the committed pictures be the bytes drawn now.

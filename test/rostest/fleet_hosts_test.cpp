@@ -7,6 +7,7 @@
 #include "cartpole_qlearning/EpisodeStats.h"
 
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -26,6 +27,8 @@ using cartpole_qlearning::test::uriOf;
 
 namespace
 {
+// The controller's table folder, which the .test file gives this node too.
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
 constexpr std::size_t kRobots = 3;
 
 ChildProcess startSim(std::size_t robot)
@@ -89,12 +92,4 @@ TEST(FleetHosts, TheLearnerGoesOnWithoutALostRobotAndTakesItBack)
   EXPECT_TRUE(
       spinUntil([&] { return episodes[0] > after[0] && episodes[1] > after[1] && episodes[2] > after[2]; }, 30.0))
       << "not all three robots train together again";
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "fleet_hosts_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
 }

@@ -14,6 +14,7 @@
 #include "cartpole_qlearning/ros/reset_caller.h"
 
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -47,6 +48,7 @@ namespace fs = std::filesystem;
 namespace
 {
 constexpr std::size_t kRobots = 3;
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
 const char* const kHungService = "/hung_reset/robot_1/cartpole_sim/reset";
 const char* const kRealService = "/hung_reset/robot_1/real_sim/reset";
 const char* const kCallerService = "/hung_reset/caller_test/reset";
@@ -221,7 +223,7 @@ TEST(HungReset, AHungResetHoldsUpOnlyItsRobotAndCtrlCStillSaves)
             << " s after Ctrl-C, with a reset call hanging\n";
   bool saved = false;
   std::error_code error;
-  const fs::path runs = fs::path(privateParam("q_table_dir")) / "runs";
+  const fs::path runs = fs::path(kTableDir.path()) / "runs";
   for (const auto& run : fs::directory_iterator(runs, error))
     saved = saved || fs::exists(run.path() / "q_table.yaml");
   EXPECT_TRUE(saved) << "no table saved on shutdown under " << runs;
@@ -273,14 +275,4 @@ TEST(HungReset, ResetCallerGivesAHungCallUpOnANewThreadAndDoesNotWaitForItAtTheE
   service.release();
   EXPECT_TRUE(spinUntil([&] { return service.hangsOver() == 3; }, 5.0));
   ros::WallDuration(0.2).sleep();
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "hung_reset_test");
-  ros::NodeHandle nh;
-  const int result = RUN_ALL_TESTS();
-  fs::remove_all(privateParam("q_table_dir"));
-  return result;
 }

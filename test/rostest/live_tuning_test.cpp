@@ -195,11 +195,3 @@ TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume
   stats_sub.shutdown();
   log_sub.shutdown();
 }
-
-int main(int argc, char** argv)
-{
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "live_tuning_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}

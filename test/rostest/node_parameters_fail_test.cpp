@@ -229,10 +229,3 @@ TEST_F(NodeParametersTest, ControllerRefusesAStatsCsvThatCannotBeOpened)
   EXPECT_FALSE(fs::exists(dir_ / "runs")) << "a refused controller started a run";
 }
 }  // namespace
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "node_parameters_fail_test");
-  return RUN_ALL_TESTS();
-}

@@ -4,6 +4,7 @@
 #include "cartpole_qlearning/Reset.h"
 
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -17,11 +18,16 @@ namespace fs = std::filesystem;
 using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::spinUntil;
 
+namespace
+{
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
+}  // namespace
+
 TEST(Nodelets, TrainingOnOneWorkerThreadSolvesWithTheHeadlessTable)
 {
   ros::NodeHandle nh;
-  std::string dir;
-  ASSERT_TRUE(ros::param::get("~q_table_dir", dir));
+  const std::string dir = kTableDir.path();
+  ASSERT_FALSE(dir.empty()) << "no ~q_table_dir";
   // Training there takes well under a second, maybe less than this node needs to subscribe to
   // episode_stats: what is awaited is the final table, which must be train_headless's.
   const std::string headless = dir + "/headless.yaml";
@@ -40,16 +46,4 @@ TEST(Nodelets, TrainingOnOneWorkerThreadSolvesWithTheHeadlessTable)
   cartpole_qlearning::Reset reset;
   EXPECT_TRUE(ros::service::call("/cartpole/cartpole_sim/reset", reset)) << "the manager ended with the training";
   EXPECT_TRUE(reset.response.success) << reset.response.message;
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "nodelets_test");
-  ros::NodeHandle nh;
-  const int result = RUN_ALL_TESTS();
-  std::string dir;
-  if (ros::param::get("~q_table_dir", dir))
-    fs::remove_all(dir);
-  return result;
 }

@@ -4,6 +4,7 @@
 // train_headless's table byte for byte; and evaluate.launch suite_case:=NAME poses as that case of
 // a suite and gives the verdict train_headless --evaluate TABLE --suite FILE gives for it.
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 #include "text_match.h"
 
@@ -25,9 +26,12 @@ namespace
 {
 const std::string kTestDir = CARTPOLE_SOURCE_DIR "/test/data";
 
+const cartpole_qlearning::test::ScratchFolder kRosHome("ros_home",
+                                                       cartpole_qlearning::test::ScratchFolder::Make::beforeTheTests);
+
 std::string rosHome()
 {
-  return cartpole_qlearning::test::privateParam("ros_home");
+  return kRosHome.path();
 }
 
 // train_headless ARGS with ROS_HOME at `home`.
@@ -101,15 +105,4 @@ TEST(PerturbedGraph, EvaluateLaunchPosingAsASuiteCaseGivesTheHeadlessVerdict)
   // episodes that agree are of both kinds.
   EXPECT_LT(std::stoul(row[1]), 20u);
   EXPECT_GT(std::stoul(row[1]), 0u);
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "perturbed_graph_test");
-  ros::NodeHandle nh;
-  fs::create_directories(rosHome());
-  const int result = RUN_ALL_TESTS();
-  fs::remove_all(rosHome());
-  return result;
 }

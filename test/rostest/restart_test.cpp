@@ -4,6 +4,7 @@
 // node (this test) subscribes to joint_command: nothing may depend on who listens.
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -25,9 +26,11 @@ using cartpole_qlearning::test::spinUntil;
 
 namespace
 {
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
+
 std::string tableDir()
 {
-  return cartpole_qlearning::test::privateParam("q_table_dir");
+  return kTableDir.path();
 }
 }  // namespace
 
@@ -87,14 +90,4 @@ TEST(Restart, TrainingGoesOnAfterTheSimAndTheControllerRestart)
 
   controller.stop(SIGINT);
   sim.stop(SIGINT);
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "restart_test");
-  ros::NodeHandle nh;
-  const int result = RUN_ALL_TESTS();
-  std::filesystem::remove_all(tableDir());
-  return result;
 }

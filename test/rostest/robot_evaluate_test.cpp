@@ -5,6 +5,7 @@
 // wrong_args and max_return: the same evaluation with those arguments added (a setting of the robot left out) must
 // stay below max_return, so that the first result is the setting's doing.
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 #include "text_match.h"
 
@@ -22,6 +23,7 @@ namespace text_match = cartpole_qlearning::test::text_match;
 
 namespace
 {
+const cartpole_qlearning::test::ScratchFolder kRosHome("ros_home");
 // A number the .test file must set: a missing one fails the test (NaN fails every comparison).
 double numberParam(const std::string& name)
 {
@@ -57,7 +59,7 @@ double evaluate(const std::string& home, const std::string& name, const std::str
 
 TEST(RobotEvaluate, TheHeadlessTableKeepsThePoleUpOnThePosedRobotAndNotWithoutItsSetting)
 {
-  const std::string home = privateParam("ros_home");
+  const std::string home = kRosHome.path();
   ASSERT_FALSE(home.empty());
   std::filesystem::create_directories(home);
   const auto trained =
@@ -71,9 +73,4 @@ TEST(RobotEvaluate, TheHeadlessTableKeepsThePoleUpOnThePosedRobotAndNotWithoutIt
   {
     EXPECT_LT(evaluate(home, "setting_left_out", args + " " + privateParam("wrong_args")), numberParam("max_return"));
   }
-}
-
-int main(int argc, char** argv)
-{
-  return cartpole_qlearning::test::runTestsRemovingRosHome(argc, argv, "robot_evaluate_test");
 }

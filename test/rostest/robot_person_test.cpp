@@ -9,6 +9,7 @@
 #include "cartpole_qlearning/learning/cartpole_task.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
 #include "ros_test_support.h"
+#include "rostest_main.h"
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -20,6 +21,12 @@
 
 using namespace cartpole_qlearning;
 using cartpole_qlearning::test::spinUntil;
+
+namespace
+{
+// The controller's table folder, which the .test file gives this node too.
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
+}  // namespace
 
 TEST(RobotPerson, EpisodesStartWhenThePersonStandsThePoleUpAndTheGapsTeachNothing)
 {
@@ -142,12 +149,4 @@ TEST(RobotPerson, EpisodesStartWhenThePersonStandsThePoleUpAndTheGapsTeachNothin
   }
   EXPECT_EQ(episode_steps, table.steps) << "steps were learnt outside the episodes";
   EXPECT_EQ(stats.size(), table.episodes);
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "robot_person_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
 }

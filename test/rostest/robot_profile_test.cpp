@@ -1,5 +1,5 @@
-// A profile of config/robots/ on the graph, as a user runs it (test/robot_profile_*.test): the sim poses as that
-// cart-pole in lockstep; the controller started by robot.launch robot:=NAME (in the .test, with a table folder and
+// A profile of config/robots/ on the graph, as a user runs it (test/rostest/robot_profile_*.test): the sim poses as
+// that cart-pole in lockstep; the controller started by robot.launch robot:=NAME (in the .test, with a table folder and
 // stop_when_solved) trains until solved; this node then runs `roslaunch cartpole_qlearning robot.launch robot:=NAME
 // mode:=evaluate load:=q_table.yaml` against the same sim, as the user's next command, and reads its verdict.
 // Private parameters: ros_home (the folder under which the training wrote its tables, ROS_HOME for the evaluation),
@@ -7,6 +7,7 @@
 // none over ROS).
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 #include "text_match.h"
 
@@ -27,13 +28,14 @@ namespace text_match = cartpole_qlearning::test::text_match;
 
 namespace
 {
+const cartpole_qlearning::test::ScratchFolder kRosHome("ros_home");
 const std::string kController = "/cartpole/qlearning_controller";
 }  // namespace
 
 TEST(RobotProfile, TrainsUntilSolvedThenTheTableIsEvaluated)
 {
   const std::string robot = privateParam("robot");
-  const std::string home = privateParam("ros_home");
+  const std::string home = kRosHome.path();
   ASSERT_FALSE(robot.empty());
   ASSERT_FALSE(home.empty());
   ros::NodeHandle nh;
@@ -100,9 +102,4 @@ TEST(RobotProfile, TrainsUntilSolvedThenTheTableIsEvaluated)
   // A learnt table, not a random one (which falls within about 20 steps): the pole is held up for most of the
   // episodes' length on average.
   EXPECT_GE(returns / 10.0, 250.0) << output;
-}
-
-int main(int argc, char** argv)
-{
-  return cartpole_qlearning::test::runTestsRemovingRosHome(argc, argv, "robot_profile_test");
 }

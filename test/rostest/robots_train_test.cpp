@@ -5,6 +5,7 @@
 #include "cartpole_qlearning/EpisodeStats.h"
 
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -21,11 +22,16 @@ using cartpole_qlearning::EpisodeStatsConstPtr;
 using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::spinUntil;
 
+namespace
+{
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
+}  // namespace
+
 TEST(RobotsTrain, ThreeRobotsWriteTheHeadlessTableForThreeRobots)
 {
   ros::NodeHandle nh;
-  std::string dir;
-  ASSERT_TRUE(ros::param::get("~q_table_dir", dir));
+  const std::string dir = kTableDir.path();
+  ASSERT_FALSE(dir.empty()) << "no ~q_table_dir";
   std::vector<EpisodeStats> all;
   std::vector<std::vector<EpisodeStats>> per_robot(3);
   std::vector<ros::Subscriber> subs;
@@ -78,16 +84,4 @@ TEST(RobotsTrain, ThreeRobotsWriteTheHeadlessTableForThreeRobots)
   for (std::size_t i = 1; i < all.size(); ++i)
     EXPECT_EQ(all[i - 1].episode + 1, all[i].episode);
   EXPECT_EQ(all.back().episode, robotEpisodes()) << "the learner's episodes are not the robots' episodes together";
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "robots_train_test");
-  ros::NodeHandle nh;
-  const int result = RUN_ALL_TESTS();
-  std::string dir;
-  if (ros::param::get("~q_table_dir", dir))
-    fs::remove_all(dir);
-  return result;
 }

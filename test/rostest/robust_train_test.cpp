@@ -4,6 +4,7 @@
 #include "cartpole_qlearning/EpisodeStats.h"
 
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -19,10 +20,14 @@ using cartpole_qlearning::EpisodeStats;
 using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::spinUntil;
 
+namespace
+{
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
+}  // namespace
+
 TEST(RobustTrain, TrainsOnTheGraphToAPassingTableThatIsTrainHeadlesss)
 {
-  std::string dir;
-  ros::param::get("~q_table_dir", dir);
+  const std::string dir = kTableDir.path();
   std::vector<EpisodeStats> stats;
   ros::NodeHandle nh;
   ros::Subscriber sub =
@@ -46,12 +51,4 @@ TEST(RobustTrain, TrainsOnTheGraphToAPassingTableThatIsTrainHeadlesss)
   ASSERT_EQ(0, std::system(command.c_str())) << command;
   EXPECT_EQ(fileText(headless), fileText(trained)) << "train.launch (nodelets) and train_headless differ for seed 0";
   sub.shutdown();
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "robust_train_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
 }

@@ -211,11 +211,3 @@ TEST_F(SimBadInputTest, StaysUpAfterBadInput)
   EXPECT_TRUE(spinUntil([&] { return states_.size() >= count + 20; })) << "joint_states stopped";
 }
 }  // namespace
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "sim_bad_input_test");
-  ros::NodeHandle keep_node_up;  // the fixtures' handles come and go; the node stays started
-  return RUN_ALL_TESTS();
-}

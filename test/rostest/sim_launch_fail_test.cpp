@@ -28,11 +28,3 @@ TEST(SimLaunchFail, ABadParameterStopsTheSimAGoodOneDoesNot)
   EXPECT_FALSE(ros::service::exists("/ko/cartpole_sim/reset", false)) << "the sim with ~mode warp serves ~reset";
   EXPECT_EQ(0, ko_states) << "the sim with ~mode warp publishes joint_states";
 }
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "sim_launch_fail_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}

@@ -527,11 +527,3 @@ TEST_F(SimLockstepRepeatTest, AnUnansweredStateIsPublishedAgainUnchangedAndOneAn
   }
 }
 }  // namespace
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "sim_lockstep_test");
-  ros::NodeHandle keep_node_up;  // the fixtures' handles come and go; the node stays started
-  return RUN_ALL_TESTS();
-}

@@ -113,11 +113,3 @@ TEST_F(SimRealtimeTest, TfAtAJointStateStampMatchesThatState)
   EXPECT_NEAR(std::cos(theta / 2.0), sign * q.w, 1e-9);
 }
 }  // namespace
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "sim_realtime_test");
-  ros::NodeHandle keep_node_up;  // the fixtures' handles come and go; the node stays started
-  return RUN_ALL_TESTS();
-}

@@ -3,11 +3,12 @@
 // table written in its namespace's folder under ROS_HOME; kill -9 of the sim, of the controller
 // or of the nodelet manager does not end training: the node respawns and the controller goes on
 // from its run's last checkpoint. What the run decides (which save replaces the default table,
-// run folders, the record, the curve of a resumed run) is RunApplicationTest's (core_tests).
+// run folders, the record, the curve of a resumed run) is RunApplicationTest's (application_tests).
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
 #include "cartpole_qlearning/application/training_run.h"
 #include "ros_test_support.h"
+#include "rostest_main.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -32,9 +33,12 @@ using cartpole_qlearning::test::spinUntil;
 
 namespace
 {
+const cartpole_qlearning::test::ScratchFolder kRosHome("ros_home",
+                                                       cartpole_qlearning::test::ScratchFolder::Make::beforeTheTests);
+
 std::string rosHome()
 {
-  return cartpole_qlearning::test::privateParam("ros_home");
+  return kRosHome.path();
 }
 
 // train.launch ARGS with this test's ROS_HOME, its output in ROS_HOME/NAME.log.
@@ -192,14 +196,3 @@ TEST(TrainLaunch, Kill9OfTheNodeletManagerDoesNotEndTraining)
 }
 
 }  // namespace
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "train_launch_test");
-  ros::NodeHandle nh;
-  fs::create_directories(rosHome());
-  const int result = RUN_ALL_TESTS();
-  fs::remove_all(rosHome());
-  return result;
-}

@@ -7,6 +7,7 @@
 #include "cartpole_qlearning/Reset.h"
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
 #include "ros_test_support.h"
+#include "rostest_main.h"
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -26,6 +27,8 @@ using cartpole_qlearning::test::spinUntil;
 
 namespace
 {
+// The controller's table folder, which the .test file gives this node too.
+const cartpole_qlearning::test::ScratchFolder kTableDir("q_table_dir");
 constexpr std::uint64_t kTauNs = 20000000;  // config/cartpole.yaml: tau 0.02 s
 constexpr double kTolerance = 1e-9;
 
@@ -164,12 +167,4 @@ TEST(UserReset, EveryStepIsThePhysicsOfTheStateItsCommandWasStampedWith)
   EXPECT_GE(resets_seen, static_cast<std::size_t>(user_resets)) << "the user's resets did not all show";
   EXPECT_EQ(0u, wrong) << wrong << " of " << checked
                        << " steps do not follow from their command: " << first_wrong.str();
-}
-
-int main(int argc, char** argv)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "user_reset_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
 }

@@ -64,8 +64,9 @@ class ZeroEffortTest(unittest.TestCase):
 
     def test_zero_after_states_stop_and_after_the_signal(self):
         stopped = self.pushing_then_stop()
-        # ~sim_timeout is 1 s here: zero comes after it, and nothing after the zero.
-        self.assertTrue(self.wait_for(lambda c: c[-1][1] == 0.0 and c[-1][0] > stopped + 0.5, 4.0),
+        # ~sim_timeout is 1 s here: zero comes after it, and nothing after the zero. (30 s bounds a
+        # broken run only: the zero is awaited, and a loaded machine may be late with it.)
+        self.assertTrue(self.wait_for(lambda c: c[-1][1] == 0.0 and c[-1][0] > stopped + 0.5, 30.0),
                         "no zero after the states stopped")
 
         self.pushing_then_stop()

@@ -24,20 +24,6 @@ inline std::string privateParam(const std::string& name)
   return value;
 }
 
-// main() of a test node whose .test file gives it a scratch ~ros_home for the launches it
-// starts: runs the tests as node `name`, then removes that folder.
-inline int runTestsRemovingRosHome(int argc, char** argv, const char* name)
-{
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, name);
-  ros::NodeHandle nh;
-  const int result = RUN_ALL_TESTS();
-  const std::string home = privateParam("ros_home");
-  if (!home.empty())
-    std::filesystem::remove_all(home);
-  return result;
-}
-
 // Spins the global callback queue until done() holds or the wall-clock timeout passes (wall
 // clock: in lockstep, ROS time is the sim's and may stand still).
 inline bool spinUntil(const std::function<bool()>& done, double timeout_s)
