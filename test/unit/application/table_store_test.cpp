@@ -89,7 +89,7 @@ TEST_F(TableStoreTest, AServicesPathStaysInTheFolderWhateverTheUserMay)
   const std::string mine = (outside_ / "mine.yaml").string();
   const TableStore tables(dir_.string(), mine, AbsolutePaths::AreTheUsersFiles);
   EXPECT_THROW(tables.resolveForService((outside_ / "other.yaml").string()), FileError);
-  for (const std::string path : {(outside_ / "other.yaml").string(), std::string("../other.yaml")})
+  for (const std::string& path : {(outside_ / "other.yaml").string(), std::string("../other.yaml")})
   {
     const ServiceAnswer saved = tables.serveSave(table(1), path);
     EXPECT_FALSE(saved.success) << path;
