@@ -155,7 +155,7 @@ void LearningCurve::open(std::uint64_t episodes, LogLines& log)
 {
   if (!opened_)
   {
-    // The run's own file: beside its checkpoints.
+    // The run folder's file: beside its checkpoints.
     try
     {
       if (waiting_for_folder_)

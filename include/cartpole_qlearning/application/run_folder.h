@@ -46,11 +46,11 @@ struct RunRecord
   std::vector<double> recent_returns;  // the solved window at the checkpoint, oldest first
   std::string finished;                // "" while the run goes on; "solved", "suite_passed" or "max_episodes"
   // What the final table is worth: the robustness suite's one-line summary (robustness_suite.h),
-  // written when training ends ("": not judged).
+  // written when training ends ("": not evaluated).
   std::string robustness;
-  // The best table the suite has judged so far (kRunBestTableFile beside the record, saved before
-  // it): the episode it was judged at (0: none yet), its worst case's balanced episodes and the
-  // suite's summary of it. What the user reads; a resumed run judges that file again.
+  // The best table the suite has seen so far (kRunBestTableFile beside the record, saved before
+  // it): the episode it was evaluated at (0: none yet), its worst case's balanced episodes and the
+  // suite's summary of it. What the user reads; a resumed run evaluates that file again.
   std::uint64_t best_episode = 0;
   std::uint64_t best_worst_balanced = 0;
   std::string best_robustness;
@@ -81,7 +81,7 @@ struct BestTable
 {
   QTable table;
   SuiteResult result;
-  std::uint64_t episode = 0;  // the episode it was judged at
+  std::uint64_t episode = 0;  // the episode it was evaluated at
 };
 
 // How a run found its folder at the start.
