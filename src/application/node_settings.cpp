@@ -1,7 +1,6 @@
 #include "cartpole_qlearning/application/node_settings.h"
 
 #include "cartpole_qlearning/io/file_access.h"
-#include "cartpole_qlearning/application/headless_trainer.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
 
@@ -198,6 +197,16 @@ void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& r
   priv.readSeconds("decision_period", robot.decision_period, 0.0, 1.0, false);
 }
 }  // namespace
+
+std::vector<std::string> robotNamespaces(std::size_t count)
+{
+  if (count == 1)
+    return {""};
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < count; ++i)
+    names.push_back("robot_" + std::to_string(i));
+  return names;
+}
 
 ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& source,
                                           const ControllerContext& context)

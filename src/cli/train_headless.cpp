@@ -12,7 +12,8 @@
 #include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/application/run_application.h"
 #include "cartpole_qlearning/learning/trace.h"
-#include "cartpole_qlearning/application/training_run.h"
+#include "cartpole_qlearning/application/run_folder.h"
+#include "cartpole_qlearning/application/table_store.h"
 #include "cartpole_qlearning/learning/transition_replay.h"
 
 #include <ros/package.h>
@@ -159,20 +160,11 @@ bool say(const cartpole_qlearning::LogLines& log, bool quiet)
   return error;
 }
 
-// A table for the services' path rule: an absolute path is the user's own, a relative one under
-// the table folder.
-void saveTable(const cartpole_qlearning::QTable& table, const std::string& table_dir, const std::string& path)
+// Tables as the command line names them: an absolute path is the user's own, a relative one
+// under the table folder.
+cartpole_qlearning::TableStore commandLineTables(const std::string& table_dir)
 {
-  if (path.front() == '/')
-    cartpole_qlearning::saveQTableFile(table, path);
-  else
-    cartpole_qlearning::saveQTableUnder(table, table_dir, path);
-}
-// The same path rule for reading a table.
-cartpole_qlearning::QTable loadTable(const std::string& table_dir, const std::string& path)
-{
-  return path.front() == '/' ? cartpole_qlearning::loadQTableFile(path)
-                             : cartpole_qlearning::loadQTableUnder(table_dir, path);
+  return cartpole_qlearning::TableStore(table_dir, "", cartpole_qlearning::AbsolutePaths::AreTheUsersFiles);
 }
 // --evaluate TABLE --suite FILE: every case of the suite, greedily; exit 0 when it ran (the verdict
 // is in the last line), 2 on a bad suite, table or configuration.
@@ -196,7 +188,7 @@ int runSuite(const cartpole_qlearning::TrainingConfig& config, const std::string
   SuiteResult result;
   try
   {
-    const QTable table = loadTable(table_dir, table_path);
+    const QTable table = commandLineTables(table_dir).load(table_path);
     result = cartpole_qlearning::evaluateSuite(table, config, suite);
   }
   catch (const std::runtime_error& e)  // FileError, ConfigError: the table cannot be read or does not fit
@@ -267,7 +259,7 @@ int printPolicy(const std::string& table_path, const std::string& table_dir, std
   QTable table;
   try
   {
-    table = loadTable(table_dir, table_path);
+    table = commandLineTables(table_dir).load(table_path);
   }
   catch (const FileError& e)
   {
@@ -586,10 +578,9 @@ int run(int argc, char** argv)
       return 0;
     try
     {
-      saveTable(agent.table(), table_dir, save_path);
+      commandLineTables(table_dir).save(agent.table(), save_path);
       if (!quiet)
-        std::printf("saved the Q-table to %s\n",
-                    save_path.front() == '/' ? save_path.c_str() : resolvePathUnder(table_dir, save_path).c_str());
+        std::printf("saved the Q-table to %s\n", commandLineTables(table_dir).resolve(save_path).c_str());
     }
     catch (const FileError& e)
     {
@@ -629,7 +620,7 @@ int run(int argc, char** argv)
           !resume_folder.empty()
               ? (resumed.finished.empty() ? loadQTableUnder(table_dir, resume_folder + "/" + kRunTableFile).episodes
                                           : 0)
-              : loadTable(table_dir, load_path).episodes;
+              : commandLineTables(table_dir).load(load_path).episodes;
     }
     catch (const FileError&)
     {

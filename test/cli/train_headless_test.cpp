@@ -5,7 +5,7 @@
 #include "cartpole_qlearning/learning/policy_grid.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
-#include "cartpole_qlearning/application/training_run.h"
+#include "cartpole_qlearning/application/run_folder.h"
 
 #include "test_support.h"
 #include "trace_check.h"

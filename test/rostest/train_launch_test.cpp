@@ -6,7 +6,7 @@
 // run folders, the record, the curve of a resumed run) is RunApplicationTest's (application_tests).
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
-#include "cartpole_qlearning/application/training_run.h"
+#include "cartpole_qlearning/application/run_folder.h"
 #include "ros_test_support.h"
 #include "rostest_main.h"
 #include "test_support.h"

@@ -41,19 +41,6 @@ inline std::uint64_t robotSeed(std::uint64_t seed, std::size_t robot)
   return seed + robot;
 }
 
-// The namespaces of `count` robots relative to the learner's: its own ("") for one, robot_0 ...
-// robot_<count-1> for more. train.launch robots:=N starts its sims there
-// (launch/include/robot_sims.launch spells the rule again: roslaunch cannot call this).
-inline std::vector<std::string> robotNamespaces(std::size_t count)
-{
-  if (count == 1)
-    return {""};
-  std::vector<std::string> names;
-  for (std::size_t i = 0; i < count; ++i)
-    names.push_back("robot_" + std::to_string(i));
-  return names;
-}
-
 class HeadlessTrainer
 {
 public:

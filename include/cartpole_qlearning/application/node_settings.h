@@ -15,6 +15,12 @@
 
 namespace cartpole_qlearning
 {
+// The namespaces of `count` robots relative to the learner's (~robots: N): its own ("") for one,
+// robot_0 ... robot_<count-1> for more. train.launch robots:=N starts its sims there
+// (launch/include/robot_sims.launch spells the rule again: roslaunch cannot call this), and
+// train_headless --robots N names its robots so.
+std::vector<std::string> robotNamespaces(std::size_t count);
+
 // What the application around the learner needs (run_application.h): the controller node fills
 // it from its private parameters, train_headless from its command line.
 struct RunSettings

@@ -1,32 +1,35 @@
-// The application around the learner: one training or evaluation run. It owns what a run
-// writes and decides: the table folder and the default table, the run's folder and record,
-// checkpoints and their cadence, the robustness suite (training/suite: run greedily on a copy of
-// the table every training/suite_every episodes, keeping the best table seen, ending training
-// when it passes under training/until suite_passes, and always on the table a run saves), the resume of a respawned
-// controller (or of `train_headless
-// --resume`), the per-episode CSV, which save replaces the default table, the save on shutdown,
-// the evaluation verdict, progress lines and their rates. It returns what to say as values (as
-// ControllerProtocol returns a Reaction), with its clocks injected, so that the controller node
-// and train_headless carry out the same decisions and every decision is a unit test.
-//
-// The controller node logs what it says on its named logger; train_headless prints it.
+// The application around the learner: one training or evaluation run, as the controller node
+// and train_headless carry it out. It puts the parts together and decides what happens at each
+// moment of a run: at the start (the table of ~load_on_start, a new run or the respawn of one), at
+// each episode's end (the curve's row, the suite, the end of training and its saves, checkpoints,
+// progress, the evaluation's verdict), on the services and on shutdown. The parts:
+//   TableStore       the table folder, the default table and the path rule; the services' answers
+//   RunFolder        the run's folder: its name, record, checkpoints, respawn and resume
+//   LearningCurve    one CSV row per episode
+//   BestTableKeeper  the robustness suite during training and the best table it has seen
+//   RunMeters        rates, progress lines, the evaluation's verdict
+// It returns what to say as values (as ControllerProtocol returns a Reaction), with its clocks
+// injected, so that the node and train_headless carry out the same decisions and every decision
+// is a unit test. The controller node logs what it says on its named logger; train_headless
+// prints it.
 #pragma once
 
-#include "cartpole_qlearning/learning/training_config.h"
-#include "cartpole_qlearning/application/episode_csv.h"
+#include "cartpole_qlearning/application/best_table_keeper.h"
+#include "cartpole_qlearning/application/learning_curve.h"
 #include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/application/run_folder.h"
+#include "cartpole_qlearning/application/run_meters.h"
+#include "cartpole_qlearning/application/table_store.h"
 #include "cartpole_qlearning/common/log_line.h"
-#include "cartpole_qlearning/application/training_run.h"
+#include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/learning/training_session.h"
 
 #include <chrono>
-#include <cstdint>
 #include <ctime>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <string>
-#include <vector>
 
 namespace cartpole_qlearning
 {
@@ -41,23 +44,6 @@ struct RunClocks
   };
   // Run folder names and the record's start time (local time).
   std::function<std::time_t()> calendar = [] { return std::time(nullptr); };
-};
-
-// What identifies a run to a respawn of the controller that started it (the node keeps it on
-// the parameter server as ~run/id, ~run/launcher, ~run/folder).
-struct RunIdentity
-{
-  std::string id;      // ~run_id ("": runs are not resumed)
-  int launcher = 0;    // the roslaunch (else the parent) process that started the run
-  std::string folder;  // relative to the table folder
-};
-
-// The greedy evaluation's outcome so far.
-struct EvaluationVerdict
-{
-  std::uint64_t episodes = 0;
-  std::uint64_t balanced = 0;  // reached the step limit without falling
-  double mean_return = 0.0;
 };
 
 // What the caller does after an episode's end.
@@ -79,26 +65,6 @@ struct EpisodeEnd
   std::string robustness;
 };
 
-// A service's answer (SaveQTable, LoadQTable): success and message, and what to log.
-struct ServiceAnswer
-{
-  bool success = false;
-  std::string message;
-  LogLines log;
-};
-
-// A setting the run cannot work with (a ~stats_csv that cannot be written): a ConfigError that
-// keeps the parameter's name (without "~"), its value and why, so that the node names the
-// parameter as it names its others. what(): "~NAME = VALUE is not allowed (WHY)".
-class RunSettingError : public ConfigError
-{
-public:
-  RunSettingError(const std::string& name, const std::string& value, const std::string& why);
-  std::string name;
-  std::string value;
-  std::string why;
-};
-
 class RunApplication
 {
 public:
@@ -110,8 +76,8 @@ public:
   RunApplication(const RunApplication&) = delete;
   RunApplication& operator=(const RunApplication&) = delete;
 
-  // Starts the run: the table of load_on_start, the CSV, the suite (training), and (training) this run's folder, or,
-  // when `previous` names this very run (same id and launcher: a respawn), goes on from its
+  // Starts the run: the table of load_on_start, the curve, the suite (training), and (training)
+  // this run's folder, or, when `previous` names this very run (same id and launcher: a respawn), goes on from its
   // checkpoint. launcher: this process's roslaunch (else parent) pid, 0 when not applicable
   // (train_headless). Throws ConfigError naming the parameter for what must stop the node: a
   // ~load_on_start table that cannot be used, a ~stats_csv that cannot be written (a
@@ -146,15 +112,15 @@ public:
   bool respawned() const;  // start() went on with a run a dead controller started
   bool finished() const;   // nothing left to do (a respawn of a finished run, training over, verdict given)
   EvaluationVerdict verdict() const;
-  // A path as the services and parameters take it, made absolute (throws QTableFileError when
+  // A path as the services take it, made absolute ("": the default table; throws FileError when
   // it escapes the table folder).
   std::string resolve(const std::string& path) const;
   const std::string& tableDirectory() const;
   const std::string& runFolder() const;  // "" when evaluating
 
 private:
-  struct State;
-  std::unique_ptr<State> state_;
+  struct Parts;
+  std::unique_ptr<Parts> parts_;
 };
 
 }  // namespace cartpole_qlearning

@@ -426,8 +426,8 @@ TEST_F(RunApplicationTest, TheCurveHasAHeaderAndOneRowPerEpisodeWithTheRobotAndT
   run.app->endEpisode("robot_1", false);
   const std::vector<std::string> rows = lines(dir_ / folderName() / "episodes.csv");
   ASSERT_EQ(2u, rows.size());
-  EXPECT_EQ(kEpisodeCsvHeader, rows[0]);
-  EXPECT_EQ(episodeCsvRow(run.session->lastEpisode(), "robot_1", 1000.25), rows[1]);
+  EXPECT_EQ(kLearningCurveHeader, rows[0]);
+  EXPECT_EQ(learningCurveRow(run.session->lastEpisode(), "robot_1", 1000.25), rows[1]);
 }
 
 TEST_F(RunApplicationTest, AStatsCsvOfTheUsersOwnIsOpenedAtTheStartOrRefused)

@@ -1,0 +1,73 @@
+// The robustness suite during training (training/suite, run every training/suite_every episodes
+// on a copy of the table) and the best table it has seen: a table that passes beats one that does
+// not, then the one more balanced in its worst case, the first of equals. Training ends on the
+// best table seen rather than the last, a checkpoint saves the best beside the run's table, and a
+// resumed run goes on comparing against it. Under training/until suite_passes, the suite passing
+// ends training.
+#pragma once
+
+#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/application/robustness_suite.h"
+#include "cartpole_qlearning/application/run_folder.h"
+#include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/learning/training_session.h"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cartpole_qlearning
+{
+class BestTableKeeper
+{
+public:
+  // config: training/suite, suite_every and until; the physics the suite's cases vary.
+  // learning: false (evaluating) keeps no suite. suite_folders: where a relative suite is looked
+  // for, in order.
+  BestTableKeeper(const TrainingConfig& config, bool learning, std::vector<std::string> suite_folders);
+
+  // Finds and reads the suite (training, unless training/suite is none). Throws ConfigError when
+  // training evaluates it (suite_every > 0); else says that the run ends without a verdict.
+  LogLines loadSuite();
+  bool hasSuite() const
+  {
+    return suite_ != nullptr;
+  }
+
+  // The suite's verdict on the session's table when it is due at the session's last episode (at
+  // suite_every's cadence, and when training ends), said; the table is kept when it is the best
+  // so far. Nothing when not due.
+  std::optional<SuiteResult> evaluateWhenDue(const TrainingSession& session, bool training_ends, LogLines& log);
+  // Training ends (needs the suite): the table it saves is the best seen when that beats the last
+  // (the session then holds it), said. Returns the verdict of that table (`last`, the best's, or
+  // evaluated now when the suite has not run at this episode), said as a table.
+  SuiteResult settle(TrainingSession& session, std::optional<SuiteResult> last, LogLines& log);
+
+  // A resumed run goes on comparing against the best table its folder holds, evaluated again (the
+  // same suite gives the same verdict; a suite changed since is applied to both tables alike).
+  // One that cannot be read or does not fit is said and forgotten.
+  LogLines restore(RunFolder& folder);
+
+  // The best table seen so far (when the suite runs during training), else null.
+  const BestTable* best() const
+  {
+    return best_ ? &*best_ : nullptr;
+  }
+
+private:
+  bool evaluatesDuringTraining() const
+  {
+    return suite_ && config_.limits.suite_every > 0;
+  }
+
+  TrainingConfig config_;
+  bool learning_;
+  std::vector<std::string> suite_folders_;
+  std::unique_ptr<RobustnessSuite> suite_;  // none: no verdict (training/suite none, or not found)
+  std::string suite_path_;
+  std::optional<BestTable> best_;
+};
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,71 @@
+// Where Q-tables are read and written: the table folder, the default table in it, and the path
+// rule the node's parameters, its services and train_headless's command line share. A relative
+// path lies under the folder; an absolute one given by the user (the settings, the command line)
+// is the user's file when the store is told so (train_headless), else it too must lie in the
+// folder; a path through a service always does. A path that escapes the folder is refused.
+#pragma once
+
+#include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/learning/q_table.h"
+
+#include <functional>
+#include <string>
+
+namespace cartpole_qlearning
+{
+// A service's answer (SaveQTable, LoadQTable): success and message, and what to log.
+struct ServiceAnswer
+{
+  bool success = false;
+  std::string message;
+  LogLines log;
+};
+
+// What an absolute path the user gives (not a service's caller) names.
+enum class AbsolutePaths
+{
+  MustLieInTheFolder,  // the node's parameters
+  AreTheUsersFiles     // train_headless's command line: followed as the shell would
+};
+
+class TableStore
+{
+public:
+  // folder: where tables go. default_table: the table "" names (relative to the folder, or
+  // absolute as `absolute` allows; "": none).
+  TableStore(std::string folder, std::string default_table, AbsolutePaths absolute);
+
+  // A path the user gives, made absolute ("" the default table). Throws FileError when it
+  // escapes the folder (and is not the user's).
+  std::string resolve(const std::string& path) const;
+  // Reads and writes a table at such a path. Throw FileError.
+  QTable load(const std::string& path) const;
+  void save(const QTable& table, const std::string& path) const;
+
+  // A path through a service, made absolute: "" the default table, anything else under the
+  // folder, absolute or not. Throws FileError when it escapes the folder.
+  std::string resolveForService(const std::string& path) const;
+  // ~save_q_table: writes the table there, saying what or why nothing. Never throws.
+  ServiceAnswer serveSave(const QTable& table, const std::string& path) const;
+  // ~load_q_table: reads the table there and hands it to `replace`, which puts it in use when it
+  // fits and otherwise says what differs (and changes nothing). Never throws.
+  ServiceAnswer serveLoad(const std::string& path, const std::function<std::string(QTable)>& replace) const;
+
+  const std::string& folder() const
+  {
+    return folder_;
+  }
+  const std::string& defaultTable() const
+  {
+    return default_table_;
+  }
+
+private:
+  bool isUsersFile(const std::string& path) const;
+
+  std::string folder_;
+  std::string default_table_;
+  AbsolutePaths absolute_;
+};
+
+}  // namespace cartpole_qlearning

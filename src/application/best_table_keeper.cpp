@@ -1,0 +1,132 @@
+#include "cartpole_qlearning/application/best_table_keeper.h"
+
+#include <fstream>
+#include <utility>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+unsigned long long count(std::uint64_t value)
+{
+  return static_cast<unsigned long long>(value);
+}
+
+// A table that passes beats one that does not; then the more balanced in its worst case.
+bool better(const SuiteResult& a, const SuiteResult& b)
+{
+  return std::make_pair(a.passed(), a.worstBalanced()) > std::make_pair(b.passed(), b.worstBalanced());
+}
+}  // namespace
+
+BestTableKeeper::BestTableKeeper(const TrainingConfig& config, bool learning, std::vector<std::string> suite_folders)
+  : config_(config), learning_(learning), suite_folders_(std::move(suite_folders))
+{
+}
+
+LogLines BestTableKeeper::loadSuite()
+{
+  LogLines log;
+  const std::string& name = config_.limits.suite;
+  if (!learning_ || name == "none")
+    return log;
+  std::string where;
+  if (name.front() == '/')
+    suite_path_ = name;
+  for (std::size_t i = 0; suite_path_.empty() && i < suite_folders_.size(); ++i)
+  {
+    where += (where.empty() ? "" : ", ") + suite_folders_[i];
+    if (std::ifstream(suite_folders_[i] + "/" + name).good())
+      suite_path_ = suite_folders_[i] + "/" + name;
+  }
+  const bool needed = config_.limits.suite_every > 0;
+  try
+  {
+    if (suite_path_.empty())
+      throw ConfigError("training/suite = '" + name + "' is not allowed (no such file in " +
+                        (where.empty() ? std::string("no folder") : where) + ")");
+    suite_ = std::make_unique<RobustnessSuite>(loadRobustnessSuite(suite_path_, config_));
+  }
+  catch (const ConfigError& e)
+  {
+    if (needed)
+      throw;
+    log.push_back({LogLine::Level::Warn, std::string("this run will end without a robustness verdict: ") + e.what()});
+    return log;
+  }
+  if (needed)
+    log.push_back(
+        {LogLine::Level::Info,
+         formatText("the robustness suite %s runs on the table every %llu episodes%s; the best table is kept",
+                    suite_path_.c_str(), count(config_.limits.suite_every),
+                    config_.limits.until == TrainUntil::SuitePasses ? ", and training ends when it passes" : "")});
+  return log;
+}
+
+std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSession& session, bool training_ends,
+                                                            LogLines& log)
+{
+  const EpisodeSummary& s = session.lastEpisode();
+  if (!evaluatesDuringTraining() || (s.episode % config_.limits.suite_every != 0 && !training_ends))
+    return std::nullopt;
+  // On a copy of the table: the suite runs greedily and learns nothing.
+  SuiteResult result = evaluateSuite(session.table(), config_, *suite_);
+  if (!best_ || better(result, best_->result))
+    best_ = BestTable{session.table(), result, s.episode};
+  log.push_back({LogLine::Level::Info, formatText("robustness at episode %llu (%llu steps): %s", count(s.episode),
+                                                  count(s.total_steps), result.summary().c_str())});
+  return result;
+}
+
+SuiteResult BestTableKeeper::settle(TrainingSession& session, std::optional<SuiteResult> last, LogLines& log)
+{
+  if (best_ && last && better(best_->result, *last))
+  {
+    // The best table seen is what the run saves (and what the session holds from now on).
+    log.push_back(
+        {LogLine::Level::Info,
+         formatText("keeping the table of episode %llu (worst case %llu balanced) over the last one (%llu)",
+                    count(best_->episode), count(best_->result.worstBalanced()), count(last->worstBalanced()))});
+    session.replaceTable(best_->table);
+    last = best_->result;
+  }
+  if (!last)
+    last = evaluateSuite(session.table(), config_, *suite_);
+  log.push_back({LogLine::Level::Info,
+                 formatText("robustness of the saved table (%s, greedy, %llu episodes per case):\n",
+                            suite_path_.c_str(), count(suite_->episodes)) +
+                     last->table(),
+                 false});
+  return *last;
+}
+
+LogLines BestTableKeeper::restore(RunFolder& folder)
+{
+  LogLines log;
+  const std::uint64_t recorded = folder.record().best_episode;
+  if (recorded == 0 || !evaluatesDuringTraining())
+    return log;
+  try
+  {
+    QTable table = folder.loadBestTable();
+    SuiteResult result = evaluateSuite(table, config_, *suite_);
+    const std::uint64_t episode = table.episodes;
+    best_ = BestTable{std::move(table), std::move(result), episode};
+  }
+  catch (const std::exception& e)  // FileError, or a ConfigError: the table does not fit this configuration
+  {
+    log.push_back({LogLine::Level::Warn,
+                   formatText("the run's best table (episode %llu) cannot be used (%s): the best is looked for afresh",
+                              count(recorded), e.what())});
+    folder.bestTableLost();
+    return log;
+  }
+  folder.bestTableKept(*best_);
+  log.push_back(
+      {LogLine::Level::Info,
+       formatText("the best table so far is still the one to beat: episode %llu, worst case %llu balanced (%s)",
+                  count(best_->episode), count(best_->result.worstBalanced()), folder.bestTablePath().c_str())});
+  return log;
+}
+
+}  // namespace cartpole_qlearning

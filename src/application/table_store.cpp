@@ -1,0 +1,97 @@
+#include "cartpole_qlearning/application/table_store.h"
+
+#include "cartpole_qlearning/io/file_access.h"
+#include "cartpole_qlearning/learning/q_table_file.h"
+
+#include <cstdint>
+#include <utility>
+
+namespace cartpole_qlearning
+{
+TableStore::TableStore(std::string folder, std::string default_table, AbsolutePaths absolute)
+  : folder_(std::move(folder)), default_table_(std::move(default_table)), absolute_(absolute)
+{
+}
+
+bool TableStore::isUsersFile(const std::string& path) const
+{
+  return absolute_ == AbsolutePaths::AreTheUsersFiles && !path.empty() && path.front() == '/';
+}
+
+std::string TableStore::resolve(const std::string& path) const
+{
+  const std::string& named = path.empty() ? default_table_ : path;
+  return isUsersFile(named) ? named : resolvePathUnder(folder_, named);
+}
+
+QTable TableStore::load(const std::string& path) const
+{
+  const std::string& named = path.empty() ? default_table_ : path;
+  return isUsersFile(named) ? loadQTableFile(named) : loadQTableUnder(folder_, named);
+}
+
+void TableStore::save(const QTable& table, const std::string& path) const
+{
+  const std::string& named = path.empty() ? default_table_ : path;
+  if (isUsersFile(named))
+    saveQTableFile(table, named);
+  else
+    saveQTableUnder(table, folder_, named);
+}
+
+std::string TableStore::resolveForService(const std::string& path) const
+{
+  // Under the folder whatever the store allows the user: a service's caller is not the user at
+  // the shell. "" is the default table, which the user named.
+  return path.empty() ? resolve("") : resolvePathUnder(folder_, path);
+}
+
+ServiceAnswer TableStore::serveSave(const QTable& table, const std::string& path) const
+{
+  ServiceAnswer answer;
+  try
+  {
+    const std::string resolved = resolveForService(path);
+    if (path.empty())
+      save(table, "");
+    else
+      saveQTableUnder(table, folder_, path);
+    answer.success = true;
+    answer.message = "saved " + std::to_string(table.episodes) + " episodes, " + std::to_string(table.steps) +
+                     " steps of training to " + resolved;
+  }
+  catch (const std::exception& e)  // FileError, or anything else: never out of a service
+  {
+    answer.message = std::string("nothing written: ") + e.what();
+  }
+  answer.log.push_back(
+      {answer.success ? LogLine::Level::Info : LogLine::Level::Warn, "save_q_table: " + answer.message});
+  return answer;
+}
+
+ServiceAnswer TableStore::serveLoad(const std::string& path, const std::function<std::string(QTable)>& replace) const
+{
+  ServiceAnswer answer;
+  try
+  {
+    const std::string resolved = resolveForService(path);
+    QTable table = path.empty() ? load("") : loadQTableUnder(folder_, path);
+    const std::uint64_t episodes = table.episodes;
+    const std::uint64_t steps = table.steps;
+    const std::string mismatch = replace(std::move(table));
+    if (!mismatch.empty())
+      throw FileError(resolved + " does not fit this controller: " + mismatch);
+    answer.success = true;
+    answer.message = "loaded " + resolved + " (" + std::to_string(episodes) + " episodes, " + std::to_string(steps) +
+                     " steps of training)";
+    answer.log.push_back({LogLine::Level::Info, "load_q_table: " + answer.message});
+  }
+  catch (const std::exception& e)  // FileError, or anything else: never out of a service
+  {
+    answer.message = std::string("refused, the table in use is unchanged: ") + e.what();
+    answer.log.push_back({LogLine::Level::Warn, "load_q_table: " + answer.message});
+  }
+  return answer;
+}
+
+}  // namespace cartpole_qlearning
