@@ -27,7 +27,7 @@ import matplotlib.image  # noqa: E402
 
 PACKAGE = "cartpole_qlearning"
 HERE = os.path.dirname(os.path.abspath(__file__))
-SCRIPT = os.path.join(HERE, "..", "scripts", "plot_learning_curve")
+SCRIPT = os.path.join(HERE, "..", "..", "scripts", "plot_learning_curve")
 HEADER = "episode,robot,steps,episode_return,mean_return_100,epsilon,alpha,terminated,truncated,solved,total_steps,wall_time,gamma"
 
 RETURN_COLOUR = "#1f77b4"
