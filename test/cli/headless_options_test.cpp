@@ -54,9 +54,9 @@ TEST(HeadlessOptions, NoArgumentsTrainWithTheDefaults)
 
 TEST(HeadlessOptions, EveryOptionGoesIntoItsField)
 {
-  const HeadlessCommandLine parsed =
-      parse("--config c.yaml --seed 7 --robots 3 --ns a/b --max-episodes 40 --save s.yaml --load l.yaml "
-            "--checkpoint-every 0 --stats-csv c.csv --quiet --returns --trace");
+  const HeadlessCommandLine parsed = parse(
+      "--config c.yaml --seed 7 --robots 3 --ns a/b --max-episodes 40 --save s.yaml --load l.yaml "
+      "--checkpoint-every 0 --stats-csv c.csv --quiet --returns --trace");
   ASSERT_EQ("", parsed.error);
   const HeadlessOptions& o = parsed.options;
   EXPECT_EQ("c.yaml", o.config_path);
@@ -121,8 +121,7 @@ TEST(HeadlessOptions, BadValuesAreRefusedNamingTheOptionTheValueAndWhatIsAllowed
             refusal("--checkpoint-every often"));
   EXPECT_EQ("--episodes 0 is not allowed (must be a whole number >= 1)", refusal("--evaluate t.yaml --episodes 0"));
   EXPECT_EQ("--grid 1 is not allowed (must be a whole number in [2, 1000])", refusal("--policy t.yaml --grid 1"));
-  EXPECT_EQ("--grid 1001 is not allowed (must be a whole number in [2, 1000])",
-            refusal("--policy t.yaml --grid 1001"));
+  EXPECT_EQ("--grid 1001 is not allowed (must be a whole number in [2, 1000])", refusal("--policy t.yaml --grid 1001"));
   EXPECT_EQ("--ns 'a/../b' is not allowed (must be a ROS namespace)", refusal("--ns a/../b"));
   EXPECT_EQ("--ns '' is not allowed (must be a ROS namespace)", parseHeadlessOptions({"--ns", ""}).error);
   // The first bad value is the one refused.
