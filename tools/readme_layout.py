@@ -54,7 +54,8 @@ def table():
          "the ROS layer: the node classes and their mains (`*_node.cpp`), the nodelets, message conversions, "
          "the parameter server reader, the reset caller, start-up and launch control: "
          + quoted(stems("include/cartpole_qlearning/ros", "src/ros"))),
-        ("`src/cli/`", "the command line: " + quoted(stems("src/cli"))),
+        ("`src/cli/`", "the command line: `train_headless` (the main only), its options and their rules, one file "
+         "per mode and the run they share: " + quoted(stems("src/cli"))),
         ("`msg/`, `srv/`", "`EpisodeStats`, `Reset`, `SaveQTable`, `LoadQTable`"),
         ("`cfg/`", "`Learning.cfg`: the controller's live-tuning fields (dynamic_reconfigure)"),
         ("`config/`", "commented YAML parameters: " + quoted(files("config"))
@@ -64,7 +65,7 @@ def table():
         ("`docs/`", "pages and pictures (`docs/images/`), each picture made by the command beside it"),
         ("`test/`", "`unit/<layer>/`: gtests of each core layer (`<layer>_tests`, no ROS) and of its layout; "
          "`ros/`: the ROS layer's message conversions (no master); `cli/`: `train_headless` run as a user runs "
-         "it; `docs/`: the pages' links and parameters; `rostest/`: the nodes' wiring (`*.test` files and their "
+         "it, and its options parsed without a process; `docs/`: the pages' links and parameters; `rostest/`: the nodes' wiring (`*.test` files and their "
          "clients); `support/`: what the tests share; `data/`: their configs; `fuzz/`: fuzzers; "
          "`sanitizer/`: suppressions"),
         ("`bench/`", "benchmarks (Google Benchmark for the core; the lockstep loops against raw TCPROS and "

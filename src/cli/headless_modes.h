@@ -1,0 +1,48 @@
+// train_headless's modes, one file each: training (from scratch, from a table, or on from a run
+// folder), a greedy evaluation, a robustness suite, a replay of transitions, a table's policy.
+// Each prints what it says and returns the exit status; the main only dispatches.
+#pragma once
+
+#include "headless_options.h"
+
+#include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/learning/q_table.h"
+#include "cartpole_qlearning/learning/training_config.h"
+
+#include <optional>
+#include <string>
+
+namespace cartpole_qlearning
+{
+// What every mode but --policy runs with: the configuration, where it came from, the table folder.
+struct HeadlessSetup
+{
+  TrainingConfig config;  // --max-episodes applied
+  std::string config_path;
+  std::string table_dir;
+};
+
+// The configuration (--config, else the package's), checked against the options (--trace and
+// --replay need bins, a relative --save stays in the table folder): nullopt after saying why.
+std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options);
+// The package's folder ("" when ROS cannot find it).
+std::string packagePath();
+
+// What the application says: information on stdout (none with --quiet), the rest on stderr.
+// Returns whether an error was said.
+bool printLog(const LogLines& log, bool quiet);
+
+// Tables by the services' path rule (an absolute path is the user's own, a relative one under the
+// table folder): the one place train_headless reads and writes them.
+QTable loadTable(const std::string& table_dir, const std::string& path);
+void saveTable(const QTable& table, const std::string& table_dir, const std::string& path);
+// Where loadTable and saveTable find `path`: made absolute.
+std::string tablePath(const std::string& table_dir, const std::string& path);
+
+int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup);     // train_mode.cpp
+int evaluateMode(const HeadlessOptions& options, const HeadlessSetup& setup);  // evaluate_mode.cpp
+int suiteMode(const HeadlessOptions& options, const HeadlessSetup& setup);     // suite_mode.cpp
+int replayMode(const HeadlessOptions& options, const HeadlessSetup& setup);    // replay_mode.cpp
+int policyMode(const HeadlessOptions& options);                                // policy_mode.cpp
+
+}  // namespace cartpole_qlearning

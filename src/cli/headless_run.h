@@ -1,0 +1,53 @@
+// A run of the controller's application with the core's trainer: training or a greedy
+// evaluation. It makes the node's RunApplication calls in the node's order and prints what they
+// say; the modes print their result lines.
+#pragma once
+
+#include "headless_modes.h"
+
+#include "cartpole_qlearning/application/headless_trainer.h"
+#include "cartpole_qlearning/application/run_application.h"
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cartpole_qlearning
+{
+class HeadlessRun
+{
+public:
+  HeadlessRun(const HeadlessOptions& options, const HeadlessSetup& setup, std::uint64_t seed);
+  ~HeadlessRun();
+
+  // Starts the application (--resume: on from the run folder's checkpoint): nullopt, or the exit
+  // status when it cannot start, after saying why.
+  std::optional<int> start();
+  // Episodes until the application or the limits end the run, or until SIGINT or SIGTERM stops it
+  // (then the save on shutdown, as the controller's); then --returns' line.
+  TrainingResult run();
+
+  bool stopped() const;
+  // A failure the mode found after the run (it has said it).
+  void addError();
+  // 128 + the signal's number when stopped, else 1 when an error was said, else 0.
+  int exitStatus() const;
+
+  RunApplication& application();
+  const TrainingSession& session() const;
+  const RunSettings& settings() const;
+
+private:
+  const HeadlessOptions& options_;
+  const HeadlessSetup& setup_;
+  RunSettings settings_;
+  HeadlessTrainer trainer_;
+  std::vector<std::string> robot_names_;
+  std::unique_ptr<RunApplication> application_;
+  bool stopped_ = false;
+  bool error_ = false;
+};
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,111 @@
+// What train_headless's modes share: the configuration, printing what the application says, and
+// the tables read and written by the services' path rule.
+#include "headless_modes.h"
+
+#include "cartpole_qlearning/io/file_access.h"
+#include "cartpole_qlearning/application/table_store.h"
+#include "cartpole_qlearning/learning/q_table_file.h"
+
+#include <ros/package.h>
+
+#include <cstdio>
+#include <iostream>
+
+namespace cartpole_qlearning
+{
+std::string packagePath()
+{
+  return ros::package::getPath("cartpole_qlearning");
+}
+
+std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options)
+{
+  HeadlessSetup setup;
+  setup.config_path = options.config_path;
+  if (setup.config_path.empty())
+  {
+    const std::string share = packagePath();
+    if (share.empty())
+    {
+      std::cerr << "train_headless: package cartpole_qlearning not found (source devel/setup.bash) "
+                   "and no --config given\n";
+      return std::nullopt;
+    }
+    setup.config_path = share + "/config/cartpole.yaml";
+  }
+  try
+  {
+    const auto source = loadYamlParameters(setup.config_path);
+    refuseUnknownSections(*source);
+    setup.config = readTrainingConfig(*source);
+  }
+  catch (const ConfigError& e)
+  {
+    std::cerr << "train_headless: " << e.what() << "\n";
+    return std::nullopt;
+  }
+  if (options.max_episodes > 0)
+    setup.config.limits.max_episodes = options.max_episodes;
+  const bool replay = !options.replay_path.empty();
+  if ((options.trace || replay) && setup.config.agent.features == FeatureKind::Tiles)
+  {
+    std::cerr << "train_headless: " << (options.trace ? "--trace" : "--replay")
+              << " shows one table row per state: it needs learning/features bins (" << setup.config_path
+              << " has tiles)\n";
+    return std::nullopt;
+  }
+  setup.table_dir = defaultTableDirectory(options.name_space);
+  // A relative --save must stay in the table folder, as over a service: said before training.
+  if (!options.save_path.empty() && options.save_path.front() != '/')
+  {
+    try
+    {
+      relativePathUnder(setup.table_dir, options.save_path);
+    }
+    catch (const FileError& e)
+    {
+      std::cerr << "train_headless: --save " << options.save_path << " is not allowed (" << e.what() << ")\n";
+      return std::nullopt;
+    }
+  }
+  return setup;
+}
+
+bool printLog(const LogLines& log, bool quiet)
+{
+  bool error = false;
+  for (const LogLine& line : log)
+  {
+    error = error || line.level == LogLine::Level::Error;
+    if (line.level == LogLine::Level::Info)
+    {
+      if (!quiet)
+        std::printf("%s\n", line.text.c_str());
+    }
+    else
+    {
+      std::fflush(stdout);
+      std::fprintf(stderr, "train_headless: %s\n", line.text.c_str());
+    }
+  }
+  return error;
+}
+
+// Tables as the command line names them (TableStore's rule): an absolute path is the user's own
+// file, a relative one lies under the table folder.
+void saveTable(const QTable& table, const std::string& table_dir, const std::string& path)
+{
+  TableStore(table_dir, "", AbsolutePaths::AreTheUsersFiles).save(table, path);
+}
+
+std::string tablePath(const std::string& table_dir, const std::string& path)
+{
+  return TableStore(table_dir, "", AbsolutePaths::AreTheUsersFiles).resolve(path);
+}
+
+QTable loadTable(const std::string& table_dir, const std::string& path)
+{
+  return TableStore(table_dir, "", AbsolutePaths::AreTheUsersFiles).load(path);
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,52 @@
+#include "headless_modes.h"
+
+#include "cartpole_qlearning/application/robustness_suite.h"
+
+#include <cstdio>
+#include <iostream>
+
+namespace cartpole_qlearning
+{
+// --evaluate TABLE --suite FILE: every case of the suite, greedily; exit 0 when it ran (the verdict
+// is in the last line), 2 on a bad suite, table or configuration.
+int suiteMode(const HeadlessOptions& options, const HeadlessSetup& setup)
+{
+  const std::string& suite_path = options.suite_path;
+  const std::string& table_path = options.evaluate_path;
+  RobustnessSuite suite;
+  try
+  {
+    suite = loadRobustnessSuite(suite_path, setup.config);
+  }
+  catch (const ConfigError& e)
+  {
+    std::cerr << "train_headless: --suite: " << e.what() << "\n";
+    return 2;
+  }
+  if (options.seed)
+    suite.seed = *options.seed;
+  SuiteResult result;
+  try
+  {
+    const QTable table = loadTable(setup.table_dir, table_path);
+    result = evaluateSuite(table, setup.config, suite);
+  }
+  catch (const std::runtime_error& e)  // FileError, ConfigError: the table cannot be read or does not fit
+  {
+    std::cerr << "train_headless: --evaluate " << table_path << ": " << e.what() << "\n";
+    return 2;
+  }
+  if (!options.quiet)
+    std::printf("suite %s: %zu cases, %llu greedy episodes each, seed %llu\n%s\n", suite_path.c_str(),
+                suite.cases.size(), static_cast<unsigned long long>(suite.episodes),
+                static_cast<unsigned long long>(suite.seed), result.table().c_str());
+  std::size_t passed = 0;
+  for (const CaseResult& c : result.cases)
+    passed += c.passed();
+  std::printf("suite=%s cases=%zu passed=%zu worst=%llu/%llu\n", result.passed() ? "PASSED" : "FAILED",
+              result.cases.size(), passed, static_cast<unsigned long long>(result.worstBalanced()),
+              static_cast<unsigned long long>(suite.episodes));
+  return 0;
+}
+
+}  // namespace cartpole_qlearning
