@@ -5,12 +5,12 @@
 
 namespace cartpole_qlearning
 {
-RobotRounds::RobotRounds(std::size_t robots, bool sync, WallClock::duration drop_out_after)
+RobotRounds::RobotRounds(std::size_t robots, bool sync, WallClock::duration drop_out_after, WallClock::time_point start)
   : sync_(sync),
     drop_out_after_(drop_out_after),
     held_(robots, false),
     taking_part_(robots, true),
-    last_heard_(robots, WallClock::now())
+    last_heard_(robots, start)
 {
   if (robots == 0)
     throw std::invalid_argument("RobotRounds: at least one robot");

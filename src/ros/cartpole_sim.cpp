@@ -2,12 +2,14 @@
 
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/ros/conversions.h"
-#include "cartpole_qlearning/ros/parameter_source.h"
+#include "parameter_source.h"
+#include "start_up.h"
 
 #include <rosgraph_msgs/Clock.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <sstream>
 
@@ -30,7 +32,7 @@ ros::Time toRosTime(Stamp stamp)
 
 CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
                                  ros::CallbackQueue* command_queue)
-  : nh_(nh), pnh_(pnh)
+  : nh_(nh), pnh_(pnh), name_(nodeLogger("cartpole_sim", pnh.getNamespace()))
 {
   const std::lock_guard<std::mutex> lock(mutex_);
   readParameters();
@@ -90,19 +92,19 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
           });
     publishState(ros::Time::now());
   }
-  ROS_INFO_NAMED(
-      "cartpole_sim", "cartpole_sim: %s mode, tau %g s, integrator %s, seed %llu, start state [%g, %g, %g, %g]%s%s",
+  say(ros::console::levels::Info,
+      "cartpole_sim: %s mode, tau %g s, integrator %s, seed %llu, start state [%g, %g, %g, %g]%s%s",
       settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau,
       toString(settings_.physics.integrator).c_str(), static_cast<unsigned long long>(settings_.seed),
       simulation_->state()[0], simulation_->state()[1], simulation_->state()[2], simulation_->state()[3],
       settings_.publish_clock ? ", publishing /clock" : "",
       own_rate ? (", joint_states every " + SectionReader::numberText(settings_.publish_period) + " s").c_str() : "");
   if (!settings_.suite_case.empty())
-    ROS_INFO_NAMED("cartpole_sim", "cartpole_sim: posing as case %s of %s", settings_.suite_case.c_str(),
-                   settings_.suite.c_str());
+    say(ros::console::levels::Info, "cartpole_sim: posing as case %s of %s", settings_.suite_case.c_str(),
+        settings_.suite.c_str());
   if (settings_.perturbations.any())
-    ROS_INFO_NAMED("cartpole_sim", "cartpole_sim: perturbations on (%s)",
-                   describePerturbations(settings_.perturbations, settings_.physics.tau).c_str());
+    say(ros::console::levels::Info, "cartpole_sim: perturbations on (%s)",
+        describePerturbations(settings_.perturbations, settings_.physics.tau).c_str());
 }
 
 void CartPoleSimNode::readParameters()
@@ -115,13 +117,13 @@ bool CartPoleSimNode::acceptEffort(double requested, double& effort) const
   if (!std::isfinite(requested))
   {
     if (nonfinite_warning_.ready())
-      ROS_WARN_NAMED("cartpole_sim", "cartpole_sim: refused a non-finite effort (%f)", requested);
+      say(ros::console::levels::Warn, "cartpole_sim: refused a non-finite effort (%f)", requested);
     return false;
   }
   effort = std::clamp(requested, -settings_.effort_limit, settings_.effort_limit);
   if (effort != requested && clamp_warning_.ready())
-    ROS_WARN_NAMED("cartpole_sim", "cartpole_sim: effort %g N clamped to the limit of %g N", requested,
-                   settings_.effort_limit);
+    say(ros::console::levels::Warn, "cartpole_sim: effort %g N clamped to the limit of %g N", requested,
+        settings_.effort_limit);
   return true;
 }
 
@@ -132,7 +134,7 @@ void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
   if (!requested)
   {
     if (bad_command_warning_.ready())
-      ROS_WARN_NAMED("cartpole_sim", "cartpole_sim: %s", requested.refusal.c_str());
+      say(ros::console::levels::Warn, "cartpole_sim: %s", requested.refusal.c_str());
     return;
   }
   double effort = 0.0;
@@ -142,7 +144,7 @@ void CartPoleSimNode::onJointCommand(const sensor_msgs::JointStateConstPtr& msg)
   if (settings_.mode == SimMode::Realtime)
   {
     if (!hold_->set(effort, msg->header.stamp.toNSec(), now))
-      ROS_DEBUG_NAMED("cartpole_sim", "cartpole_sim: dropped a joint_command older than the one held");
+      say(ros::console::levels::Debug, "cartpole_sim: dropped a joint_command older than the one held");
     return;
   }
   // An unstamped zero is a controller stopping (an episode's end, its shutdown): it answers no
@@ -164,8 +166,8 @@ void CartPoleSimNode::onGroupEffort(const std_msgs::Float64MultiArrayConstPtr& m
   if (msg->data.size() <= settings_.group_effort_index)
   {
     if (bad_command_warning_.ready())
-      ROS_WARN_NAMED("cartpole_sim", "cartpole_sim: dropped a group_effort of %zu values: the cart's is at index %llu",
-                     msg->data.size(), static_cast<unsigned long long>(settings_.group_effort_index));
+      say(ros::console::levels::Warn, "cartpole_sim: dropped a group_effort of %zu values: the cart's is at index %llu",
+          msg->data.size(), static_cast<unsigned long long>(settings_.group_effort_index));
     return;
   }
   onUnstampedEffort(msg->data[settings_.group_effort_index]);
@@ -198,8 +200,6 @@ void CartPoleSimNode::apply(SimProtocol::Verdict verdict, double effort, const r
   if (!dropped_warning_.ready())
     return;
   const SimProtocol::Counts& c = lockstep_->counts();
-  // Stale and duplicate answers are expected now and then (a reset with an answer in flight, a
-  // repeat answered twice); future and unstamped ones come from a misbehaving publisher.
   char text[320];
   std::snprintf(text, sizeof text,
                 "cartpole_sim: dropped a joint_command stamped %.6f for the state at %.6f: %s (dropped so far: %llu "
@@ -210,9 +210,9 @@ void CartPoleSimNode::apply(SimProtocol::Verdict verdict, double effort, const r
   // Stale and duplicate answers are expected now and then (a reset with an answer in flight, a
   // repeat answered twice); future and unstamped ones come from a misbehaving publisher.
   if (verdict == SimProtocol::Verdict::Stale || verdict == SimProtocol::Verdict::Duplicate)
-    ROS_INFO_NAMED("cartpole_sim", "%s", text);
+    say(ros::console::levels::Info, "%s", text);
   else
-    ROS_WARN_NAMED("cartpole_sim", "%s", text);
+    say(ros::console::levels::Warn, "%s", text);
 }
 
 void CartPoleSimNode::step(double effort)
@@ -259,8 +259,8 @@ void CartPoleSimNode::onLockstepTimer(const ros::SteadyTimerEvent&)
   const std::lock_guard<std::mutex> lock(mutex_);
   if (!lockstep_->repeatDue(WallClock::now()))
     return;
-  ROS_DEBUG_NAMED("cartpole_sim", "cartpole_sim: no command for %.3f s, publishing the state again",
-                  settings_.lockstep_timeout);
+  say(ros::console::levels::Debug, "cartpole_sim: no command for %.3f s, publishing the state again",
+      settings_.lockstep_timeout);
   republishState();
 }
 
@@ -372,6 +372,15 @@ void CartPoleSimNode::publishState(const ros::Time& stamp, bool before_last_step
   last_tf_ = wall_now;
   tf_broadcaster_.sendTransform(transformsFromState(s, settings_.track_y, stamp, settings_.world_frame,
                                                     settings_.cart_frame, settings_.pole_frame));
+}
+
+void CartPoleSimNode::say(ros::console::Level level, const char* format, ...) const
+{
+  std::va_list args;
+  va_start(args, format);
+  const std::string text = formatTextV(format, args);
+  va_end(args);
+  logLine(name_, level, text);
 }
 
 }  // namespace cartpole_qlearning

@@ -1,6 +1,6 @@
 // cartpole_sim: the simulated cart-pole robot (see ros/cartpole_sim.h).
 #include "cartpole_qlearning/ros/cartpole_sim.h"
-#include "cartpole_qlearning/ros/start_up.h"
+#include "start_up.h"
 
 #include <memory>
 
@@ -10,7 +10,7 @@ int main(int argc, char** argv)
   ros::NodeHandle nh;
   ros::NodeHandle pnh("~");
   std::unique_ptr<cartpole_qlearning::CartPoleSimNode> node;
-  if (!cartpole_qlearning::startNode("cartpole_sim",
+  if (!cartpole_qlearning::startNode("cartpole_sim", ros::this_node::getName(),
                                      [&] { node = std::make_unique<cartpole_qlearning::CartPoleSimNode>(nh, pnh); }))
     return 1;
   ros::spin();

@@ -1,4 +1,4 @@
-#include "cartpole_qlearning/ros/command_publisher.h"
+#include "command_publisher.h"
 
 #include "cartpole_qlearning/ros/conversions.h"
 

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
+#include <variant>
 
 namespace cartpole_qlearning
 {
@@ -153,6 +155,60 @@ EpisodeStats robotEpisodeStats(const EpisodeSummary& s, const std::string& robot
   stats.mean_return_100 = s.robot_mean_return_window;
   stats.total_steps = s.robot_total_steps;
   return stats;
+}
+
+namespace
+{
+// The server's fields and their keys, in cfg/Learning.cfg's order (ros_conversions_test holds the
+// two alike).
+using Field = std::variant<double LearningConfig::*, std::string LearningConfig::*>;
+const std::pair<const char*, Field> kFields[] = {{"epsilon_override", &LearningConfig::epsilon_override},
+                                                 {"alpha_override", &LearningConfig::alpha_override},
+                                                 {"gamma", &LearningConfig::gamma},
+                                                 {"epsilon_schedule", &LearningConfig::epsilon_schedule},
+                                                 {"epsilon_start", &LearningConfig::epsilon_start},
+                                                 {"epsilon_min", &LearningConfig::epsilon_min},
+                                                 {"epsilon_decay_episodes", &LearningConfig::epsilon_decay_episodes},
+                                                 {"epsilon_decay_rate", &LearningConfig::epsilon_decay_rate},
+                                                 {"epsilon_log_divisor", &LearningConfig::epsilon_log_divisor},
+                                                 {"alpha_schedule", &LearningConfig::alpha_schedule},
+                                                 {"alpha_start", &LearningConfig::alpha_start},
+                                                 {"alpha_min", &LearningConfig::alpha_min},
+                                                 {"alpha_decay_episodes", &LearningConfig::alpha_decay_episodes},
+                                                 {"alpha_decay_rate", &LearningConfig::alpha_decay_rate},
+                                                 {"alpha_log_divisor", &LearningConfig::alpha_log_divisor}};
+
+template <typename T>
+void readField(const ParameterSource& source, const char* key, T& field)
+{
+  T value = field;
+  try
+  {
+    if (source.get(key, value))
+      field = value;
+  }
+  catch (const ConfigError&)
+  {
+  }
+}
+}  // namespace
+
+std::vector<std::string> learningConfigKeys()
+{
+  std::vector<std::string> keys;
+  for (const auto& field : kFields)
+    keys.push_back(field.first);
+  return keys;
+}
+
+LearningSettings learningSettingsLeft(const ParameterSource& source, const LearningSettings& in_use)
+{
+  LearningConfig config = toConfig(in_use);
+  for (const auto& [key, field] : kFields)
+    std::visit([&, key = key](auto member) { readField(source, key, config.*member); }, field);
+  LearningSettings left = in_use;
+  fromConfig(config, left);  // an unknown schedule name leaves that schedule as it is
+  return left;
 }
 
 LearningConfig toConfig(const LearningSettings& s)

@@ -1,4 +1,4 @@
-#include "cartpole_qlearning/ros/launch_control.h"
+#include "launch_control.h"
 
 #include <fstream>
 #include <iterator>

@@ -10,7 +10,7 @@
 // services stay on the manager's threads; the node classes lock their state for that.
 #include "cartpole_qlearning/ros/cartpole_sim.h"
 #include "cartpole_qlearning/ros/qlearning_controller.h"
-#include "cartpole_qlearning/ros/start_up.h"
+#include "start_up.h"
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
@@ -70,13 +70,59 @@ private:
   std::atomic<bool> stopping_{false};
   std::thread thread_;
 };
-}  // namespace
 
-class CartPoleSimNodelet : public nodelet::Nodelet
+// What differs between the two nodes as nodelets: how each is made and what it does when unloaded.
+template <class Node>
+struct NodeletTraits;
+
+template <>
+struct NodeletTraits<CartPoleSimNode>
+{
+  static constexpr const char* kType = "cartpole_sim";
+  static std::unique_ptr<CartPoleSimNode> make(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
+                                               ros::CallbackQueue* queue)
+  {
+    return std::make_unique<CartPoleSimNode>(nh, pnh, queue);
+  }
+  static void unload(CartPoleSimNode&) {}
+};
+
+template <>
+struct NodeletTraits<QLearningControllerNode>
+{
+  static constexpr const char* kType = "qlearning_controller";
+  // When training ends the controller saves, reports and stops acting; the manager and the other
+  // nodelets keep running unless ~shutdown_when_finished asks to end the manager (train.launch
+  // nodelet:=true, where the manager is the run's own).
+  static std::unique_ptr<QLearningControllerNode> make(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
+                                                       ros::CallbackQueue* queue)
+  {
+    return std::make_unique<QLearningControllerNode>(
+        nh, pnh, [] { ros::requestShutdown(); }, false, queue);
+  }
+  // Unloaded (or its manager stopping): zero effort first, as the executable does on Ctrl-C, since
+  // a robot's forward controller holds the last command forever. While ROS runs, a moment for the
+  // zero to leave on the connections to other processes, which the publishers' end closes.
+  static void unload(QLearningControllerNode& node)
+  {
+    if (ros::ok())
+    {
+      node.stop();
+      ros::WallDuration(0.2).sleep();
+    }
+  }
+};
+
+// A node class as a nodelet: the same class the executable runs, its lockstep topics on the
+// manager's lockstep thread.
+template <class Node>
+class NodeNodelet : public nodelet::Nodelet
 {
 public:
-  ~CartPoleSimNodelet() override
+  ~NodeNodelet() override
   {
+    if (node_)
+      NodeletTraits<Node>::unload(*node_);
     node_.reset();  // before the thread that serves its callbacks
   }
 
@@ -87,56 +133,23 @@ private:
     // manager instead (as for the executables), and the manager is told it failed.
     std::string reason;
     if (!startNode(
-            "cartpole_sim",
+            NodeletTraits<Node>::kType, getName(),
             [&] {
               lockstep_ = LockstepThread::acquire();
-              node_ = std::make_unique<CartPoleSimNode>(getNodeHandle(), getPrivateNodeHandle(), lockstep_->queue());
+              node_ = NodeletTraits<Node>::make(getNodeHandle(), getPrivateNodeHandle(), lockstep_->queue());
             },
             &reason))
       throw std::runtime_error(reason);
   }
 
   std::shared_ptr<LockstepThread> lockstep_;
-  std::unique_ptr<CartPoleSimNode> node_;
+  std::unique_ptr<Node> node_;
 };
 
-class QLearningControllerNodelet : public nodelet::Nodelet
-{
-public:
-  ~QLearningControllerNodelet() override
-  {
-    // Unloaded (or its manager stopping): zero effort first, as the executable does on Ctrl-C, since
-    // a robot's forward controller holds the last command forever. While ROS runs, a moment for
-    // the zero to leave on the connections to other processes, which the publishers' end closes.
-    if (node_ && ros::ok())
-    {
-      node_->stop();
-      ros::WallDuration(0.2).sleep();
-    }
-    node_.reset();  // before the thread that serves its callbacks
-  }
+}  // namespace
 
-private:
-  void onInit() override
-  {
-    // When training ends the controller saves, reports and stops acting; the manager and the
-    // other nodelets keep running unless ~shutdown_when_finished asks to end the manager
-    // (train.launch nodelet:=true, where the manager is the run's own).
-    std::string reason;
-    if (!startNode(
-            "qlearning_controller",
-            [&] {
-              lockstep_ = LockstepThread::acquire();
-              node_ = std::make_unique<QLearningControllerNode>(
-                  getNodeHandle(), getPrivateNodeHandle(), [] { ros::requestShutdown(); }, false, lockstep_->queue());
-            },
-            &reason))
-      throw std::runtime_error(reason);
-  }
-
-  std::shared_ptr<LockstepThread> lockstep_;
-  std::unique_ptr<QLearningControllerNode> node_;
-};
+using CartPoleSimNodelet = NodeNodelet<CartPoleSimNode>;
+using QLearningControllerNodelet = NodeNodelet<QLearningControllerNode>;
 
 }  // namespace cartpole_qlearning
 

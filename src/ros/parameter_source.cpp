@@ -1,4 +1,4 @@
-#include "cartpole_qlearning/ros/parameter_source.h"
+#include "parameter_source.h"
 
 #include <xmlrpcpp/XmlRpcValue.h>
 

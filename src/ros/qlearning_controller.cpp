@@ -1,29 +1,37 @@
 #include "cartpole_qlearning/ros/qlearning_controller.h"
 
 #include "cartpole_qlearning/ros/conversions.h"
-#include "cartpole_qlearning/ros/launch_control.h"
-#include "cartpole_qlearning/ros/parameter_source.h"
+#include "command_publisher.h"
+#include "launch_control.h"
+#include "parameter_source.h"
+#include "reset_caller.h"
+#include "start_up.h"
 
 #include <ros/names.h>
 #include <ros/package.h>
 
 #include <algorithm>
-#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <utility>
 
 #include <unistd.h>
 
 namespace cartpole_qlearning
 {
+struct QLearningControllerNode::Robot
+{
+  std::string name;    // its namespace relative to the learner's ("" : the learner's own)
+  ros::NodeHandle nh;  // in that namespace
+  ros::Subscriber state_sub;
+  CommandPublisher command;               // ~command_type on joint_command
+  ros::Publisher stats_pub;               // only for a robot in a namespace of its own
+  std::unique_ptr<ResetCaller> resetter;  // none without a reset service
+};
+
 namespace
 {
-double secondsSince(std::chrono::steady_clock::time_point then)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - then).count();
-}
-
 // The prefix of the node's lines: written here only.
 std::string prefixed(const LogLine& log)
 {
@@ -34,7 +42,7 @@ std::string prefixed(const LogLine& log)
 QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
                                                  std::function<void()> shutdown, bool shutdown_by_default,
                                                  ros::CallbackQueue* state_queue)
-  : nh_(nh), pnh_(pnh), shutdown_(std::move(shutdown))
+  : nh_(nh), pnh_(pnh), name_(nodeLogger("qlearning_controller", pnh.getNamespace())), shutdown_(std::move(shutdown))
 {
   std::unique_lock<std::mutex> lock(mutex_);
   readParameters(shutdown_by_default);
@@ -56,46 +64,32 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
   load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
   setUpRobots(state_queue);
-  if (settings_.protocol.reset_service)
-  {
-    // docs/nodes.md: the ~reset_service row.
-    const auto give_up_after = resetGiveUpAfter(settings_.sim_timeout);
-    for (Robot& robot : robots_)
-      robot.resetter = std::make_unique<ResetCaller>(robot.nh.resolveName(settings_.reset_service),
-                                                     settings_.reset_service_type, give_up_after);
-  }
   watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, settings_.sim_timeout / 2.0)),
                                     &QLearningControllerNode::onWatchdog, this);
   std::string served;
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
-  say(LogLine::Level::Info, "%s",
-      controllerStartText(settings_, session_->table(), app_->tableDirectory(), served).c_str());
+  say({{LogLine::Level::Info, controllerStartText(settings_, session_->table(), app_->tableDirectory(), served)}});
   lock.unlock();
   startLiveTuning();
 }
 
 void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
 {
-  rounds_ = std::make_unique<RobotRounds>(
-      settings_.robots.size(), settings_.sync,
-      std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(settings_.sim_timeout)));
   robots_.resize(settings_.robots.size());
-  const auto now = std::chrono::steady_clock::now();
+  std::vector<std::string> names;  // as the log names the robots
   for (std::size_t r = 0; r < robots_.size(); ++r)
   {
     Robot& robot = robots_[r];
     robot.name = settings_.robots[r];
-    ControllerProtocolParams params = settings_.protocol;
-    params.robot = r;
-    robot.protocol = std::make_unique<ControllerProtocol>(*session_, params);
     robot.nh = robot.name.empty() ? nh_ : ros::NodeHandle(nh_, robot.name);
     robot.command = CommandPublisher(robot.nh, settings_.robot.command_topic, settings_.robot);
-    robot.mapping = std::make_unique<StateMapping>(settings_.robot);
-    robot.decisions = std::make_unique<DecisionClock>(settings_.robot.decision_period);
     if (!robot.name.empty())
       robot.stats_pub = robot.nh.advertise<EpisodeStats>("episode_stats", 100);
-    robot.last_state_at = now;
+    if (settings_.protocol.reset_service)  // docs/nodes.md: the ~reset_service row
+      robot.resetter = std::make_unique<ResetCaller>(
+          robot.nh.resolveName(settings_.reset_service), settings_.reset_service_type,
+          resetGiveUpAfter(settings_.sim_timeout), [this](const LogLines& log) { say(log); });
     ros::NodeHandle state_nh(robot.nh);
     if (state_queue != nullptr)
       state_nh.setCallbackQueue(state_queue);
@@ -104,7 +98,10 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
         settings_.robot.state_topic, 10,
         [this, r](const sensor_msgs::JointStateConstPtr& msg) { onJointState(r, msg); }, ros::VoidConstPtr(),
         ros::TransportHints().tcpNoDelay());
+    names.push_back(describe(robot));
   }
+  const RobotDispatchParams dispatch{names, settings_.sync, settings_.sim_timeout, settings_.robot, settings_.protocol};
+  dispatch_ = std::make_unique<RobotDispatch>(*session_, dispatch, WallClock::now());
 }
 
 QLearningControllerNode::~QLearningControllerNode()
@@ -143,35 +140,15 @@ void QLearningControllerNode::readParameters(bool shutdown_by_default)
     std::string error;
     return ros::names::validate(name, error) ? std::string() : error;
   };
-  // Live tuning's values, which the controller's own dynamic_reconfigure server keeps there.
-  for (const auto& param : LearningConfig::__getParamDescriptions__())
-    context.other_keys.push_back(param->name);
+  // Live tuning's values, which the controller's dynamic_reconfigure server keeps there.
+  context.other_keys = learningConfigKeys();
   context.suite_folders = {ros::package::getPath("cartpole_qlearning") + "/config"};
   settings_ = readControllerSettings(RosParameterSource(nh_), RosParameterSource(pnh_), context);
-}
-
-bool QLearningControllerNode::extractState(Robot& robot, const sensor_msgs::JointState& msg, CartPoleState& state) const
-{
-  const Reading<JointReadings> reading =
-      readingsFromJointState(msg, settings_.robot.cart_joint, settings_.robot.pole_joint);
-  if (!reading)
-  {
-    if (bad_state_warning_.ready())
-      say(LogLine::Level::Warn, "%s", reading.refusal.c_str());
-    return false;
-  }
-  state = robot.mapping->map(msg.header.stamp.toNSec(), *reading.value);
-  return true;
 }
 
 std::string QLearningControllerNode::describe(const Robot& robot) const
 {
   return robot.state_sub.getTopic().empty() ? robot.name : robot.state_sub.getTopic();
-}
-
-void QLearningControllerNode::command(Robot& robot, double effort, const ros::Time& stamp)
-{
-  robot.command.publish(effort, stamp);
 }
 
 void QLearningControllerNode::stop()
@@ -187,75 +164,52 @@ void QLearningControllerNode::stop()
 void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::JointStateConstPtr& msg)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
-  CartPoleState state;
-  Robot& robot = robots_[r];
-  if (app_->finished() || !extractState(robot, *msg, state))
+  if (app_->finished())
     return;
-  robot.last_state_at = std::chrono::steady_clock::now();
-  if (robot.silent_reported)
+  const Reading<JointReadings> reading =
+      readingsFromJointState(*msg, settings_.robot.cart_joint, settings_.robot.pole_joint);
+  if (!reading)
   {
-    robot.silent_reported = false;
-    say(LogLine::Level::Info, "joint_states are back on %s; going on", describe(robot).c_str());
-  }
-  if (rounds_->heard(r, robot.last_state_at))
-    say(LogLine::Level::Info, "%s takes part in the rounds again", describe(robot).c_str());
-
-  const ros::Time stamp = msg->header.stamp;
-  const DecisionClock::Verdict decision = robot.decisions->onState(stamp.toNSec());
-  if (decision.slow && slow_states_warning_.ready())
-    say(LogLine::Level::Warn,
-        "joint_states on %s come further apart than ~decision_period = %g s, the step the table learns",
-        describe(robot).c_str(), settings_.robot.decision_period);
-  // A fall ends the running episode whenever it comes, not a period later.
-  const bool falls =
-      robot.protocol->phase() == ControllerProtocol::Phase::InEpisode && session_->task().isTerminal(state);
-  if (!decision.decide && !falls)
-    return robot.command.hold(stamp);
-  if (!rounds_->holds() || !robot.protocol->takesAsNew(stamp.toNSec()))
-  {
-    serve(r, stamp, state);
+    if (bad_state_warning_.ready())
+      say({{LogLine::Level::Warn, reading.refusal}});
     return;
   }
-  robot.held_stamp = stamp;
-  robot.held_state = state;
-  rounds_->hold(r);
-  serveRounds();
+  const RobotDispatch::Orders orders =
+      dispatch_->onState(r, msg->header.stamp.toNSec(), *reading.value, WallClock::now());
+  say(orders.log);
+  if (orders.hold)
+    return robots_[r].command.hold(msg->header.stamp);
+  serveDue();
 }
 
-void QLearningControllerNode::serveRounds()
+void QLearningControllerNode::serveDue()
 {
-  while (!app_->finished() && rounds_->roundComplete())
+  while (!app_->finished())
   {
-    for (std::size_t r = 0; r < robots_.size() && !app_->finished(); ++r)
-    {
-      if (!rounds_->held(r))
-        continue;
-      rounds_->take(r);
-      serve(r, robots_[r].held_stamp, robots_[r].held_state);
-    }
+    const std::optional<RobotDispatch::Turn> turn = dispatch_->next(WallClock::now());
+    if (!turn)
+      return;
+    serve(*turn);
   }
 }
 
-void QLearningControllerNode::serve(std::size_t r, const ros::Time& stamp, const CartPoleState& state)
+void QLearningControllerNode::serve(const RobotDispatch::Turn& turn)
 {
-  Robot& robot = robots_[r];
-  const Reaction reaction = robot.protocol->onState(stamp.toNSec(), state);
-  report(robot, reaction, stamp);
+  Robot& robot = robots_[turn.robot];
+  const Reaction& reaction = turn.reaction;
+  const ros::Time stamp = ros::Time().fromNSec(turn.stamp);
+  say(turn.log);
   if (reaction.answer)
-    command(robot, reaction.effort, stamp);
+    robot.command.publish(reaction.effort, stamp);
   if (reaction.episode_ended && !reaction.answer)
     robot.command.stop();
   if (reaction.episode_ended)
     endEpisode(robot, stamp, reaction.training_finished);
-  if (reaction.request_reset && !app_->finished())
-    requestReset(r);
-}
-
-void QLearningControllerNode::report(const Robot& robot, const Reaction& reaction, const ros::Time& stamp)
-{
-  say(reactionLog(
-      reaction, robot.protocol->counts(), describe(robot), stamp.toSec(),
-      [this] { return dropped_state_warning_.ready(); }, [this] { return restart_warning_.ready(); }));
+  // Reset calls run on threads of their own (ResetCaller): a blocking call from this callback would
+  // never return if the sim's service ran on the same single thread (nodelets), and a robot whose
+  // call hangs must not hold up the others. None once the destructor has begun.
+  if (reaction.request_reset && !app_->finished() && robot.resetter)
+    robot.resetter->request();
 }
 
 void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, bool training_finished)
@@ -280,14 +234,9 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
 
 void QLearningControllerNode::endWhenFinished()
 {
-  if (!settings_.shutdown_when_finished)
-    return;
-  if (endParentLaunch())
-  {
-    say(LogLine::Level::Info, "done; ending the launch");
-    return;
-  }
-  if (shutdown_)
+  if (settings_.shutdown_when_finished && endParentLaunch())
+    say({{LogLine::Level::Info, "done; ending the launch"}});
+  else if (settings_.shutdown_when_finished && shutdown_)
     shutdown_();
 }
 
@@ -319,26 +268,20 @@ void QLearningControllerNode::startRun()
   // A respawn of a run that has finished stays up rather than exit (under respawn that would
   // only start it again), and ends the launch when asked to.
   if (app_->finished() && settings_.shutdown_when_finished && endParentLaunch())
-    say(LogLine::Level::Info, "ending the launch");
+    say({{LogLine::Level::Info, "ending the launch"}});
 }
 
 bool QLearningControllerNode::onSave(SaveQTable::Request& request, SaveQTable::Response& response)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const ServiceAnswer answer = app_->save(request.path);
-  response.success = answer.success;
-  response.message = answer.message;
-  say(answer.log);
+  say(toResponse(app_->save(request.path), response));
   return true;
 }
 
 bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::Response& response)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
-  const ServiceAnswer answer = app_->load(request.path);
-  response.success = answer.success;
-  response.message = answer.message;
-  say(answer.log);
+  say(toResponse(app_->load(request.path), response));
   return true;
 }
 
@@ -347,41 +290,33 @@ void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
   const std::lock_guard<std::mutex> lock(mutex_);
   if (app_->finished())
     return;
-  for (Robot& robot : robots_)
-  {
-    if (robot.silent_reported || secondsSince(robot.last_state_at) < settings_.sim_timeout)
-      continue;
-    robot.silent_reported = true;
-    robot.command.stop();
-    say(LogLine::Level::Warn, "no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting for it",
-        describe(robot).c_str(), settings_.sim_timeout);
-  }
-  const std::vector<std::size_t> dropped = rounds_->dropOuts(WallClock::now());
-  for (const std::size_t r : dropped)
-    say(LogLine::Level::Warn, "%s is silent; the rounds go on without it until it is back", describe(robots_[r]).c_str());
-  if (!dropped.empty())
-    serveRounds();
+  const RobotDispatch::Orders orders = dispatch_->onTick(WallClock::now());
+  for (const std::size_t r : orders.stop)
+    robots_[r].command.stop();
+  say(orders.log);
+  serveDue();
 }
 
 void QLearningControllerNode::startLiveTuning()
 {
+  std::optional<LearningConfig> running;
   {
     const std::lock_guard<std::mutex> lock(mutex_);
-    // The server starts from what it finds on the parameter server. A respawn finds the values
-    // its predecessor served, the live tuning of this run, and goes on with them (onReconfigure
-    // says so). A new run starts from its configuration: what an earlier node left is replaced.
+    // A new run starts from its configuration: what an earlier node left on the parameter server
+    // is replaced, and said. A respawn finds the values its predecessor served, the live tuning of
+    // this run, and goes on with them (onReconfigure says so).
     if (!app_->respawned())
     {
-      const LearningSettings& running = session_->learningSettings();
-      LearningConfig left = toConfig(running);
-      left.__fromServer__(pnh_);  // only the fields present there change
-      LearningSettings left_settings = running;
-      fromConfig(left, left_settings);
-      say(liveTuningReplacedLog(left_settings, running));
-      toConfig(session_->learningSettings()).__toServer__(pnh_);
+      const LearningSettings& in_use = session_->learningSettings();
+      say(liveTuningReplacedLog(learningSettingsLeft(RosParameterSource(pnh_), in_use), in_use));
+      running = toConfig(in_use);
     }
   }
+  // With mutex_ free: setCallback calls onReconfigure at once, which takes it. The server starts
+  // from what it finds on the parameter server; a new run gives it the values in use first.
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<LearningConfig>>(reconfigure_mutex_, pnh_);
+  if (running)
+    reconfigure_->updateConfig(*running);
   reconfigure_->setCallback([this](LearningConfig& config, std::uint32_t level) { onReconfigure(config, level); });
 }
 
@@ -401,39 +336,10 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
   say(liveTuningLog(in_use, wanted, asServerField(error), first && app_->respawned(), settings_.run.learning));
 }
 
-void QLearningControllerNode::requestReset(std::size_t robot)
-{
-  // None once the destructor has begun.
-  if (robots_.at(robot).resetter)
-    robots_.at(robot).resetter->request();
-}
-
 void QLearningControllerNode::say(const LogLines& log) const
 {
   for (const LogLine& line : log)
-  {
-    switch (line.level)
-    {
-      case LogLine::Level::Info:
-        ROS_INFO_STREAM_NAMED("qlearning_controller", prefixed(line));
-        break;
-      case LogLine::Level::Warn:
-        ROS_WARN_STREAM_NAMED("qlearning_controller", prefixed(line));
-        break;
-      case LogLine::Level::Error:
-        ROS_ERROR_STREAM_NAMED("qlearning_controller", prefixed(line));
-        break;
-    }
-  }
-}
-
-void QLearningControllerNode::say(LogLine::Level level, const char* format, ...) const
-{
-  std::va_list args;
-  va_start(args, format);
-  const std::string text = formatTextV(format, args);
-  va_end(args);
-  say({{level, text}});
+    logLine(name_, line.level, prefixed(line));
 }
 
 }  // namespace cartpole_qlearning

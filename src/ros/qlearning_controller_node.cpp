@@ -1,6 +1,6 @@
 // qlearning_controller: the tabular Q-learning controller (see ros/qlearning_controller.h).
 #include "cartpole_qlearning/ros/qlearning_controller.h"
-#include "cartpole_qlearning/ros/start_up.h"
+#include "start_up.h"
 
 #include <atomic>
 #include <csignal>
@@ -26,7 +26,7 @@ int main(int argc, char** argv)
   ros::NodeHandle nh;
   ros::NodeHandle pnh("~");
   std::unique_ptr<cartpole_qlearning::QLearningControllerNode> node;
-  if (!cartpole_qlearning::startNode("qlearning_controller", [&] {
+  if (!cartpole_qlearning::startNode("qlearning_controller", ros::this_node::getName(), [&] {
         node = std::make_unique<cartpole_qlearning::QLearningControllerNode>(
             nh, pnh, [] { ros::shutdown(); }, true);
       }))

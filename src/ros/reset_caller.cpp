@@ -1,4 +1,4 @@
-#include "cartpole_qlearning/ros/reset_caller.h"
+#include "reset_caller.h"
 
 #include "cartpole_qlearning/Reset.h"
 
@@ -73,9 +73,11 @@ struct ResetCaller::Shared
   std::optional<bool> handed;
 };
 
-ResetCaller::ResetCaller(std::string service, std::string type, std::chrono::steady_clock::duration give_up_after)
+ResetCaller::ResetCaller(std::string service, std::string type, std::chrono::steady_clock::duration give_up_after,
+                         std::function<void(const LogLines&)> log)
   : service_(std::move(service)),
     type_(std::move(type)),
+    log_(std::move(log)),
     calls_(service_, give_up_after),
     shared_(std::make_shared<Shared>())
 {
@@ -173,13 +175,8 @@ void ResetCaller::carryOut(const ResetCalls::Orders& orders)
   if (orders.give_up && caller_.joinable())
     caller_.detach();  // blocked in its call, or about to see that it was given up
   shared_->generation = calls_.generation();
-  for (const LogLine& line : orders.log)
-  {
-    if (line.level == LogLine::Level::Warn)
-      ROS_WARN_NAMED("qlearning_controller", "qlearning_controller: %s", line.text.c_str());
-    else
-      ROS_INFO_NAMED("qlearning_controller", "qlearning_controller: %s", line.text.c_str());
-  }
+  if (!orders.log.empty() && log_)
+    log_(orders.log);
   if (orders.call)
   {
     if (!caller_.joinable())

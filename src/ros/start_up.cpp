@@ -1,14 +1,57 @@
-#include "cartpole_qlearning/ros/start_up.h"
+#include "start_up.h"
 
-#include "cartpole_qlearning/ros/launch_control.h"
+#include "launch_control.h"
 
 #include <ros/console.h>
 
+#include <algorithm>
 #include <exception>
+#include <map>
+#include <mutex>
+#include <utility>
 
 namespace cartpole_qlearning
 {
-bool startNode(const std::string& name, const std::function<void()>& start, std::string* reason)
+std::string nodeLogger(const std::string& type, const std::string& node_name)
+{
+  std::string name = node_name;
+  std::replace(name.begin(), name.end(), '/', '.');
+  if (!name.empty() && name.front() == '.')
+    name.erase(0, 1);
+  return name.empty() ? type : type + "." + name;
+}
+
+void logLine(const std::string& logger, ros::console::Level level, const std::string& text)
+{
+  // rosconsole keeps the address of every place it has set up (to update it when a level is
+  // changed), so these are never freed.
+  static std::mutex mutex;
+  static auto* const places = new std::map<std::pair<std::string, int>, ros::console::LogLocation*>();
+  ros::console::LogLocation* place = nullptr;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    ros::console::LogLocation*& found = (*places)[{logger, static_cast<int>(level)}];
+    if (found == nullptr)
+    {
+      ROSCONSOLE_AUTOINIT;
+      found = new ros::console::LogLocation{false, false, ros::console::levels::Count, nullptr};
+      ros::console::initializeLogLocation(found, std::string(ROSCONSOLE_NAME_PREFIX) + "." + logger, level);
+    }
+    place = found;
+  }
+  if (place->logger_enabled_)
+    ros::console::print(nullptr, place->logger_, place->level_, __FILE__, __LINE__, __func__, "%s", text.c_str());
+}
+
+void logLine(const std::string& logger, LogLine::Level level, const std::string& text)
+{
+  static const ros::console::Level kLevels[] = {ros::console::levels::Info, ros::console::levels::Warn,
+                                                ros::console::levels::Error};
+  logLine(logger, kLevels[static_cast<int>(level)], text);
+}
+
+bool startNode(const std::string& type, const std::string& node_name, const std::function<void()>& start,
+               std::string* reason)
 {
   // Only the start-up is caught here: an exception from a callback later is a crash like any
   // other, and under train.launch the node respawns.
@@ -19,10 +62,12 @@ bool startNode(const std::string& name, const std::function<void()>& start, std:
   }
   catch (const std::exception& e)
   {
-    // ros.cartpole_qlearning.<name>: the logger the node logs on afterwards.
-    ROS_FATAL_STREAM_NAMED(name, name << ": " << e.what());
+    // The logger the node logs on afterwards.
+    const std::string logger = nodeLogger(type, node_name);
+    logLine(logger, ros::console::levels::Fatal, type + ": " + e.what());
     if (endParentLaunch())
-      ROS_FATAL_STREAM_NAMED(name, name << ": ending the launch: this cannot work until the above is fixed");
+      logLine(logger, ros::console::levels::Fatal,
+              type + ": ending the launch: this cannot work until the above is fixed");
     if (reason != nullptr)
       *reason = e.what();
     return false;

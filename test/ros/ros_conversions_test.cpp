@@ -2,7 +2,9 @@
 // the sim publishes is what the controller reads, commands carry the stamp of the state they
 // answer, a refused message says why in the words the nodes log, episode_stats on the learner's
 // and a robot's topic, and the live-tuning server's fields to and from the core's settings.
+#include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/ros/conversions.h"
+#include "../../src/ros/start_up.h"
 
 #include "cartpole_qlearning/learning/schedule.h"
 #include "cartpole_qlearning/learning/training_session.h"
@@ -11,6 +13,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <string>
 
 using namespace cartpole_qlearning;
@@ -444,6 +447,111 @@ TEST(LearningConfigConversion, TheCoresFieldNamesBecomeTheServers)
   EXPECT_EQ("", asServerField(""));
 }
 
+TEST(ServiceConversion, TheAnswerFillsTheResponseAndItsLinesAreReturned)
+{
+  struct
+  {
+    bool success = true;
+    std::string message = "saved";
+    LogLines log = {{LogLine::Level::Info, "saved 3 episodes"}};
+  } answer;
+  SaveQTable::Response response;
+  const LogLines& log = toResponse(answer, response);
+  EXPECT_TRUE(response.success);
+  EXPECT_EQ("saved", response.message);
+  ASSERT_EQ(1u, log.size());
+  EXPECT_EQ("saved 3 episodes", log[0].text);
+}
+
+// The keys the controller lets pass on its private namespace and reads there are the cfg's fields,
+// all of them, in its order.
+TEST(LearningConfigConversion, TheKeysAreTheCfgsFields)
+{
+  std::vector<std::string> cfg;
+  for (const auto& param : LearningConfig::__getParamDescriptions__())
+    cfg.push_back(param->name);
+  EXPECT_EQ(cfg, learningConfigKeys());
+}
+
+namespace
+{
+// Parameters as a map, the server's fields only (numbers and strings).
+class FieldSource : public ParameterSource
+{
+public:
+  std::map<std::string, double> numbers;
+  std::map<std::string, std::string> texts;
+  bool get(const std::string& key, double& value) const override
+  {
+    if (texts.count(key) != 0)
+      throw ConfigError(key + " must be a number");
+    return find(numbers, key, value);
+  }
+  bool get(const std::string&, std::int64_t&) const override
+  {
+    return false;
+  }
+  bool get(const std::string&, bool&) const override
+  {
+    return false;
+  }
+  bool get(const std::string& key, std::string& value) const override
+  {
+    return find(texts, key, value);
+  }
+  bool get(const std::string&, std::vector<double>&) const override
+  {
+    return false;
+  }
+  bool get(const std::string&, std::vector<std::string>&) const override
+  {
+    return false;
+  }
+  std::vector<std::string> keysUnder(const std::string&) const override
+  {
+    return {};
+  }
+  std::string origin() const override
+  {
+    return "test";
+  }
+
+private:
+  template <typename T>
+  static bool find(const std::map<std::string, T>& values, const std::string& key, T& value)
+  {
+    const auto it = values.find(key);
+    if (it == values.end())
+      return false;
+    value = it->second;
+    return true;
+  }
+};
+}  // namespace
+
+TEST(LearningConfigConversion, WhatAnEarlierServerLeftReplacesOnlyTheFieldsPresent)
+{
+  const LearningSettings in_use = unusualSettings();
+  EXPECT_TRUE(liveTuningReplacedLog(learningSettingsLeft(FieldSource(), in_use), in_use).empty())
+      << "nothing left: nothing replaced";
+
+  FieldSource left;
+  left.numbers["gamma"] = 0.5;
+  left.numbers["alpha_min"] = 0.0125;
+  left.numbers["epsilon_override"] = -1.0;
+  left.texts["epsilon_schedule"] = "constant";
+  left.texts["alpha_decay_rate"] = "fast";  // a wrong type: left as it was
+  const LearningSettings read = learningSettingsLeft(left, in_use);
+  EXPECT_EQ(0.5, read.gamma);
+  EXPECT_EQ(0.0125, read.alpha.min);
+  EXPECT_FALSE(read.epsilon_override);
+  EXPECT_EQ(ScheduleType::Constant, read.epsilon.type);
+  EXPECT_EQ(in_use.alpha.decay_rate, read.alpha.decay_rate);
+  EXPECT_EQ(in_use.epsilon.min, read.epsilon.min);
+  EXPECT_EQ(in_use.alpha.type, read.alpha.type);
+  EXPECT_FALSE(liveTuningReplacedLog(read, in_use).empty());
+}
+
 // What onReconfigure does with a client's change, without the server: the change as the node
 // announces it, a refusal in the server's names, and the values it then answers with. (The
 // texts were checked in live_tuning.test on the running controller; the rostest keeps the wiring.)
@@ -506,4 +614,31 @@ TEST(LearningConfigConversion, BackToTheSchedulesTheyResumeAtTheEpisodeCount)
   const double expected = Schedule(AgentParams().epsilon).value(30);
   EXPECT_GT(expected, 0.0);
   EXPECT_DOUBLE_EQ(expected, session.lastEpisode().epsilon);
+}
+
+// The loggers of node instances: named after each node, and apart even when one line of code logs
+// for both (ROS_*_NAMED would keep the first name it met there).
+TEST(NodeLogger, EveryInstanceHasALoggerOfItsOwnUnderItsType)
+{
+  EXPECT_EQ("cartpole_sim.robot_1.cartpole_sim", nodeLogger("cartpole_sim", "/robot_1/cartpole_sim"));
+  EXPECT_EQ("qlearning_controller.cartpole.qlearning_controller",
+            nodeLogger("qlearning_controller", "/cartpole/qlearning_controller"));
+  EXPECT_EQ("cartpole_sim", nodeLogger("cartpole_sim", ""));
+
+  struct Lines : ros::console::LogAppender
+  {
+    std::vector<std::string> texts;
+    void log(ros::console::Level, const char* str, const char*, const char*, int) override
+    {
+      texts.push_back(str);
+    }
+  } lines;
+  ros::console::register_appender(&lines);
+  ros::console::set_logger_level(std::string(ROSCONSOLE_NAME_PREFIX) + ".cartpole_sim.a.cartpole_sim",
+                                 ros::console::levels::Error);
+  ros::console::notifyLoggerLevelsChanged();
+  for (const std::string name : {"/a/cartpole_sim", "/b/cartpole_sim"})
+    logLine(nodeLogger("cartpole_sim", name), LogLine::Level::Warn, name);
+  ros::console::deregister_appender(&lines);
+  EXPECT_EQ(std::vector<std::string>{"/b/cartpole_sim"}, lines.texts) << "the first sim's logger is set to errors only";
 }

@@ -11,7 +11,8 @@
 //     destructor does not wait for a hung call.
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/Reset.h"
-#include "cartpole_qlearning/ros/reset_caller.h"
+#include "../../src/ros/reset_caller.h"
+#include "../../src/ros/start_up.h"
 
 #include "ros_test_support.h"
 #include "rostest_main.h"
@@ -235,7 +236,11 @@ TEST(HungReset, ResetCallerGivesAHungCallUpOnANewThreadAndDoesNotWaitForItAtTheE
   const std::string answers_again = std::string(kCallerService) + " answers again";
   LogLines log(kCallerService);
   HangingReset service(kCallerService, "");
-  auto caller = std::make_unique<ResetCaller>(kCallerService, "cartpole_qlearning/Reset", std::chrono::seconds(1));
+  auto caller = std::make_unique<ResetCaller>(kCallerService, "cartpole_qlearning/Reset", std::chrono::seconds(1),
+                                              [](const cartpole_qlearning::LogLines& lines) {
+                                                for (const cartpole_qlearning::LogLine& line : lines)
+                                                  cartpole_qlearning::logLine("hung_reset_test", line.level, line.text);
+                                              });
 
   // The first call hangs; after 1 s it is given up and made again on a fresh connection.
   caller->request();

@@ -14,7 +14,11 @@ public:
   // True at most once per period: the caller logs then.
   bool ready()
   {
-    const auto now = std::chrono::steady_clock::now();
+    return ready(std::chrono::steady_clock::now());
+  }
+  // The same, at a time the caller gives (a clock injected in tests).
+  bool ready(std::chrono::steady_clock::time_point now)
+  {
     if (fired_ && now - last_ < period_)
       return false;
     fired_ = true;

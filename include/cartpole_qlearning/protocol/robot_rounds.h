@@ -17,7 +17,8 @@ namespace cartpole_qlearning
 class RobotRounds
 {
 public:
-  RobotRounds(std::size_t robots, bool sync, WallClock::duration drop_out_after);
+  // Every robot counts as heard at start.
+  RobotRounds(std::size_t robots, bool sync, WallClock::duration drop_out_after, WallClock::time_point start);
 
   // A state of the robot arrived (any state). Returns true when the robot had dropped out and
   // now takes part again.
@@ -46,6 +47,11 @@ public:
   bool takesPart(std::size_t robot) const
   {
     return taking_part_.at(robot);
+  }
+  // How long the robot has been silent: since it was last heard (or since start).
+  WallClock::duration silentFor(std::size_t robot, WallClock::time_point now) const
+  {
+    return now - last_heard_.at(robot);
   }
 
 private:

@@ -38,6 +38,8 @@ public:
 
 private:
   void readParameters();
+  // One line on this instance's logger (name_).
+  void say(ros::console::Level level, const char* format, ...) const __attribute__((format(printf, 3, 4)));
   void onJointCommand(const sensor_msgs::JointStateConstPtr& msg);
   void onEffort(const std_msgs::Float64ConstPtr& msg);
   // group_effort (std_msgs/Float64MultiArray, unstamped, as a JointGroupEffortController takes it): the slot
@@ -74,6 +76,7 @@ private:
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
+  std::string name_;  // the logger of this instance: ros.cartpole_qlearning.cartpole_sim.<its name>
   // Callbacks may run on two threads (a nodelet's command topics on the lockstep thread, its
   // timer and service on the manager's): each holds this while it runs.
   std::mutex mutex_;

@@ -7,6 +7,7 @@
 #include "cartpole_qlearning/LearningConfig.h"
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
 #include "cartpole_qlearning/learning/learning_settings.h"
+#include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/protocol/robot_interface.h"
 #include "cartpole_qlearning/learning/training_session.h"
 
@@ -75,6 +76,16 @@ EpisodeStats learnerEpisodeStats(const EpisodeSummary& summary, const std::strin
 EpisodeStats robotEpisodeStats(const EpisodeSummary& summary, const std::string& robot, const ros::Time& stamp,
                                double steps_per_second);
 
+// A service's response (success, message) from the core's answer (RunApplication's ServiceAnswer);
+// returns what the answer has to say, for the node's log.
+template <typename Answer, typename Response>
+const auto& toResponse(const Answer& answer, Response& response)
+{
+  response.success = answer.success;
+  response.message = answer.message;
+  return answer.log;
+}
+
 // Live tuning: the server's fields <-> the core's settings. An override is off when negative
 // (the server shows it as -1).
 LearningConfig toConfig(const LearningSettings& settings);
@@ -85,5 +96,12 @@ std::string fromConfig(const LearningConfig& config, LearningSettings& settings)
 // The core names a schedule's field as the config file does ("epsilon/min = ..."); the server's
 // field is "epsilon_min".
 std::string asServerField(std::string message);
+// The server's fields as it keeps them on the parameter server, under the node's private
+// namespace ("gamma", "epsilon_schedule", ...): keys the node's parameter check must let pass.
+std::vector<std::string> learningConfigKeys();
+// What an earlier server left in source (the node's private namespace): the settings in use with
+// the fields present there replaced. A value of the wrong type leaves its field as it was, as the
+// server's own start does.
+LearningSettings learningSettingsLeft(const ParameterSource& source, const LearningSettings& in_use);
 
 }  // namespace cartpole_qlearning

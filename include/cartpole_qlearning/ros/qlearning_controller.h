@@ -3,12 +3,14 @@
 // joint_states, decides with the core's ControllerProtocol (which drives the shared
 // TrainingSession), answers on joint_command stamped with the state's stamp, ends episodes by
 // calling that robot's reset service (or, for a robot without one, waits for it to be stood
-// up), and publishes episode_stats. Several robots are served in lockstep rounds (RobotRounds)
-// unless ~sync is false. It saves and loads its Q-table through services, and serves its learning
+// up), and publishes episode_stats. Which robot's state it decides on, and when (rounds over
+// several robots unless ~sync is false, ~decision_period, the silence watchdog), is the core's
+// RobotDispatch. It saves and loads its Q-table through services, and serves its learning
 // settings (epsilon, alpha, gamma and their schedules) for live tuning with dynamic_reconfigure.
 // What a run writes and decides (its folder, checkpoints, resume, the curve, which save replaces
 // the default table, the evaluation verdict) is the core's RunApplication: the node carries it out
-// and logs what it says on its named logger (ros.cartpole_qlearning.qlearning_controller).
+// and logs what it says on a logger of its own instance
+// (ros.cartpole_qlearning.qlearning_controller.<its name, dots for slashes>).
 #pragma once
 
 #include "cartpole_qlearning/EpisodeStats.h"
@@ -16,14 +18,11 @@
 #include "cartpole_qlearning/LoadQTable.h"
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/learning/training_config.h"
-#include "cartpole_qlearning/ros/command_publisher.h"
-#include "cartpole_qlearning/ros/reset_caller.h"
-#include "cartpole_qlearning/protocol/lockstep_protocol.h"
 #include "cartpole_qlearning/application/node_settings.h"
-#include "cartpole_qlearning/protocol/robot_rounds.h"
 #include "cartpole_qlearning/application/run_application.h"
-#include "cartpole_qlearning/learning/training_session.h"
 #include "cartpole_qlearning/common/wall_throttle.h"
+#include "cartpole_qlearning/learning/training_session.h"
+#include "cartpole_qlearning/protocol/robot_dispatch.h"
 
 #include <boost/thread/recursive_mutex.hpp>
 #include <dynamic_reconfigure/server.h>
@@ -65,23 +64,9 @@ public:
   QLearningControllerNode& operator=(const QLearningControllerNode&) = delete;
 
 private:
-  // One robot the learner serves.
-  struct Robot
-  {
-    std::string name;    // its namespace relative to the learner's ("" : the learner's own)
-    ros::NodeHandle nh;  // in that namespace
-    std::unique_ptr<ControllerProtocol> protocol;
-    ros::Subscriber state_sub;
-    CommandPublisher command;  // ~command_type on joint_command
-    std::unique_ptr<StateMapping> mapping;
-    std::unique_ptr<DecisionClock> decisions;
-    ros::Publisher stats_pub;               // only for a robot in a namespace of its own
-    std::unique_ptr<ResetCaller> resetter;  // none without a reset service
-    ros::Time held_stamp;                   // a new state waiting for its round
-    CartPoleState held_state;
-    std::chrono::steady_clock::time_point last_state_at;
-    bool silent_reported = false;
-  };
+  // One robot the learner serves: its topics and its reset service (in the .cpp, with the
+  // helpers it holds, which are the node's own and not installed).
+  struct Robot;
 
   void readParameters(bool shutdown_by_default);
   // Serves the learning settings in use on ~set_parameters (dynamic_reconfigure). Called with
@@ -97,36 +82,26 @@ private:
   void endWhenFinished();
   void setUpRobots(ros::CallbackQueue* state_queue);
   void onJointState(std::size_t robot, const sensor_msgs::JointStateConstPtr& msg);
+  // Serves what the dispatch has to serve until it has nothing more or the run is over.
+  void serveDue();
   bool onSave(SaveQTable::Request& request, SaveQTable::Response& response);
   bool onLoad(LoadQTable::Request& request, LoadQTable::Response& response);
   void onWatchdog(const ros::SteadyTimerEvent& event);
 
-  // The state in a message, or false (with a throttled warning) when it cannot be used.
-  bool extractState(Robot& robot, const sensor_msgs::JointState& msg, CartPoleState& state) const;
-  // Hands one state to the robot's protocol and carries out its reaction.
-  void serve(std::size_t robot, const ros::Time& stamp, const CartPoleState& state);
-  // Serves every complete round of held states, in robot order.
-  void serveRounds();
-  void command(Robot& robot, double effort, const ros::Time& stamp);
+  // Carries out what the robot's protocol decided about one of its states.
+  void serve(const RobotDispatch::Turn& turn);
   // Carries out the application's episode end (statistics, progress, checkpoints, the final
   // save) and publishes episode_stats.
   void endEpisode(Robot& robot, const ros::Time& stamp, bool training_finished);
-  // Logs what the protocol did with a state that was not simply answered.
-  void report(const Robot& robot, const Reaction& reaction, const ros::Time& stamp);
   std::string describe(const Robot& robot) const;
 
-  // Reset calls run on threads of their own (ResetCaller, one per robot): a blocking service
-  // call from this node's callback would never return if the sim's service ran on the same
-  // single thread (nodelets), and a robot whose call hangs must not hold up the others.
-  void requestReset(std::size_t robot);
-
-  // The node's log: every line on its named logger, "qlearning_controller: " before those said
-  // with a prefix.
+  // The node's log: every line on its logger (name_), "qlearning_controller: " before those said
+  // with a prefix (the text users and the docs know the lines by).
   void say(const LogLines& log) const;
-  void say(LogLine::Level level, const char* format, ...) const __attribute__((format(printf, 3, 4)));
 
   ros::NodeHandle nh_;
   ros::NodeHandle pnh_;
+  std::string name_;  // the logger of this instance (nodeLogger)
   // Callbacks may run on two threads (a nodelet's joint_states on the lockstep thread, its
   // services and timer on the manager's): each holds this while it runs.
   std::mutex mutex_;
@@ -140,13 +115,9 @@ private:
   // The run around the session: what it writes and decides (finished(): serve no more states).
   std::unique_ptr<RunApplication> app_;
   std::vector<Robot> robots_;
-  std::unique_ptr<RobotRounds> rounds_;
+  std::unique_ptr<RobotDispatch> dispatch_;
 
-  mutable WallThrottle bad_state_warning_{1.0};
-  WallThrottle dropped_state_warning_{1.0};
-  WallThrottle slow_states_warning_{10.0};
-  // A replayed older stamp, sent twice, looks like a restarted sim: said at most once a second.
-  WallThrottle restart_warning_{1.0};
+  WallThrottle bad_state_warning_{1.0};
 
   ros::Publisher stats_pub_;
   ros::ServiceServer save_srv_;

@@ -13,10 +13,11 @@ using cartpole_qlearning::WallClock;
 using std::chrono::milliseconds;
 
 const WallClock::duration kTimeout = milliseconds(1000);
+const WallClock::time_point kT0{};
 
 TEST(RobotRounds, OneRobotsStateMakesARoundAtOnce)
 {
-  RobotRounds rounds(1, true, kTimeout);
+  RobotRounds rounds(1, true, kTimeout, kT0);
   EXPECT_FALSE(rounds.roundComplete()) << "a round of nothing";
   rounds.hold(0);
   EXPECT_TRUE(rounds.roundComplete());
@@ -26,7 +27,7 @@ TEST(RobotRounds, OneRobotsStateMakesARoundAtOnce)
 
 TEST(RobotRounds, ARoundWaitsForEveryRobotThatTakesPart)
 {
-  RobotRounds rounds(3, true, kTimeout);
+  RobotRounds rounds(3, true, kTimeout, kT0);
   rounds.hold(2);
   rounds.hold(0);
   rounds.hold(0);  // a newer state of the same robot replaces the one waiting
@@ -43,8 +44,9 @@ TEST(RobotRounds, ARoundWaitsForEveryRobotThatTakesPart)
 
 TEST(RobotRounds, ASilentRobotDropsOutOnlyWhileOthersWaitAndRejoinsWhenHeard)
 {
-  const WallClock::time_point t0 = WallClock::now();
-  RobotRounds rounds(3, true, kTimeout);
+  const WallClock::time_point t0 = kT0 + milliseconds(100);
+  RobotRounds rounds(3, true, kTimeout, kT0);
+  EXPECT_EQ(milliseconds(100), rounds.silentFor(2, t0)) << "silent since the start";
   for (std::size_t r = 0; r < 3; ++r)
     rounds.heard(r, t0);
   // Nobody waits: silence holds nobody up, so nobody drops out.
@@ -56,6 +58,7 @@ TEST(RobotRounds, ASilentRobotDropsOutOnlyWhileOthersWaitAndRejoinsWhenHeard)
   rounds.heard(2, t0 + milliseconds(5000));
   rounds.hold(2);
   EXPECT_TRUE(rounds.dropOuts(t0 + milliseconds(5000)).empty()) << "robot 1 was heard 0.5 s ago, not 1 s";
+  EXPECT_EQ(milliseconds(1000), rounds.silentFor(1, t0 + milliseconds(5500)));
   EXPECT_EQ(std::vector<std::size_t>{1}, rounds.dropOuts(t0 + milliseconds(5500)));
   EXPECT_TRUE(rounds.dropOuts(t0 + milliseconds(9000)).empty()) << "a robot drops out once";
   EXPECT_FALSE(rounds.takesPart(1));
@@ -75,8 +78,8 @@ TEST(RobotRounds, ASilentRobotDropsOutOnlyWhileOthersWaitAndRejoinsWhenHeard)
 
 TEST(RobotRounds, WithoutSyncNothingIsHeldBack)
 {
-  EXPECT_FALSE(RobotRounds(4, false, kTimeout).holds());
-  EXPECT_TRUE(RobotRounds(4, true, kTimeout).holds());
-  EXPECT_THROW(RobotRounds(0, true, kTimeout), std::invalid_argument);
+  EXPECT_FALSE(RobotRounds(4, false, kTimeout, kT0).holds());
+  EXPECT_TRUE(RobotRounds(4, true, kTimeout, kT0).holds());
+  EXPECT_THROW(RobotRounds(0, true, kTimeout, kT0), std::invalid_argument);
 }
 }  // namespace

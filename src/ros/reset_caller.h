@@ -1,10 +1,12 @@
 // A robot's reset service, called on threads of its own (see ResetCaller).
 #pragma once
 
+#include "cartpole_qlearning/common/log_line.h"
 #include "cartpole_qlearning/protocol/reset_calls.h"
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -23,8 +25,10 @@ class ResetCaller
 {
 public:
   // service: the service's resolved name; type: ~reset_service_type (cartpole_qlearning/Reset,
-  // std_srvs/Empty or std_srvs/Trigger); give_up_after: resetGiveUpAfter(~sim_timeout).
-  ResetCaller(std::string service, std::string type, std::chrono::steady_clock::duration give_up_after);
+  // std_srvs/Empty or std_srvs/Trigger); give_up_after: resetGiveUpAfter(~sim_timeout); log: says
+  // what ResetCalls says (the controller's log), called on this object's thread.
+  ResetCaller(std::string service, std::string type, std::chrono::steady_clock::duration give_up_after,
+              std::function<void(const LogLines&)> log);
   // Never waits for a call under way: gives it up as a hung one.
   ~ResetCaller();
 
@@ -46,6 +50,7 @@ private:
 
   const std::string service_;
   const std::string type_;
+  const std::function<void(const LogLines&)> log_;
   ResetCalls calls_;  // run()'s only (a given-up thread must not touch this object)
   std::shared_ptr<Shared> shared_;
   std::thread caller_;  // the current calling thread, if any; run()'s only

@@ -1,0 +1,34 @@
+// Starting a node class, for the executables' mains and the nodelets alike, and the logger each
+// node instance logs on.
+#pragma once
+
+#include "cartpole_qlearning/common/log_line.h"
+
+#include <ros/console.h>
+
+#include <functional>
+#include <string>
+
+namespace cartpole_qlearning
+{
+// The logger of one node instance (ROS_*_NAMED's name, under ros.cartpole_qlearning): its type,
+// then its name with dots for slashes ("cartpole_sim", "/robot_1/cartpole_sim" ->
+// "cartpole_sim.robot_1.cartpole_sim"), so that two sims in one manager log apart and a level
+// set on ros.cartpole_qlearning.cartpole_sim still reaches every sim.
+std::string nodeLogger(const std::string& type, const std::string& node_name);
+
+// One line on a logger named as above (under ros.cartpole_qlearning), at its level. Unlike
+// ROS_*_NAMED, whose call site keeps the logger it first met (a static per line of code, so a second
+// sim in the same manager would log on the first one's), every logger name gets its own place.
+void logLine(const std::string& logger, ros::console::Level level, const std::string& text);
+void logLine(const std::string& logger, LogLine::Level level, const std::string& text);
+
+// Runs start() (which constructs the node class) and returns true. When it throws (a bad
+// parameter, an unusable table file), logs the reason as FATAL, "type: reason", on the logger
+// nodeLogger(type, node_name), and, when roslaunch started this process, ends that launch: under
+// roslaunch the node may respawn, and would fail the same way forever. Returns false then, with
+// the reason in *reason when given.
+bool startNode(const std::string& type, const std::string& node_name, const std::function<void()>& start,
+               std::string* reason = nullptr);
+
+}  // namespace cartpole_qlearning
