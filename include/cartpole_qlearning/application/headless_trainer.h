@@ -57,7 +57,8 @@ inline std::vector<std::string> robotNamespaces(std::size_t count)
 class HeadlessTrainer
 {
 public:
-  // learning = false: greedy, no updates (an evaluation).
+  // learning = false: greedy, no updates (an evaluation). The simulations run on the config's
+  // engine: throws EngineError when it cannot be made (physics_engines.h).
   HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed, std::size_t robots = 1, bool learning = true);
 
   // Robot 0 alone: one whole episode from a random start; returns its summary.
