@@ -28,6 +28,7 @@ DEBIAN_PACKAGES=(
   python3-rospy xvfb imagemagick libgl1-mesa-dri python3-numpy python3-pil python3-yaml
   clang-14 libclang-rt-14-dev llvm-14
   python3-matplotlib python3-numpy python3-rosbag python3-rospy python3-genpy
+  libmujoco-dev
 )
 
 install_dependencies() {

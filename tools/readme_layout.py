@@ -39,7 +39,7 @@ def table():
          "core layer 2: files (atomic saves, confined paths, size-checked reads): "
          + quoted(stems("include/cartpole_qlearning/io", "src/io"))),
         ("`include/cartpole_qlearning/simulation/`, `src/simulation/`",
-         "core layer 3: the cart-pole's equations and what a real one does: "
+         "core layer 3: the cart-pole's physics (the equations; a MuJoCo model, its own library) and what a real one does: "
          + quoted(stems("include/cartpole_qlearning/simulation", "src/simulation"))),
         ("`include/cartpole_qlearning/learning/`, `src/learning/`",
          "core layer 4: the task, features, the Q-table and its file, the learner, a training session, the "
@@ -64,6 +64,7 @@ def table():
          + "; `config/robots/`: one profile per public cart-pole, for robot.launch's robot argument"),
         ("`launch/`", "the launch files users type: " + quoted(files("launch")) + "; `launch/include/` holds their parts"),
         ("`urdf/`, `rviz/`", "`cartpole.urdf` (links match the TF frames), `cartpole.rviz`"),
+        ("`mjcf/`", "`cartpole.xml`: the cart-pole as a MuJoCo model (config/mujoco_cartpole.yaml; docs/mujoco.md)"),
         ("`docs/`", "pages and pictures (`docs/images/`), each picture made by the command beside it"),
         ("`test/`", "`unit/<layer>/`: gtests of each core layer (`<layer>_tests`, no ROS) and of its layout; "
          "`ros/`: the ROS layer's message conversions (no master); `cli/`: `train_headless` run as a user runs "

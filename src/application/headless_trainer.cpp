@@ -1,5 +1,7 @@
 #include "cartpole_qlearning/application/headless_trainer.h"
 
+#include "cartpole_qlearning/simulation/physics_engines.h"
+
 #include <chrono>
 
 namespace cartpole_qlearning
@@ -7,8 +9,10 @@ namespace cartpole_qlearning
 HeadlessTrainer::HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed, std::size_t robots, bool learning)
   : config_(config), session_(config.task, config.agent, seed, learning, robots)
 {
+  simulations_.reserve(robots);
   for (std::size_t r = 0; r < robots; ++r)
-    simulations_.emplace_back(config.physics, config.start_state_bound, robotSeed(seed, r), config.perturbations);
+    simulations_.push_back(makeSimulation(config.physics, config.engine, config.start_state_bound,
+                                          robotSeed(seed, r), config.perturbations));
 }
 
 const EpisodeSummary& HeadlessTrainer::runEpisode()

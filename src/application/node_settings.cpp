@@ -345,6 +345,10 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
   if (const auto found = readSuiteCase(priv, base))
   {
     const auto& [suite, suite_case] = *found;
+    if (suite_case.engine.kind != EngineKind::Equations)
+      priv.fail("suite_case", "'" + suite_case.name + "'",
+                "its physics/engine is " + toString(suite_case.engine.kind) +
+                    "; the sim runs the equations only (train_headless --suite runs it)");
     settings.suite = suite.origin;
     settings.suite_case = suite_case.name;
     settings.physics = suite_case.physics;

@@ -1,6 +1,6 @@
 #include "cartpole_qlearning/application/robustness_suite.h"
 
-#include "cartpole_qlearning/simulation/cartpole_simulation.h"
+#include "cartpole_qlearning/simulation/physics_engines.h"
 #include "cartpole_qlearning/learning/training_session.h"
 
 #include <yaml-cpp/yaml.h>
@@ -101,6 +101,7 @@ RobustnessSuite parseRobustnessSuite(const std::string& yaml, const std::string&
     if (!names.insert(c.name).second)
       throw ConfigError(where + ": the name " + c.name + " is used twice");
     c.physics = base.physics;
+    c.engine = base.engine;
     c.start_state_bound = suite.start_state_bound;
     YAML::Node sections(YAML::NodeType::Map);
     for (const auto& entry : node)
@@ -115,9 +116,13 @@ RobustnessSuite parseRobustnessSuite(const std::string& yaml, const std::string&
                           " (known keys: name, pass, physics, perturbations)");
     }
     // The case's sections, read by the configuration's own readers: the same keys, checks and messages.
-    const auto source = parseYamlParameters(YAML::Dump(sections), origin + ": case " + c.name);
-    readPhysics(*source, c.physics, c.start_state_bound);
+    // (A case's model is relative to the suite file's folder.)
+    const std::size_t slash = origin.find_last_of('/');
+    const auto source = parseYamlParameters(YAML::Dump(sections), origin + ": case " + c.name,
+                                            slash == std::string::npos ? "." : origin.substr(0, slash + (slash == 0)));
+    readPhysics(*source, c.physics, c.start_state_bound, c.engine);
     c.perturbations = readPerturbations(*source);
+    checkPerturbationsFitEngine(*source, c.engine, c.perturbations);
     suite.cases.push_back(c);
   }
   return suite;
@@ -140,7 +145,8 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
   const std::string mismatch = session.replaceTable(table);
   if (!mismatch.empty())
     throw ConfigError("the table does not fit the configuration: " + mismatch);
-  CartPoleSimulation simulation(suite_case.physics, suite_case.start_state_bound, seed, suite_case.perturbations);
+  CartPoleSimulation simulation =
+      makeSimulation(suite_case.physics, suite_case.engine, suite_case.start_state_bound, seed, suite_case.perturbations);
   CaseResult result;
   result.name = suite_case.name;
   result.pass = suite_case.pass;

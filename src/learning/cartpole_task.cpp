@@ -14,7 +14,9 @@ RewardScheme rewardSchemeFromString(const std::string& name)
     return RewardScheme::Seed;
   if (name == "sutton_barto")
     return RewardScheme::SuttonBarto;
-  throw std::invalid_argument("unknown reward scheme '" + name + "' (allowed: gymnasium, seed, sutton_barto)");
+  if (name == "alive")
+    return RewardScheme::Alive;
+  throw std::invalid_argument("unknown reward scheme '" + name + "' (allowed: gymnasium, seed, sutton_barto, alive)");
 }
 
 std::string toString(RewardScheme scheme)
@@ -27,6 +29,8 @@ std::string toString(RewardScheme scheme)
       return "seed";
     case RewardScheme::SuttonBarto:
       return "sutton_barto";
+    case RewardScheme::Alive:
+      return "alive";
   }
   return "unknown";
 }
@@ -81,6 +85,9 @@ StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned step
       break;
     case RewardScheme::SuttonBarto:
       outcome.reward = outcome.terminated ? -1.0 : 0.0;
+      break;
+    case RewardScheme::Alive:
+      outcome.reward = outcome.terminated ? 0.0 : 1.0;
       break;
   }
   return outcome;

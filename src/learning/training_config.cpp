@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -24,7 +25,10 @@ std::vector<std::string> splitKey(const std::string& key)
 class YamlParameters : public ParameterSource
 {
 public:
-  YamlParameters(YAML::Node root, std::string origin) : root_(std::move(root)), origin_(std::move(origin)) {}
+  YamlParameters(YAML::Node root, std::string origin, std::string folder)
+    : root_(std::move(root)), origin_(std::move(origin)), folder_(std::move(folder))
+  {
+  }
 
   bool get(const std::string& key, double& value) const override
   {
@@ -96,6 +100,10 @@ public:
   {
     return origin_;
   }
+  std::string folder() const override
+  {
+    return folder_;
+  }
 
 private:
   YAML::Node find(const std::string& key) const
@@ -165,6 +173,7 @@ private:
 
   YAML::Node root_;
   std::string origin_;
+  std::string folder_;
 };
 
 template <typename Enum, typename Parse>
@@ -192,9 +201,32 @@ void readSchedule(SectionReader& reader, const std::string& name, ScheduleParams
   reader.read(name + "/log_divisor", schedule.log_divisor);
 }
 
+// The text with each ${NAME} replaced by the environment variable NAME; on_missing(NAME) is called
+// (and must throw) for one that is not set.
+template <typename OnMissing>
+std::string expandEnvironment(const std::string& text, OnMissing on_missing)
+{
+  std::string out;
+  std::size_t at = 0;
+  for (std::size_t open = text.find("${"); open != std::string::npos; open = text.find("${", at))
+  {
+    const std::size_t close = text.find('}', open);
+    if (close == std::string::npos)
+      break;
+    const std::string name = text.substr(open + 2, close - open - 2);
+    const char* value = std::getenv(name.c_str());
+    if (value == nullptr)
+      on_missing(name);
+    out += text.substr(at, open - at) + (value ? value : "");
+    at = close + 1;
+  }
+  return out + text.substr(at);
+}
+
 }  // namespace
 
-std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin)
+std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin,
+                                                     const std::string& folder)
 {
   YAML::Node root;
   try
@@ -209,7 +241,7 @@ std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, co
     root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap())
     throw ConfigError(origin + ": must be a YAML mapping of sections (physics, task, learning, training)");
-  return std::make_unique<YamlParameters>(root, origin);
+  return std::make_unique<YamlParameters>(root, origin, folder);
 }
 
 void refuseUnknownSections(const ParameterSource& source)
@@ -231,12 +263,54 @@ std::unique_ptr<ParameterSource> loadYamlParameters(const std::string& path)
     throw ConfigError(path + ": cannot be read");
   std::stringstream text;
   text << in.rdbuf();
-  return parseYamlParameters(text.str(), path);
+  const std::size_t slash = path.find_last_of('/');
+  return parseYamlParameters(text.str(), path, slash == std::string::npos ? "." : path.substr(0, slash + (slash == 0)));
 }
 
 void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound)
 {
+  EngineParams engine;
+  readPhysics(source, physics, start_state_bound, engine);
+  if (engine.kind != EngineKind::Equations)
+    throw ConfigError(source.describe("physics/engine") + " = '" + toString(engine.kind) +
+                      "' is not allowed here (allowed: equations; MuJoCo runs in train_headless and its robustness suite)");
+}
+
+void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound,
+                 EngineParams& engine)
+{
   SectionReader reader(source, "physics");
+  readEnum(reader, "engine", engine.kind, engineKindFromString);
+  reader.read("model", engine.model);
+  reader.read("cart_joint", engine.cart_joint);
+  reader.read("pole_joint", engine.pole_joint);
+  reader.read("actuator", engine.actuator);
+  const bool mujoco = engine.kind == EngineKind::Mujoco;
+  const char* const equations_keys[] = {"gravity", "mass_cart", "mass_pole", "half_length",
+                                        "integrator", "cart_friction", "pole_friction"};
+  const char* const model_keys[] = {"model", "cart_joint", "pole_joint", "actuator"};
+  for (const char* name : mujoco ? std::vector<const char*>(std::begin(equations_keys), std::end(equations_keys))
+                                 : std::vector<const char*>(std::begin(model_keys), std::end(model_keys)))
+  {
+    if (!source.keysUnder(reader.key(name)).empty())
+      throw ConfigError(source.describe(reader.key(name)) + " is not allowed with physics/engine " +
+                        toString(engine.kind) +
+                        (mujoco ? " (the model sets it: edit the model)" : " (it names a MuJoCo model's parts)"));
+  }
+  if (mujoco && !source.keysUnder(reader.key("model")).empty())
+  {
+    const std::string given = engine.model;
+    engine.model = expandEnvironment(given, [&](const std::string& variable) {
+      reader.fail("model", "'" + given + "'",
+                  "the environment variable " + variable + " is not set: set it, or give the path itself");
+    });
+    if (engine.model.empty())
+      reader.fail("model", "''", "must name an MJCF file");
+    if (engine.model.front() != '/' && !source.folder().empty())
+      engine.model = source.folder() + "/" + engine.model;
+  }
+  if (mujoco && engine.model.empty())
+    reader.fail("model", "''", "physics/engine mujoco needs an MJCF file");
   reader.read("gravity", physics.gravity);
   reader.read("mass_cart", physics.mass_cart);
   reader.read("mass_pole", physics.mass_pole);
@@ -251,6 +325,14 @@ void readPhysics(const ParameterSource& source, CartPoleParams& physics, double&
   reader.check(physics.validate());
   if (!(std::isfinite(start_state_bound) && start_state_bound >= 0.0))
     reader.fail("start_state_bound", std::to_string(start_state_bound), "must be finite and >= 0");
+}
+
+void checkPerturbationsFitEngine(const ParameterSource& source, const EngineParams& engine,
+                                 const PerturbationParams& perturbations)
+{
+  if (engine.kind != EngineKind::Equations && perturbations.half_length.varies())
+    throw ConfigError(source.describe("perturbations/half_length") + " is not allowed with physics/engine " +
+                      toString(engine.kind) + " (a model's pole is its geometry: scale it in the model)");
 }
 
 PerturbationParams readPerturbations(const ParameterSource& source)
@@ -365,8 +447,9 @@ TrainingLimits readLimits(const ParameterSource& source)
 TrainingConfig readTrainingConfig(const ParameterSource& source)
 {
   TrainingConfig config;
-  readPhysics(source, config.physics, config.start_state_bound);
+  readPhysics(source, config.physics, config.start_state_bound, config.engine);
   config.perturbations = readPerturbations(source);
+  checkPerturbationsFitEngine(source, config.engine, config.perturbations);
   config.task = readTask(source);
   config.agent = readAgent(source);
   config.limits = readLimits(source);

@@ -8,8 +8,13 @@ namespace cartpole_qlearning
 {
 CartPoleSimulation::CartPoleSimulation(const CartPoleParams& params, double start_state_bound, std::uint64_t seed,
                                        const PerturbationParams& perturbations)
-  : nominal_(params),
-    dynamics_(params),
+  : CartPoleSimulation(std::make_unique<EquationsEngine>(params), start_state_bound, seed, perturbations)
+{
+}
+
+CartPoleSimulation::CartPoleSimulation(std::unique_ptr<PhysicsEngine> engine, double start_state_bound,
+                                       std::uint64_t seed, const PerturbationParams& perturbations)
+  : engine_(std::move(engine)),
     start_state_bound_(start_state_bound),
     perturbations_(perturbations),
     rng_(seed, kEnvironmentStream),
@@ -17,12 +22,48 @@ CartPoleSimulation::CartPoleSimulation(const CartPoleParams& params, double star
     perturbation_rng_(seed, kPerturbationStream),
     delay_(perturbations.delay_steps)
 {
+  if (!engine_)
+    throw std::invalid_argument("CartPoleSimulation: no engine");
   if (!(std::isfinite(start_state_bound) && start_state_bound >= 0.0))
     throw std::invalid_argument("start_state_bound = " + std::to_string(start_state_bound) +
                                 " is not allowed (must be finite and >= 0)");
   const std::string error = perturbations.validate();
   if (!error.empty())
     throw std::invalid_argument("perturbations: " + error);
+  if (perturbations.half_length.varies() && dynamic_cast<const EquationsEngine*>(engine_.get()) == nullptr)
+    throw std::invalid_argument(
+        "perturbations: half_length is not allowed with this engine (a model's pole is its geometry: "
+        "scale it in the model)");
+}
+
+CartPoleSimulation::CartPoleSimulation(const CartPoleSimulation& other)
+  : engine_(other.engine_->clone()),
+    start_state_bound_(other.start_state_bound_),
+    perturbations_(other.perturbations_),
+    rng_(other.rng_),
+    noise_rng_(other.noise_rng_),
+    perturbation_rng_(other.perturbation_rng_),
+    delay_(other.delay_),
+    observation_(other.observation_),
+    applied_force_(other.applied_force_),
+    motor_factor_(other.motor_factor_),
+    last_push_(other.last_push_)
+{
+}
+
+CartPoleSimulation& CartPoleSimulation::operator=(const CartPoleSimulation& other)
+{
+  if (this != &other)
+    *this = CartPoleSimulation(other);
+  return *this;
+}
+
+const CartPoleDynamics& CartPoleSimulation::dynamics() const
+{
+  const auto* equations = dynamic_cast<const EquationsEngine*>(engine_.get());
+  if (equations == nullptr)
+    throw std::logic_error("CartPoleSimulation::dynamics: the engine is not the equations");
+  return equations->dynamics();
 }
 
 void CartPoleSimulation::beginEpisode()
@@ -32,40 +73,42 @@ void CartPoleSimulation::beginEpisode()
   unsigned delay = perturbations_.delay_steps;
   if (perturbations_.mass_cart.varies() || perturbations_.mass_pole.varies() || perturbations_.half_length.varies() ||
       perturbations_.motor.varies() || perturbations_.delay_steps_max != perturbations_.delay_steps)
-    dynamics_ = CartPoleDynamics(drawEpisodePhysics(nominal_, perturbations_, perturbation_rng_, motor_factor_, delay));
+  {
+    const EpisodeFactors factors = drawEpisodeFactors(perturbations_, perturbation_rng_, delay);
+    motor_factor_ = factors.motor;
+    engine_->setFactors(factors);
+  }
   delay_.reset(delay);
-  observation_ = perturbations_.noisy() ? addSensorNoise(state_, perturbations_, noise_rng_) : state_;
+  const CartPoleState& state = engine_->state();
+  observation_ = perturbations_.noisy() ? addSensorNoise(state, perturbations_, noise_rng_) : state;
 }
 
 const CartPoleState& CartPoleSimulation::resetRandom()
 {
+  CartPoleState start;
   for (int i = 0; i < 4; ++i)
-    state_[i] = rng_.uniform(-start_state_bound_, start_state_bound_);
-  beginEpisode();
-  return state_;
+    start[i] = rng_.uniform(-start_state_bound_, start_state_bound_);
+  return reset(start);
 }
 
 const CartPoleState& CartPoleSimulation::reset(const CartPoleState& state)
 {
-  state_ = state;
+  engine_->setState(state);
   beginEpisode();
-  return state_;
+  return engine_->state();
 }
 
 const CartPoleState& CartPoleSimulation::step(double command)
 {
-  // The clamp is the configured force_mag's (the drive's limit); a weaker motor gives less of it.
-  applied_force_ = motor_factor_ * dynamics_.clampForce(delay_.apply(command));
   last_push_ = 0.0;
+  const double acting = delay_.apply(command);
   if (perturbations_.push_probability > 0.0 && perturbations_.push_force != 0.0 &&
       perturbation_rng_.uniform01() < perturbations_.push_probability)
-  {
     last_push_ = perturbation_rng_.uniform01() < 0.5 ? -perturbations_.push_force : perturbations_.push_force;
-    applied_force_ += last_push_;
-  }
-  state_ = dynamics_.step(state_, applied_force_);
-  observation_ = perturbations_.noisy() ? addSensorNoise(state_, perturbations_, noise_rng_) : state_;
-  return state_;
+  applied_force_ = engine_->step(acting, last_push_);
+  const CartPoleState& state = engine_->state();
+  observation_ = perturbations_.noisy() ? addSensorNoise(state, perturbations_, noise_rng_) : state;
+  return state;
 }
 
 }  // namespace cartpole_qlearning

@@ -66,18 +66,17 @@ std::string PerturbationParams::validate() const
   return "";
 }
 
-CartPoleParams drawEpisodePhysics(const CartPoleParams& nominal, const PerturbationParams& p, RandomStream& rng,
-                                  double& motor_factor, unsigned& delay_steps)
+EpisodeFactors drawEpisodeFactors(const PerturbationParams& p, RandomStream& rng, unsigned& delay_steps)
 {
   delay_steps = p.delay_steps_max == p.delay_steps
                     ? p.delay_steps
                     : p.delay_steps + static_cast<unsigned>(rng.uniformIndex(p.delay_steps_max - p.delay_steps + 1));
-  CartPoleParams physics = nominal;
-  physics.mass_cart = nominal.mass_cart * draw(p.mass_cart, rng);
-  physics.mass_pole = nominal.mass_pole * draw(p.mass_pole, rng);
-  physics.half_length = nominal.half_length * draw(p.half_length, rng);
-  motor_factor = draw(p.motor, rng);
-  return physics;
+  EpisodeFactors factors;
+  factors.mass_cart = draw(p.mass_cart, rng);
+  factors.mass_pole = draw(p.mass_pole, rng);
+  factors.half_length = draw(p.half_length, rng);
+  factors.motor = draw(p.motor, rng);
+  return factors;
 }
 
 ActuationDelay::ActuationDelay(unsigned steps) : steps_(steps)

@@ -1,5 +1,7 @@
 #include "lockstep_loopback.h"
 
+#include "cartpole_qlearning/simulation/physics_engines.h"
+
 #include <chrono>
 #include <stdexcept>
 
@@ -18,7 +20,8 @@ ControllerProtocolParams protocolParams(const TrainingConfig& config, std::size_
 
 LockstepLoopback::Robot::Robot(const TrainingConfig& config, std::uint64_t seed, TrainingSession& session,
                                std::size_t index)
-  : simulation(config.physics, config.start_state_bound, robotSeed(seed, index), config.perturbations),
+  : simulation(makeSimulation(config.physics, config.engine, config.start_state_bound, robotSeed(seed, index),
+                               config.perturbations)),
     // No message is ever lost here, so no state is ever repeated.
     sim_protocol(tickOf(config.physics.tau), WallClock::duration::max()),
     controller_protocol(session, protocolParams(config, index))

@@ -44,7 +44,8 @@ inline std::uint64_t robotSeed(std::uint64_t seed, std::size_t robot)
 class HeadlessTrainer
 {
 public:
-  // learning = false: greedy, no updates (an evaluation).
+  // learning = false: greedy, no updates (an evaluation). The simulations run on the config's
+  // engine: throws EngineError when it cannot be made (physics_engines.h).
   HeadlessTrainer(const TrainingConfig& config, std::uint64_t seed, std::size_t robots = 1, bool learning = true);
 
   // Robot 0 alone: one whole episode from a random start; returns its summary.

@@ -21,6 +21,7 @@ struct SuiteCase
   std::string name;
   // The case's physics (the configuration's, with the case's physics keys over it) and start region.
   CartPoleParams physics;
+  EngineParams engine;  // the configuration's, or the case's own (a case may name a model)
   double start_state_bound = 0.05;
   PerturbationParams perturbations;
   std::uint64_t pass = 95;  // balanced episodes (of the suite's episodes) needed to pass

@@ -12,10 +12,11 @@ enum class RewardScheme
 {
   Gymnasium,   // +1 every step, the terminating one included (CartPole-v1)
   Seed,        // +1 while alive, -1 on the step that falls (the Q-learning tutorial's)
-  SuttonBarto  // 0 while alive, -1 on the step that falls (Barto, Sutton and Anderson 1983)
+  SuttonBarto,  // 0 while alive, -1 on the step that falls (Barto, Sutton and Anderson 1983)
+  Alive         // +1 while alive, 0 on the step that falls (Gymnasium's InvertedPendulum-v5)
 };
 
-// Parses "gymnasium", "seed" or "sutton_barto"; throws std::invalid_argument otherwise.
+// Parses "gymnasium", "seed", "sutton_barto" or "alive"; throws std::invalid_argument otherwise.
 RewardScheme rewardSchemeFromString(const std::string& name);
 std::string toString(RewardScheme scheme);
 

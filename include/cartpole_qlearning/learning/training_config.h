@@ -7,6 +7,7 @@
 #include "cartpole_qlearning/learning/cartpole_task.h"
 #include "cartpole_qlearning/learning/discretiser.h"
 #include "cartpole_qlearning/simulation/perturbations.h"
+#include "cartpole_qlearning/simulation/physics_engine.h"
 #include "cartpole_qlearning/learning/q_learning_agent.h"
 
 #include <algorithm>
@@ -46,6 +47,12 @@ public:
   virtual std::vector<std::string> keysUnder(const std::string& section) const = 0;
   // Where the parameters come from, for messages ("config/cartpole.yaml", "/cartpole").
   virtual std::string origin() const = 0;
+  // The folder a relative path in these parameters is relative to (physics/model): a file's own
+  // folder; empty: the working folder.
+  virtual std::string folder() const
+  {
+    return "";
+  }
   // A key as messages name it ("config/cartpole.yaml: learning/gamma", "parameter /cartpole/learning/gamma").
   virtual std::string describe(const std::string& key) const
   {
@@ -212,7 +219,9 @@ private:
 
 // A YAML document as a parameter source. Throws ConfigError when the file cannot be read or parsed.
 std::unique_ptr<ParameterSource> loadYamlParameters(const std::string& path);
-std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin);
+// (folder: what folder() answers; loadYamlParameters gives the file's.)
+std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin,
+                                                     const std::string& folder = "");
 
 // Refuses top-level keys other than the sections physics, perturbations, task, learning and training (for a
 // file that holds only those; the parameter server holds other names beside them).
@@ -248,6 +257,7 @@ struct TrainingLimits
 struct TrainingConfig
 {
   CartPoleParams physics;
+  EngineParams engine;               // physics/engine and, for MuJoCo, its model, joints and actuator
   double start_state_bound = 0.05;   // [m, m/s, rad, rad/s] random starts are uniform in +-this
   PerturbationParams perturbations;  // what a real cart-pole does (none by default)
   TaskParams task;
@@ -258,8 +268,18 @@ struct TrainingConfig
 // Each reader starts from the defaults, overrides what the source sets, validates, and throws
 // ConfigError naming the key on a bad value or an unknown key in its section.
 void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound);
+// The same with the engine's keys: engine (equations or mujoco), and for mujoco model (an MJCF
+// file: absolute, or relative to source.folder(); ${NAME} is the environment variable NAME),
+// cart_joint, pole_joint and actuator. The equations' own keys (gravity, masses, half_length,
+// integrator, friction) are refused beside engine mujoco, the model's keys beside the equations.
+// (The model itself is read when a simulation is made: physics_engines.h.)
+void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound,
+                 EngineParams& engine);
 // The perturbations section (a late command, sensor noise, physics drawn per episode, pushes).
 PerturbationParams readPerturbations(const ParameterSource& source);
+// Refuses perturbations the engine cannot apply (half_length beside a MuJoCo model), naming the key.
+void checkPerturbationsFitEngine(const ParameterSource& source, const EngineParams& engine,
+                                 const PerturbationParams& perturbations);
 TaskParams readTask(const ParameterSource& source);
 AgentParams readAgent(const ParameterSource& source);
 TrainingLimits readLimits(const ParameterSource& source);

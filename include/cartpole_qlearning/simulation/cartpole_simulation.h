@@ -1,7 +1,8 @@
-// The simulated robot: dynamics, the current state, the seeded draw of start states, and what a
-// real cart-pole does beside the ideal model (perturbations.h: a late command, noisy sensors,
-// other masses per episode, pushes). The simulator node owns one; the headless trainer owns one
-// in the same way.
+// The simulated robot: a physics engine (physics_engine.h: the equations, or a MuJoCo model), the
+// seeded draw of start states, and what a real cart-pole does beside the ideal model
+// (perturbations.h: a late command, noisy sensors, other masses per episode, pushes). The
+// simulator node owns one; the headless trainer owns one in the same way. physics_engines.h
+// makes one from a config's engine.
 #pragma once
 
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
@@ -9,6 +10,7 @@
 #include "cartpole_qlearning/common/random.h"
 
 #include <cstdint>
+#include <memory>
 
 namespace cartpole_qlearning
 {
@@ -16,18 +18,34 @@ class CartPoleSimulation
 {
 public:
   // start_state_bound: a random reset draws each state value uniformly in +-this.
+  // The equations (EquationsEngine) with these params.
   CartPoleSimulation(const CartPoleParams& params, double start_state_bound, std::uint64_t seed,
                      const PerturbationParams& perturbations = PerturbationParams());
+  // Another engine (not null). Throws std::invalid_argument when a perturbation asks for what the
+  // engine cannot do (half_length on a model whose geometry is its own).
+  CartPoleSimulation(std::unique_ptr<PhysicsEngine> engine, double start_state_bound, std::uint64_t seed,
+                     const PerturbationParams& perturbations = PerturbationParams());
+  CartPoleSimulation(const CartPoleSimulation& other);
+  CartPoleSimulation& operator=(const CartPoleSimulation& other);
+  CartPoleSimulation(CartPoleSimulation&&) = default;
+  CartPoleSimulation& operator=(CartPoleSimulation&&) = default;
 
-  // This episode's dynamics (the configured physics, or the physics drawn for this episode).
-  const CartPoleDynamics& dynamics() const
+  const PhysicsEngine& engine() const
   {
-    return dynamics_;
+    return *engine_;
   }
+  // This episode's equations (the configured physics, or the physics drawn for this episode).
+  // The equations' engine only: throws std::logic_error with another.
+  const CartPoleDynamics& dynamics() const;
   // The true state.
   const CartPoleState& state() const
   {
-    return state_;
+    return engine_->state();
+  }
+  // Steps whose command the drive clamped (to +-force_mag, or a model's ctrlrange), since construction.
+  std::uint64_t clamps() const
+  {
+    return engine_->clamps();
   }
   // What the sensors read of it (the true state when they are not noisy): drawn once per reset
   // and step, so it reads the same however often it is asked.
@@ -36,7 +54,7 @@ public:
     return observation_;
   }
   // The force that acted during the last step [N]: the command that came through the delay,
-  // clamped to +-force_mag, times this episode's motor factor, plus any push.
+  // clamped to the drive's limit, times this episode's motor factor, plus any push.
   double appliedForce() const
   {
     return applied_force_;
@@ -75,15 +93,13 @@ public:
 private:
   void beginEpisode();
 
-  CartPoleParams nominal_;
-  CartPoleDynamics dynamics_;
+  std::unique_ptr<PhysicsEngine> engine_;
   double start_state_bound_;
   PerturbationParams perturbations_;
   RandomStream rng_;
   RandomStream noise_rng_;
   RandomStream perturbation_rng_;
   ActuationDelay delay_;
-  CartPoleState state_ = CartPoleState::Zero();
   CartPoleState observation_ = CartPoleState::Zero();
   double applied_force_ = 0.0;
   double motor_factor_ = 1.0;

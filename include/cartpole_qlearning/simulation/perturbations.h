@@ -6,6 +6,7 @@
 #pragma once
 
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
+#include "cartpole_qlearning/simulation/physics_engine.h"
 #include "cartpole_qlearning/common/random.h"
 
 #include <array>
@@ -59,10 +60,10 @@ struct PerturbationParams
 // so that turning perturbations on changes neither the start states nor exploration.
 constexpr std::uint64_t kPerturbationStream = 3;
 
-// The physics of one episode: the configured physics with the drawn factors applied (the motor
-// factor is kept apart: it scales commands, not force_mag's clamp), and its delay.
-CartPoleParams drawEpisodePhysics(const CartPoleParams& nominal, const PerturbationParams& perturbations,
-                                  RandomStream& rng, double& motor_factor, unsigned& delay_steps);
+// The factors of one episode's physics over the configured (the motor factor scales commands
+// after the drive's clamp), and its delay: drawn in that order (delay, mass_cart, mass_pole,
+// half_length, motor), a range that is off drawing nothing.
+EpisodeFactors drawEpisodeFactors(const PerturbationParams& perturbations, RandomStream& rng, unsigned& delay_steps);
 
 // A command line that delivers each command delay_steps steps after it was given.
 class ActuationDelay

@@ -1,6 +1,9 @@
 #include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/learning/cartpole_task.h"
 
 #include <gtest/gtest.h>
+
+#include <cstdlib>
 
 using namespace cartpole_qlearning;
 
@@ -156,4 +159,72 @@ TEST(Config, InvalidYamlAndMissingFilesAreRefused)
 {
   EXPECT_NE(std::string::npos, errorOf("physics: [unclosed").find("not valid YAML"));
   EXPECT_THROW(loadYamlParameters("/nonexistent/cartpole.yaml"), ConfigError);
+}
+
+namespace
+{
+TrainingConfig readFrom(const std::string& yaml, const std::string& folder)
+{
+  return readTrainingConfig(*parseYamlParameters(yaml, "test.yaml", folder));
+}
+}  // namespace
+
+TEST(Config, TheEngineIsTheEquationsUnlessTheConfigNamesAModel)
+{
+  EXPECT_EQ(EngineKind::Equations, parse("").engine.kind);
+  const TrainingConfig c = readFrom(
+      "physics: {engine: mujoco, model: models/pole.xml, cart_joint: a, pole_joint: b, actuator: c, tau: 0.04}",
+      "/configs");
+  EXPECT_EQ(EngineKind::Mujoco, c.engine.kind);
+  EXPECT_EQ("/configs/models/pole.xml", c.engine.model);  // relative to the config's folder
+  EXPECT_EQ("a", c.engine.cart_joint);
+  EXPECT_EQ("b", c.engine.pole_joint);
+  EXPECT_EQ("c", c.engine.actuator);
+  EXPECT_EQ("/abs/pole.xml", readFrom("physics: {engine: mujoco, model: /abs/pole.xml}", "/configs").engine.model);
+  // The defaults are Gymnasium's InvertedPendulum's names.
+  EXPECT_EQ("slider", EngineParams().cart_joint);
+  EXPECT_EQ("hinge", EngineParams().pole_joint);
+  EXPECT_EQ("slide", EngineParams().actuator);
+}
+
+TEST(Config, AModelPathTakesEnvironmentVariables)
+{
+  ::setenv("CARTPOLE_TEST_ASSETS", "/opt/assets", 1);
+  EXPECT_EQ("/opt/assets/pendulum.xml",
+            readFrom("physics: {engine: mujoco, model: \"${CARTPOLE_TEST_ASSETS}/pendulum.xml\"}", "/c").engine.model);
+  ::unsetenv("CARTPOLE_TEST_ASSETS");
+  const std::string unset = errorOf("physics: {engine: mujoco, model: \"${CARTPOLE_TEST_ASSETS}/pendulum.xml\"}");
+  EXPECT_NE(std::string::npos, unset.find("physics/model = '${CARTPOLE_TEST_ASSETS}/pendulum.xml'")) << unset;
+  EXPECT_NE(std::string::npos, unset.find("CARTPOLE_TEST_ASSETS is not set")) << unset;
+}
+
+TEST(Config, EngineKeysThatDoNotApplyAreRefused)
+{
+  EXPECT_NE(std::string::npos, errorOf("physics: {engine: ode}").find("physics/engine = 'ode' is not allowed"));
+  EXPECT_NE(std::string::npos, errorOf("physics: {engine: mujoco}").find("physics/model = '' is not allowed"));
+  const std::string mass = errorOf("physics: {engine: mujoco, model: m.xml, mass_pole: 0.2}");
+  EXPECT_NE(std::string::npos, mass.find("physics/mass_pole is not allowed with physics/engine mujoco")) << mass;
+  EXPECT_NE(std::string::npos,
+            errorOf("physics: {engine: mujoco, model: m.xml, integrator: rk4}").find("physics/integrator"));
+  const std::string joint = errorOf("physics: {cart_joint: slider}");
+  EXPECT_NE(std::string::npos, joint.find("physics/cart_joint is not allowed with physics/engine equations")) << joint;
+  const std::string length =
+      errorOf("physics: {engine: mujoco, model: m.xml}\nperturbations: {half_length: [0.9, 1.1]}");
+  EXPECT_NE(std::string::npos, length.find("perturbations/half_length is not allowed with physics/engine mujoco"))
+      << length;
+  // The 3-argument reader (the sim node's, for now) runs the equations only.
+  CartPoleParams physics;
+  double bound = 0.05;
+  EXPECT_THROW(readPhysics(*parseYamlParameters("physics: {engine: mujoco, model: m.xml}", "t"), physics, bound),
+               ConfigError);
+}
+
+TEST(Config, TheAliveRewardIsInvertedPendulumsV5)
+{
+  TaskParams params;
+  params.reward = rewardSchemeFromString("alive");
+  const CartPoleTask task(params);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1).reward);
+  EXPECT_EQ(0.0, task.evaluate(CartPoleState(0.0, 0.0, 1.0, 0.0), 1).reward);
+  EXPECT_EQ("alive", toString(RewardScheme::Alive));
 }

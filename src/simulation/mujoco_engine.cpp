@@ -1,0 +1,245 @@
+#include "cartpole_qlearning/simulation/mujoco_engine.h"
+
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <sstream>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+const char* jointKind(int type)
+{
+  switch (type)
+  {
+    case mjJNT_FREE:
+      return "free";
+    case mjJNT_BALL:
+      return "ball";
+    case mjJNT_SLIDE:
+      return "slide";
+    case mjJNT_HINGE:
+      return "hinge";
+  }
+  return "unknown";
+}
+
+// "slider (slide), hinge (hinge)"
+std::string jointList(const mjModel* m)
+{
+  std::string list;
+  for (int j = 0; j < m->njnt; ++j)
+  {
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    list += (list.empty() ? "" : ", ") + std::string(name ? name : "(unnamed)") + " (" + jointKind(m->jnt_type[j]) + ")";
+  }
+  return list.empty() ? "none" : list;
+}
+
+std::string actuatorList(const mjModel* m)
+{
+  std::string list;
+  for (int a = 0; a < m->nu; ++a)
+  {
+    const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
+    list += (list.empty() ? "" : ", ") + std::string(name ? name : "(unnamed)");
+  }
+  return list.empty() ? "none" : list;
+}
+
+// MuJoCo's XML parser and compiler keep global state while they run: one model at a time
+// (the robustness suite builds its cases' simulations on several threads).
+std::mutex& loadMutex()
+{
+  static std::mutex mutex;
+  return mutex;
+}
+}  // namespace
+
+MujocoEngine::MujocoEngine(const EngineParams& params, double tau) : params_(params), tau_(tau)
+{
+  const std::string in_model = " in the model " + params.model;
+  const auto fail = [&](const std::string& key, const std::string& value, const std::string& why) {
+    throw EngineError("physics/" + key + " = '" + value + "'" + in_model + ": " + why);
+  };
+  if (params.model.empty())
+    throw EngineError("physics/model is not set (physics/engine mujoco needs an MJCF file)");
+  char error[1000] = "";
+  mjModel* loaded = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(loadMutex());
+    loaded = mj_loadXML(params.model.c_str(), nullptr, error, sizeof error);
+  }
+  if (loaded == nullptr)
+    throw EngineError("physics/model = '" + params.model + "' cannot be loaded: " + error);
+  loaded_ = std::shared_ptr<const mjModel>(loaded, [](const mjModel* m) { mj_deleteModel(const_cast<mjModel*>(m)); });
+  const mjModel* m = loaded;
+
+  const int cart = mj_name2id(m, mjOBJ_JOINT, params.cart_joint.c_str());
+  if (cart < 0)
+    fail("cart_joint", params.cart_joint, "no such joint (its joints: " + jointList(m) + ")");
+  if (m->jnt_type[cart] != mjJNT_SLIDE)
+    fail("cart_joint", params.cart_joint,
+         std::string("a ") + jointKind(m->jnt_type[cart]) + " joint; the cart's must be a slide joint");
+  const int pole = mj_name2id(m, mjOBJ_JOINT, params.pole_joint.c_str());
+  if (pole < 0)
+    fail("pole_joint", params.pole_joint, "no such joint (its joints: " + jointList(m) + ")");
+  if (m->jnt_type[pole] != mjJNT_HINGE)
+    fail("pole_joint", params.pole_joint,
+         std::string("a ") + jointKind(m->jnt_type[pole]) + " joint; the pole's must be a hinge joint");
+  cart_body_ = m->jnt_bodyid[cart];
+  pole_body_ = m->jnt_bodyid[pole];
+  bool carried = false;
+  for (int b = m->body_parentid[pole_body_]; b > 0 && !carried; b = m->body_parentid[b])
+    carried = b == cart_body_;
+  if (!carried)
+    fail("pole_joint", params.pole_joint,
+         "its body is not carried by the body of physics/cart_joint '" + params.cart_joint + "'");
+  cart_qpos_ = m->jnt_qposadr[cart];
+  cart_dof_ = m->jnt_dofadr[cart];
+  pole_qpos_ = m->jnt_qposadr[pole];
+  pole_dof_ = m->jnt_dofadr[pole];
+
+  actuator_ = mj_name2id(m, mjOBJ_ACTUATOR, params.actuator.c_str());
+  if (actuator_ < 0)
+    fail("actuator", params.actuator, "no such actuator (its actuators: " + actuatorList(m) + ")");
+  if (m->actuator_trntype[actuator_] != mjTRN_JOINT || m->actuator_trnid[2 * actuator_] != cart)
+    fail("actuator", params.actuator, "it does not act on physics/cart_joint '" + params.cart_joint + "'");
+  if (m->actuator_dyntype[actuator_] != mjDYN_NONE || m->actuator_gaintype[actuator_] != mjGAIN_FIXED ||
+      m->actuator_biastype[actuator_] != mjBIAS_NONE)
+    fail("actuator", params.actuator, "not a motor (a force of gear x ctrl: no dynamics, a fixed gain, no bias)");
+  gear_ = m->actuator_gear[6 * actuator_] * m->actuator_gainprm[mjNGAIN * actuator_];
+  if (!(std::isfinite(gear_) && gear_ != 0.0))
+    fail("actuator", params.actuator, "its gear times gain is 0: it gives no force");
+
+  const double steps = tau / m->opt.timestep;
+  frame_skip_ = static_cast<int>(std::llround(steps));
+  if (!(std::isfinite(tau) && tau > 0.0 && frame_skip_ >= 1 && std::fabs(steps - frame_skip_) <= 1e-9 * steps))
+  {
+    std::ostringstream why;
+    why << "not a whole number of the model's timestep " << m->opt.timestep << " s (the frame skip)";
+    std::ostringstream value;
+    value << tau;
+    fail("tau", value.str(), why.str());
+  }
+
+  model_ = mj_copyModel(nullptr, m);
+  data_ = mj_makeData(model_);
+  // Which way theta grows: a turn about the hinge's axis moves the pole's centre of mass by
+  // axis x (centre - anchor); positive theta leans it toward the slide's +x.
+  mj_forward(model_, data_);
+  double lever[3];
+  for (int k = 0; k < 3; ++k)
+  {
+    lever[k] = data_->xipos[3 * pole_body_ + k] - data_->xanchor[3 * pole + k];
+    slide_axis_[k] = data_->xaxis[3 * cart + k];
+  }
+  const double* a = data_->xaxis + 3 * pole;
+  const double turn[3] = {a[1] * lever[2] - a[2] * lever[1], a[2] * lever[0] - a[0] * lever[2],
+                          a[0] * lever[1] - a[1] * lever[0]};
+  const double along = turn[0] * slide_axis_[0] + turn[1] * slide_axis_[1] + turn[2] * slide_axis_[2];
+  if (std::fabs(along) < 1e-9)
+  {
+    mj_deleteData(data_);
+    mj_deleteModel(model_);
+    fail("pole_joint", params.pole_joint, "turning it does not move the pole along the slide");
+  }
+  theta_sign_ = along > 0.0 ? 1.0 : -1.0;
+  setState(CartPoleState::Zero());
+}
+
+MujocoEngine::MujocoEngine(const MujocoEngine& other)
+  : params_(other.params_),
+    tau_(other.tau_),
+    loaded_(other.loaded_),
+    model_(mj_copyModel(nullptr, other.model_)),
+    data_(mj_copyData(nullptr, other.model_, other.data_)),
+    cart_qpos_(other.cart_qpos_),
+    cart_dof_(other.cart_dof_),
+    pole_qpos_(other.pole_qpos_),
+    pole_dof_(other.pole_dof_),
+    cart_body_(other.cart_body_),
+    pole_body_(other.pole_body_),
+    actuator_(other.actuator_),
+    frame_skip_(other.frame_skip_),
+    gear_(other.gear_),
+    theta_sign_(other.theta_sign_),
+    state_(other.state_),
+    motor_factor_(other.motor_factor_),
+    clamps_(other.clamps_)
+{
+  for (int k = 0; k < 3; ++k)
+    slide_axis_[k] = other.slide_axis_[k];
+}
+
+MujocoEngine::~MujocoEngine()
+{
+  mj_deleteData(data_);
+  mj_deleteModel(model_);
+}
+
+double MujocoEngine::forceLimit() const
+{
+  if (!model_->actuator_ctrllimited[actuator_])
+    return std::numeric_limits<double>::infinity();
+  const double* range = model_->actuator_ctrlrange + 2 * actuator_;
+  return std::fabs(gear_) * std::max(std::fabs(range[0]), std::fabs(range[1]));
+}
+
+void MujocoEngine::setFactors(const EpisodeFactors& factors)
+{
+  const mjModel* m = loaded_.get();
+  for (const auto& [body, factor] : {std::pair<int, double>{cart_body_, factors.mass_cart}, {pole_body_, factors.mass_pole}})
+  {
+    model_->body_mass[body] = m->body_mass[body] * factor;
+    for (int k = 0; k < 3; ++k)
+      model_->body_inertia[3 * body + k] = m->body_inertia[3 * body + k] * factor;
+  }
+  model_->actuator_gainprm[mjNGAIN * actuator_] = m->actuator_gainprm[mjNGAIN * actuator_] * factors.motor;
+  motor_factor_ = factors.motor;
+}
+
+void MujocoEngine::setState(const CartPoleState& state)
+{
+  const CartPoleState start = state;  // (it may be state_ itself)
+  mj_resetData(model_, data_);
+  data_->qpos[cart_qpos_] = start[0];
+  data_->qvel[cart_dof_] = start[1];
+  data_->qpos[pole_qpos_] = theta_sign_ * start[2];
+  data_->qvel[pole_dof_] = theta_sign_ * start[3];
+  mj_forward(model_, data_);
+  readState();
+}
+
+double MujocoEngine::step(double command, double push)
+{
+  double ctrl = command / gear_;
+  if (model_->actuator_ctrllimited[actuator_])
+  {
+    const double* range = model_->actuator_ctrlrange + 2 * actuator_;
+    const double clamped = std::min(std::max(ctrl, range[0]), range[1]);
+    clamps_ += clamped != ctrl;
+    ctrl = clamped;
+  }
+  data_->ctrl[actuator_] = ctrl;
+  double* applied = data_->xfrc_applied + 6 * cart_body_;
+  for (int k = 0; k < 3; ++k)
+    applied[k] = push * slide_axis_[k];
+  for (int i = 0; i < frame_skip_; ++i)
+    mj_step(model_, data_);
+  for (int k = 0; k < 3; ++k)
+    applied[k] = 0.0;
+  readState();
+  return motor_factor_ * gear_ * ctrl + push;
+}
+
+void MujocoEngine::readState()
+{
+  state_ << data_->qpos[cart_qpos_], data_->qvel[cart_dof_], theta_sign_ * data_->qpos[pole_qpos_],
+      theta_sign_ * data_->qvel[pole_dof_];
+}
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,47 @@
+#include "cartpole_qlearning/simulation/physics_engine.h"
+
+#include <cmath>
+
+namespace cartpole_qlearning
+{
+EngineKind engineKindFromString(const std::string& name)
+{
+  if (name == "equations")
+    return EngineKind::Equations;
+  if (name == "mujoco")
+    return EngineKind::Mujoco;
+  throw std::invalid_argument("unknown engine '" + name + "' (allowed: equations, mujoco)");
+}
+
+std::string toString(EngineKind kind)
+{
+  return kind == EngineKind::Mujoco ? "mujoco" : "equations";
+}
+
+EquationsEngine::EquationsEngine(const CartPoleParams& params) : nominal_(params), dynamics_(params)
+{
+}
+
+void EquationsEngine::setFactors(const EpisodeFactors& factors)
+{
+  CartPoleParams physics = nominal_;
+  physics.mass_cart = nominal_.mass_cart * factors.mass_cart;
+  physics.mass_pole = nominal_.mass_pole * factors.mass_pole;
+  physics.half_length = nominal_.half_length * factors.half_length;
+  dynamics_ = CartPoleDynamics(physics);
+  motor_factor_ = factors.motor;
+}
+
+double EquationsEngine::step(double command, double push)
+{
+  // The clamp is the configured force_mag's (the drive's limit); a weaker motor gives less of it.
+  const double clamped = dynamics_.clampForce(command);
+  clamps_ += clamped != command;
+  double force = motor_factor_ * clamped;
+  if (push != 0.0)
+    force += push;
+  state_ = dynamics_.step(state_, force);
+  return force;
+}
+
+}  // namespace cartpole_qlearning
