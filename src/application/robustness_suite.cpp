@@ -227,7 +227,11 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
     }
   };
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t threads = std::min<std::size_t>(how.threads > 0 ? how.threads : cores, order.size());
+  std::size_t threads = std::min<std::size_t>(how.threads > 0 ? how.threads : cores, order.size());
+  // MuJoCo's XML loading is not documented as thread-safe: cases on a model run one after another.
+  if (std::any_of(suite.cases.begin(), suite.cases.end(),
+                  [](const SuiteCase& c) { return c.engine.kind != EngineKind::Equations; }))
+    threads = 1;
   std::vector<std::thread> helpers;
   for (std::size_t t = 1; t < threads; ++t)
     helpers.emplace_back(work);
