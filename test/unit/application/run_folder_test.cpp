@@ -253,7 +253,7 @@ TEST_F(RunFolderTest, ACheckpointSavesTheBestTableBeforeTheRecordThatNamesIt)
   EXPECT_EQ(0u, record(name()).best_episode);
   EXPECT_FALSE(fs::exists(dir_ / name() / kRunBestTableFile));
 
-  BestTable best{learner.table(), SuiteResult{{CaseResult{"nominal", 4, 3, 4, 0.0}}}, 2};
+  BestTable best{learner.table(), SuiteResult{{CaseResult{"nominal", 4, 4, 3, 4, 0.0}}}, 2};
   fall(learner);
   ASSERT_TRUE(run.checkpoint(learner, "max_episodes", &best, message)) << message;
   const RunRecord written = record(name());
