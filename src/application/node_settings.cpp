@@ -308,6 +308,10 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
     protocol.start_region[i] = region[i];
   }
   readRobotInterface(priv, settings.training.physics.tau, settings.robot);
+  // The freshness guard's bound: a few decision periods, and no less than 0.1 s (a real-time
+  // machine's hiccup is not a robot gone). 0 turns it off: a lockstep sim holds no command.
+  settings.freshness_timeout = std::max(0.1, 5.0 * settings.robot.decision_period);
+  priv.readSeconds("freshness_timeout", settings.freshness_timeout, 0.0, 10.0, false);
   priv.readChoice("reset_service_type", settings.reset_service_type,
                   {"cartpole_qlearning/Reset", "std_srvs/Empty", "std_srvs/Trigger"});
   protocol.reset_starts_in_region = settings.reset_service_type != "cartpole_qlearning/Reset";

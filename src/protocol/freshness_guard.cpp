@@ -16,6 +16,7 @@ double seconds(WallClock::duration d)
 // A first publisher silent this long (or the guard's bound, when longer) has gone: a publisher
 // that comes after it takes over (a driver restarted under a new anonymous name).
 constexpr WallClock::duration kPublisherGone = std::chrono::milliseconds(500);
+constexpr WallClock::duration kSayStopEvery = std::chrono::seconds(10);
 }  // namespace
 
 const char* describe(FreshnessGuard::Cause cause)
@@ -93,7 +94,7 @@ bool FreshnessGuard::onMessage(Stamp stamp, bool valid, const std::string& publi
 
 void FreshnessGuard::onDecision(Stamp stamp, WallClock::time_point now, LogLines& log)
 {
-  if (stopped_)
+  if (stopped_ && stop_said_)
     log.push_back({LogLine::Level::Info,
                    formatText("fresh joint_states on %s again after %.2f s without; deciding again", robot_.c_str(),
                               last_decision_at_ ? seconds(now - *last_decision_at_) : 0.0)});
@@ -115,7 +116,12 @@ bool FreshnessGuard::check(WallClock::time_point now, LogLines& log)
   if (stopped_ || !stale(now))
     return false;
   stopped_ = true;
-  log.push_back({LogLine::Level::Warn, describeStop(now)});
+  stop_said_ = !stop_said_at_ || now - *stop_said_at_ >= kSayStopEvery;
+  if (stop_said_)
+  {
+    stop_said_at_ = now;
+    log.push_back({LogLine::Level::Warn, describeStop(now)});
+  }
   return true;
 }
 

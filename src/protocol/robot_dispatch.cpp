@@ -30,7 +30,8 @@ RobotDispatch::Robot::Robot(TrainingSession& session, const RobotDispatchParams&
   : name(params.robots.at(index)),
     protocol(session, protocolParams(params, index)),
     mapping(params.robot),
-    decisions(params.robot.decision_period)
+    decisions(params.robot.decision_period),
+    guard(wallDuration(params.freshness_timeout_s), params.robots.at(index))
 {
 }
 
@@ -44,12 +45,26 @@ RobotDispatch::RobotDispatch(TrainingSession& session, const RobotDispatchParams
     robots_.emplace_back(session, params, r);
 }
 
+RobotDispatch::Orders RobotDispatch::onInvalid(std::size_t r, Stamp stamp, WallClock::time_point now,
+                                               const std::string& publisher)
+{
+  Orders orders;
+  robots_.at(r).guard.onMessage(stamp, false, publisher, now, orders.log);
+  orders.drop = true;
+  return orders;
+}
+
 RobotDispatch::Orders RobotDispatch::onState(std::size_t r, Stamp stamp, const JointReadings& readings,
-                                             WallClock::time_point now)
+                                             WallClock::time_point now, const std::string& publisher)
 {
   Robot& robot = robots_.at(r);
-  const CartPoleState state = robot.mapping.map(stamp, readings);
   Orders orders;
+  if (!robot.guard.onMessage(stamp, true, publisher, now, orders.log))
+  {
+    orders.drop = true;
+    return orders;
+  }
+  const CartPoleState state = robot.mapping.map(stamp, readings);
   if (robot.silent_reported)
   {
     robot.silent_reported = false;
@@ -70,6 +85,7 @@ RobotDispatch::Orders RobotDispatch::onState(std::size_t r, Stamp stamp, const J
   if (!decision.decide && !falls)
   {
     orders.hold = true;
+    orders.hold_zero = !robot.guard.mayPush(now);
     return orders;
   }
   // Only a state the protocol takes as new may learn and draw from the exploration stream: that
@@ -92,14 +108,17 @@ RobotDispatch::Orders RobotDispatch::onTick(WallClock::time_point now)
   for (std::size_t r = 0; r < robots_.size(); ++r)
   {
     Robot& robot = robots_[r];
+    if (robot.guard.check(now, orders.log))
+      orders.stop.push_back(r);
     if (robot.silent_reported || rounds_.silentFor(r, now) < silent_after)
       continue;
     robot.silent_reported = true;
-    orders.stop.push_back(r);
-    orders.log.push_back(
-        {LogLine::Level::Warn, formatText("no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting "
-                                          "for it",
-                                          robot.name.c_str(), params_.silent_after_s)});
+    if (orders.stop.empty() || orders.stop.back() != r)
+      orders.stop.push_back(r);
+    orders.log.push_back({LogLine::Level::Warn,
+                          formatText("no joint_states on %s for %.1f s: is the robot's driver (or its cartpole_sim) "
+                                     "running? Waiting for it",
+                                     robot.name.c_str(), params_.silent_after_s)});
   }
   for (const std::size_t r : rounds_.dropOuts(now))
     orders.log.push_back(
@@ -142,6 +161,11 @@ RobotDispatch::Turn RobotDispatch::serve(std::size_t r, Stamp stamp, const CartP
   turn.log = reactionLog(
       turn.reaction, robot.protocol.counts(), robot.name, stampSeconds(stamp),
       [&] { return dropped_state_warning_.ready(now); }, [&] { return restart_warning_.ready(now); });
+  if (turn.reaction.kind == Reaction::Kind::New)
+    robot.guard.onDecision(stamp, now, turn.log);
+  // An effort goes out only while the guard allows it (a repeat's answer after the bound, say).
+  if (turn.reaction.answer && !robot.guard.mayPush(now))
+    turn.reaction.effort = 0.0;
   return turn;
 }
 

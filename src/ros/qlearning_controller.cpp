@@ -64,8 +64,11 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
   load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
   setUpRobots(state_queue);
-  watchdog_ = nh_.createSteadyTimer(ros::WallDuration(std::min(0.5, settings_.sim_timeout / 2.0)),
-                                    &QLearningControllerNode::onWatchdog, this);
+  // Often enough for the freshness guard to stop a robot within a quarter of its bound past it.
+  double tick = std::min(0.5, settings_.sim_timeout / 2.0);
+  if (settings_.freshness_timeout > 0.0)
+    tick = std::min(tick, settings_.freshness_timeout / 4.0);
+  watchdog_ = nh_.createSteadyTimer(ros::WallDuration(tick), &QLearningControllerNode::onWatchdog, this);
   std::string served;
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
@@ -94,13 +97,17 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
     if (state_queue != nullptr)
       state_nh.setCallbackQueue(state_queue);
     // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
-    robot.state_sub = state_nh.subscribe<sensor_msgs::JointState>(
-        settings_.robot.state_topic, 10,
-        [this, r](const sensor_msgs::JointStateConstPtr& msg) { onJointState(r, msg); }, ros::VoidConstPtr(),
-        ros::TransportHints().tcpNoDelay());
+    // The event, for its publisher's name: two drivers of one robot are told apart by it.
+    const boost::function<void(const ros::MessageEvent<sensor_msgs::JointState const>&)> on_state =
+        [this, r](const ros::MessageEvent<sensor_msgs::JointState const>& event) {
+          onJointState(r, event.getConstMessage(), event.getPublisherName());
+        };
+    robot.state_sub = state_nh.subscribe<sensor_msgs::JointState>(settings_.robot.state_topic, 10, on_state, ros::VoidConstPtr(),
+                                         ros::TransportHints().tcpNoDelay());
     names.push_back(describe(robot));
   }
-  const RobotDispatchParams dispatch{names, settings_.sync, settings_.sim_timeout, settings_.robot, settings_.protocol};
+  const RobotDispatchParams dispatch{names,          settings_.sync,  settings_.sim_timeout, settings_.freshness_timeout,
+                                     settings_.robot, settings_.protocol};
   dispatch_ = std::make_unique<RobotDispatch>(*session_, dispatch, WallClock::now());
 }
 
@@ -161,7 +168,8 @@ void QLearningControllerNode::stop()
     robot.command.stop();
 }
 
-void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::JointStateConstPtr& msg)
+void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::JointStateConstPtr& msg,
+                                           const std::string& publisher)
 {
   const std::lock_guard<std::mutex> lock(mutex_);
   if (app_->finished())
@@ -172,11 +180,16 @@ void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::Joi
   {
     if (bad_state_warning_.ready())
       say({{LogLine::Level::Warn, reading.refusal}});
+    say(dispatch_->onInvalid(r, msg->header.stamp.toNSec(), WallClock::now(), publisher).log);
     return;
   }
   const RobotDispatch::Orders orders =
-      dispatch_->onState(r, msg->header.stamp.toNSec(), *reading.value, WallClock::now());
+      dispatch_->onState(r, msg->header.stamp.toNSec(), *reading.value, WallClock::now(), publisher);
   say(orders.log);
+  if (orders.drop)
+    return;
+  if (orders.hold && orders.hold_zero)
+    return robots_[r].command.publish(0.0, msg->header.stamp);
   if (orders.hold)
     return robots_[r].command.hold(msg->header.stamp);
   serveDue();

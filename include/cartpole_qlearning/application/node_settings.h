@@ -62,6 +62,8 @@ struct ControllerSettings
   RunSettings run;
   bool shutdown_when_finished = true;                // end the launch (or the node) when done
   double sim_timeout = 2.0;                          // [s] wall: a robot silent this long is said to be gone
+  // [s] wall: efforts go out only this long after a fresh, valid state was decided on (0: off).
+  double freshness_timeout = 0.1;
   std::string reset_service = "cartpole_sim/reset";  // "": a robot that cannot be reset on command
   std::vector<std::string> robots{""};               // namespaces relative to the learner's
   bool sync = true;                                  // several robots: served in lockstep rounds

@@ -84,6 +84,10 @@ private:
   std::string publisher_;
   WallClock::time_point publisher_heard_at_;
   std::string refused_publisher_;  // the second one, said once
+  // A robot whose states come and go (a loaded machine in real time) is stopped each time, but
+  // said so at most once per kSayStopEvery; its return is said when its stop was.
+  std::optional<WallClock::time_point> stop_said_at_;
+  bool stop_said_ = false;
 };
 
 const char* describe(FreshnessGuard::Cause cause);

@@ -4,7 +4,10 @@
 // ~decision_period (DecisionClock; the states between are answered with the effort held, except
 // a fall, which ends the episode whenever it comes), and holds a new state back for its round
 // (RobotRounds) so that the Q-table depends on the seed alone. A robot silent for ~sim_timeout is
-// reported once and commanded zero, and drops out of the rounds while the others wait.
+// reported once and commanded zero, and drops out of the rounds while the others wait. Each
+// robot's FreshnessGuard keeps its efforts going only while fresh, valid states are decided on
+// (freshness_timeout_s): frozen or dropping stamps, invalid readings, a second publisher or
+// silence command it zero within the bound.
 //
 // Events in (a state arrived, a timer tick), orders out: the node feeds it what it receives with
 // the time, then serves each Turn that next() returns (publishes, ends episodes, asks for resets)
@@ -14,6 +17,7 @@
 #include "cartpole_qlearning/common/log_line.h"
 #include "cartpole_qlearning/common/wall_throttle.h"
 #include "cartpole_qlearning/learning/training_session.h"
+#include "cartpole_qlearning/protocol/freshness_guard.h"
 #include "cartpole_qlearning/protocol/lockstep_protocol.h"
 #include "cartpole_qlearning/protocol/robot_interface.h"
 #include "cartpole_qlearning/protocol/robot_rounds.h"
@@ -31,6 +35,7 @@ struct RobotDispatchParams
   std::vector<std::string> robots;
   bool sync = true;                   // ~sync: several robots' new states in rounds
   double silent_after_s = 5.0;        // ~sim_timeout [s]: a robot this long without a state is silent
+  double freshness_timeout_s = 0.0;   // ~freshness_timeout [s]: efforts only this long after a fresh state (0: off)
   RobotInterfaceParams robot;         // the readings' mapping and ~decision_period (every robot alike)
   ControllerProtocolParams protocol;  // every robot's (the index is set per robot)
 };
@@ -43,9 +48,12 @@ public:
   {
     LogLines log;
     // onState: the state is not decided on (within the decision period): answer it with the
-    // effort held, stamped with its stamp.
+    // effort held, stamped with its stamp (with 0 when hold_zero: the guard allows no effort).
     bool hold = false;
-    // onTick: robots silent for silent_after_s, just noticed: command them zero.
+    bool hold_zero = false;
+    // onState, onInvalid: the message is dropped (a second publisher's, or invalid readings).
+    bool drop = false;
+    // onTick: robots silent for silent_after_s, or whose guard has just stopped them: command them zero.
     std::vector<std::size_t> stop;
   };
 
@@ -63,8 +71,13 @@ public:
   // every robot's silence.
   RobotDispatch(TrainingSession& session, const RobotDispatchParams& params, WallClock::time_point now);
 
-  // A state of `robot` arrived, stamped `stamp`, at wall time now.
-  Orders onState(std::size_t robot, Stamp stamp, const JointReadings& readings, WallClock::time_point now);
+  // A state of `robot` arrived, stamped `stamp`, at wall time now, from `publisher` (its caller
+  // id; "" when unknown).
+  Orders onState(std::size_t robot, Stamp stamp, const JointReadings& readings, WallClock::time_point now,
+                 const std::string& publisher = "");
+  // A message of `robot` without a usable state (NaN or inf readings, a joint missing): the node
+  // has dropped it and said why; the guard counts it.
+  Orders onInvalid(std::size_t robot, Stamp stamp, WallClock::time_point now, const std::string& publisher = "");
   // The watchdog's tick: silent robots (reported once each until heard again) and drop-outs.
   Orders onTick(WallClock::time_point now);
   // The next state to serve, or none: a state taken at once, else every state of a complete
@@ -84,6 +97,7 @@ private:
     ControllerProtocol protocol;
     StateMapping mapping;
     DecisionClock decisions;
+    FreshnessGuard guard;
     Stamp held_stamp = 0;  // a new state waiting for its round
     CartPoleState held_state;
     bool silent_reported = false;

@@ -258,3 +258,22 @@ TEST(FreshnessGuard, ABoundOfZeroIsOff)
 }
 
 }  // namespace
+
+TEST(FreshnessGuard, AStreamThatComesAndGoesIsStoppedEachTimeAndSaidOncePerTenSeconds)
+{
+  Script s;
+  Stamp next = kTick;
+  for (int i = 0; i < 20; ++i)  // 20 gaps of 0.2 s in 4 s: each one stops the efforts
+  {
+    next = s.freshRun(next, 5);
+    s.wait(milliseconds(200));
+    EXPECT_FALSE(s.pushes());
+  }
+  EXPECT_EQ(20, s.stops_);
+  EXPECT_EQ(1, s.linesAt(LogLine::Level::Warn)) << s.text();
+  EXPECT_EQ(1, s.linesAt(LogLine::Level::Info)) << "back, once: after the stop that was said";
+  s.wait(milliseconds(10000));
+  s.freshRun(next, 5);
+  s.wait(milliseconds(200));
+  EXPECT_EQ(2, s.linesAt(LogLine::Level::Warn)) << "ten seconds on, a stop is said again";
+}

@@ -197,7 +197,7 @@ TEST_F(RobotDispatchTest, ASilentRobotIsStoppedAndSaidOnceAndDropsOutOfTheRounds
   RobotDispatch::Orders orders = dispatch.onTick(kT0 + milliseconds(1000));
   EXPECT_EQ(std::vector<std::size_t>{1}, orders.stop) << "robot 1 silent since the start; robot 0 heard 0.5 s ago";
   EXPECT_EQ(
-      "no joint_states on /robot_1/joint_states for 1.0 s: is its cartpole_sim running? Waiting for it\n"
+      "no joint_states on /robot_1/joint_states for 1.0 s: is the robot's driver (or its cartpole_sim) running? Waiting for it\n"
       "/robot_1/joint_states is silent; the rounds go on without it until it is back\n",
       text(orders.log));
   // The round of robot 0 alone goes on.
@@ -316,3 +316,102 @@ TEST(RobotDispatch, RobotsWhoseStatesArriveInAnyOrderTrainExactlyAsTheLoopback)
 }
 
 }  // namespace
+
+// The freshness guard on the dispatch's paths: the answer to a frozen stamp, a hold between
+// decisions, invalid readings and a second publisher, each ending in 0 within the bound.
+TEST_F(RobotDispatchTest, FrozenStampsAreAnsweredWithZeroOnceTheBoundHasPassed)
+{
+  params_.freshness_timeout_s = 0.1;
+  RobotDispatch& dispatch = make(1);
+  WallClock::time_point now = kT0;
+  std::optional<RobotDispatch::Turn> turn;
+  // Some fresh states: an episode runs, efforts of +-10 go out.
+  Stamp s = 0;
+  for (int i = 1; i <= 5; ++i)
+  {
+    now += milliseconds(20);
+    s = tick(static_cast<std::uint64_t>(i));
+    dispatch.onState(0, s, readings(kUpright), now, "/driver");
+    turn = dispatch.next(now);
+    ASSERT_TRUE(turn);
+    ASSERT_NE(0.0, turn->reaction.effort);
+  }
+  const double effort = turn->reaction.effort;
+  // The driver republishes its last message: the same effort within the bound, 0 past it.
+  now += milliseconds(50);
+  dispatch.onState(0, s, readings(kUpright), now, "/driver");
+  turn = dispatch.next(now);
+  ASSERT_TRUE(turn);
+  EXPECT_EQ(Reaction::Kind::Repeat, turn->reaction.kind);
+  EXPECT_EQ(effort, turn->reaction.effort);
+  now += milliseconds(60);
+  const RobotDispatch::Orders tick_orders = dispatch.onTick(now);
+  EXPECT_EQ(std::vector<std::size_t>{0}, tick_orders.stop);
+  EXPECT_NE(std::string::npos, text(tick_orders.log).find("frozen stamps")) << text(tick_orders.log);
+  dispatch.onState(0, s, readings(kUpright), now, "/driver");
+  turn = dispatch.next(now);
+  ASSERT_TRUE(turn);
+  EXPECT_TRUE(turn->reaction.answer);
+  EXPECT_EQ(0.0, turn->reaction.effort) << "a stale decision's effort is not sent again";
+  // A fresh state: efforts again.
+  now += milliseconds(20);
+  dispatch.onState(0, tick(6), readings(kUpright), now, "/driver");
+  turn = dispatch.next(now);
+  ASSERT_TRUE(turn);
+  EXPECT_NE(0.0, turn->reaction.effort);
+  EXPECT_NE(std::string::npos, text(turn->log).find("again")) << text(turn->log);
+}
+
+TEST_F(RobotDispatchTest, HoldsBetweenDecisionsTurnToZeroWhenNoDecisionComes)
+{
+  params_.freshness_timeout_s = 0.1;
+  RobotDispatch& dispatch = make(1);
+  params_.robot.decision_period = 0.02;
+  WallClock::time_point now = kT0 + milliseconds(1);
+  dispatch.onState(0, tick(1), readings(kUpright), now, "/driver");
+  ASSERT_TRUE(dispatch.next(now));
+  // NaN bursts: dropped, counted, and past the bound the guard stops the robot.
+  for (int i = 0; i < 10; ++i)
+  {
+    now += milliseconds(20);
+    const RobotDispatch::Orders orders = dispatch.onInvalid(0, tick(2) + static_cast<Stamp>(i) * kMs, now, "/driver");
+    EXPECT_TRUE(orders.drop);
+  }
+  const RobotDispatch::Orders stop = dispatch.onTick(now);
+  EXPECT_EQ(std::vector<std::size_t>{0}, stop.stop);
+  EXPECT_NE(std::string::npos, text(stop.log).find("NaN")) << text(stop.log);
+  // A state a millisecond after the last decided one is held (within the decision period): with 0.
+  now += milliseconds(1);
+  const RobotDispatch::Orders hold = dispatch.onState(0, tick(1) + kMs, readings(kUpright), now, "/driver");
+  EXPECT_TRUE(hold.hold);
+  EXPECT_TRUE(hold.hold_zero);
+}
+
+TEST_F(RobotDispatchTest, ASecondPublishersStatesAreDroppedWithAnErrorNamingBoth)
+{
+  params_.freshness_timeout_s = 0.1;
+  RobotDispatch& dispatch = make(1);
+  WallClock::time_point now = kT0 + milliseconds(1);
+  dispatch.onState(0, tick(1), readings(kUpright), now, "/driver");
+  ASSERT_TRUE(dispatch.next(now));
+  now += milliseconds(10);
+  const RobotDispatch::Orders second = dispatch.onState(0, tick(2), readings(kUpright), now, "/other_driver");
+  EXPECT_TRUE(second.drop);
+  EXPECT_FALSE(dispatch.next(now)) << "nothing to serve from the second driver";
+  ASSERT_EQ(1u, second.log.size());
+  EXPECT_EQ(LogLine::Level::Error, second.log[0].level);
+  EXPECT_NE(std::string::npos, second.log[0].text.find("/driver and /other_driver")) << second.log[0].text;
+}
+
+TEST_F(RobotDispatchTest, WithTheGuardOffARepeatIsAnsweredWithItsEffortHoweverLate)
+{
+  RobotDispatch& dispatch = make(1);  // freshness_timeout_s 0: a lockstep sim
+  dispatch.onState(0, tick(1), readings(kUpright), kT0, "/sim");
+  const std::optional<RobotDispatch::Turn> first = dispatch.next(kT0);
+  ASSERT_TRUE(first);
+  dispatch.onState(0, tick(1), readings(kUpright), kT0 + milliseconds(5000), "/sim");
+  const std::optional<RobotDispatch::Turn> repeat = dispatch.next(kT0 + milliseconds(5000));
+  ASSERT_TRUE(repeat);
+  EXPECT_EQ(first->reaction.effort, repeat->reaction.effort);
+  EXPECT_TRUE(dispatch.onTick(kT0 + milliseconds(5000)).stop.size() <= 1) << "only the silence report";
+}
