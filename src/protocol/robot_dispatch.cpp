@@ -1,5 +1,6 @@
 #include "cartpole_qlearning/protocol/robot_dispatch.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace cartpole_qlearning
@@ -43,6 +44,14 @@ RobotDispatch::RobotDispatch(TrainingSession& session, const RobotDispatchParams
   robots_.reserve(params.robots.size());
   for (std::size_t r = 0; r < params.robots.size(); ++r)
     robots_.emplace_back(session, params, r);
+}
+
+double RobotDispatch::tickSeconds() const
+{
+  double tick = std::min(0.5, params_.silent_after_s / 2.0);
+  if (params_.freshness_timeout_s > 0.0)
+    tick = std::min(tick, params_.freshness_timeout_s / 4.0);
+  return tick;
 }
 
 RobotDispatch::Orders RobotDispatch::onInvalid(std::size_t r, Stamp stamp, WallClock::time_point now,

@@ -20,10 +20,11 @@ public:
   // A state between two decisions (~decision_period): a stamped command answers it with the
   // effort held (a lockstep sim steps only on an answer); Float64 commands go out at decisions
   // only (the robot's controller holds the last one).
-  void hold(const ros::Time& stamp)
+  // allowed false (the freshness guard): 0 in place of the effort held.
+  void hold(const ros::Time& stamp, bool allowed = true)
   {
     if (params_.command_type == CommandType::JointState)
-      publish(held_, stamp);
+      publish(allowed ? held_ : 0.0, stamp);
   }
   // Zero effort, unstamped: it answers no state (a lockstep sim steps on no such command), it
   // stops a robot that holds its last command (ros_control's forward controllers hold it forever).

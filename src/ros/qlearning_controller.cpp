@@ -10,7 +10,6 @@
 #include <ros/names.h>
 #include <ros/package.h>
 
-#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -64,11 +63,8 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
   load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
   setUpRobots(state_queue);
-  // Often enough for the freshness guard to stop a robot within a quarter of its bound past it.
-  double tick = std::min(0.5, settings_.sim_timeout / 2.0);
-  if (settings_.freshness_timeout > 0.0)
-    tick = std::min(tick, settings_.freshness_timeout / 4.0);
-  watchdog_ = nh_.createSteadyTimer(ros::WallDuration(tick), &QLearningControllerNode::onWatchdog, this);
+  watchdog_ = nh_.createSteadyTimer(ros::WallDuration(dispatch_->tickSeconds()), &QLearningControllerNode::onWatchdog,
+                                    this);
   std::string served;
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
@@ -98,12 +94,9 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
       state_nh.setCallbackQueue(state_queue);
     // TCP_NODELAY: in lockstep every step is a message each way; Nagle's delay would dominate.
     // The event, for its publisher's name: two drivers of one robot are told apart by it.
-    const boost::function<void(const ros::MessageEvent<sensor_msgs::JointState const>&)> on_state =
-        [this, r](const ros::MessageEvent<sensor_msgs::JointState const>& event) {
-          onJointState(r, event.getConstMessage(), event.getPublisherName());
-        };
-    robot.state_sub = state_nh.subscribe<sensor_msgs::JointState>(settings_.robot.state_topic, 10, on_state, ros::VoidConstPtr(),
-                                         ros::TransportHints().tcpNoDelay());
+    robot.state_sub = state_nh.subscribe<sensor_msgs::JointState>(
+        settings_.robot.state_topic, 10, StateCallback([this, r](const StateEvent& event) { onJointState(r, event); }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
     names.push_back(describe(robot));
   }
   const RobotDispatchParams dispatch{names,          settings_.sync,  settings_.sim_timeout, settings_.freshness_timeout,
@@ -168,9 +161,10 @@ void QLearningControllerNode::stop()
     robot.command.stop();
 }
 
-void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::JointStateConstPtr& msg,
-                                           const std::string& publisher)
+void QLearningControllerNode::onJointState(std::size_t r, const StateEvent& event)
 {
+  const sensor_msgs::JointStateConstPtr msg = event.getConstMessage();
+  const std::string& publisher = event.getPublisherName();
   const std::lock_guard<std::mutex> lock(mutex_);
   if (app_->finished())
     return;
@@ -186,13 +180,10 @@ void QLearningControllerNode::onJointState(std::size_t r, const sensor_msgs::Joi
   const RobotDispatch::Orders orders =
       dispatch_->onState(r, msg->header.stamp.toNSec(), *reading.value, WallClock::now(), publisher);
   say(orders.log);
-  if (orders.drop)
-    return;
-  if (orders.hold && orders.hold_zero)
-    return robots_[r].command.publish(0.0, msg->header.stamp);
   if (orders.hold)
-    return robots_[r].command.hold(msg->header.stamp);
-  serveDue();
+    robots_[r].command.hold(msg->header.stamp, !orders.hold_zero);
+  if (!orders.drop && !orders.hold)
+    serveDue();
 }
 
 void QLearningControllerNode::serveDue()

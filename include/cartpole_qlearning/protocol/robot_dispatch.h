@@ -84,6 +84,10 @@ public:
   // round, in robot order. Call until none (or until the run is over) after every event.
   std::optional<Turn> next(WallClock::time_point now);
 
+  // How often onTick must come: the silence report within half of silent_after_s, and the guard's
+  // stop within a quarter of its bound past it.
+  double tickSeconds() const;
+
   const ControllerProtocol& protocol(std::size_t robot) const
   {
     return robots_.at(robot).protocol;

@@ -81,7 +81,9 @@ private:
   // Training or evaluation is over: ends the launch (or the node) when ~shutdown_when_finished.
   void endWhenFinished();
   void setUpRobots(ros::CallbackQueue* state_queue);
-  void onJointState(std::size_t robot, const sensor_msgs::JointStateConstPtr& msg, const std::string& publisher);
+  using StateEvent = ros::MessageEvent<sensor_msgs::JointState const>;
+  using StateCallback = boost::function<void(const StateEvent&)>;
+  void onJointState(std::size_t robot, const StateEvent& event);
   // Serves what the dispatch has to serve until it has nothing more or the run is over.
   void serveDue();
   bool onSave(SaveQTable::Request& request, SaveQTable::Response& response);
