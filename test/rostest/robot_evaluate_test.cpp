@@ -39,7 +39,9 @@ double numberParam(const std::string& name)
 // robot.launch mode:=evaluate with the table, 5 episodes, and `args`; the mean return of its verdict (-1: none).
 double evaluate(const std::string& home, const std::string& name, const std::string& args)
 {
-  TrainLaunch launch(home, name, "mode:=evaluate load:=q_table.yaml episodes:=5 " + args, "robot.launch");
+  // The sim poses in lockstep and holds no command: no freshness guard.
+  TrainLaunch launch(home, name, "mode:=evaluate load:=q_table.yaml episodes:=5 freshness_timeout:=0 " + args,
+                     "robot.launch");
   const int status = launch.waitFor(90.0);
   const std::string output = launch.output();
   EXPECT_EQ(0, status) << output;

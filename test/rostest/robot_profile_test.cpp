@@ -62,7 +62,9 @@ TEST(RobotProfile, TrainsUntilSolvedThenTheTableIsEvaluated)
   stats.clear();
   TrainLaunch evaluation(
       home, "evaluate",
-      "robot:=" + robot + " mode:=evaluate load:=q_table.yaml episodes:=10 " + privateParam("evaluate_args"),
+      // A lockstep sim holds no command: no freshness guard, as in the .test's training.
+      "robot:=" + robot + " mode:=evaluate load:=q_table.yaml episodes:=10 freshness_timeout:=0 " +
+          privateParam("evaluate_args"),
       "robot.launch");
   const int status = evaluation.waitFor(120.0);
   const std::string output = evaluation.output();
