@@ -1,5 +1,7 @@
 #include "cartpole_qlearning/ros/conversions.h"
 
+#include <ros/node_handle.h>
+
 #include "cartpole_qlearning/learning/schedule.h"
 
 #include <algorithm>
@@ -199,6 +201,12 @@ std::vector<std::string> learningConfigKeys()
   for (const auto& field : kFields)
     keys.push_back(field.first);
   return keys;
+}
+
+void setLearningConfigParams(const LearningConfig& config, const ros::NodeHandle& nh)
+{
+  for (const auto& [key, field] : kFields)
+    std::visit([&, key = key](auto member) { nh.setParam(key, config.*member); }, field);
 }
 
 LearningSettings learningSettingsLeft(const ParameterSource& source, const LearningSettings& in_use)

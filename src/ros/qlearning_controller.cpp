@@ -316,11 +316,11 @@ void QLearningControllerNode::startLiveTuning()
       running = toConfig(in_use);
     }
   }
-  // With mutex_ free: setCallback calls onReconfigure at once, which takes it. The server starts
-  // from what it finds on the parameter server; a new run gives it the values in use first.
-  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<LearningConfig>>(reconfigure_mutex_, pnh_);
+  // With mutex_ free: setCallback calls onReconfigure at once, which takes it. The server starts from
+  // the parameter server, where a new run first puts the values in use: no client sees others.
   if (running)
-    reconfigure_->updateConfig(*running);
+    setLearningConfigParams(*running, pnh_);
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<LearningConfig>>(reconfigure_mutex_, pnh_);
   reconfigure_->setCallback([this](LearningConfig& config, std::uint32_t level) { onReconfigure(config, level); });
 }
 

@@ -21,6 +21,11 @@
 #include <string>
 #include <vector>
 
+namespace ros
+{
+class NodeHandle;
+}
+
 namespace cartpole_qlearning
 {
 // What a message said, or why it was refused ("dropped joint_states without pole_joint").
@@ -99,6 +104,10 @@ std::string asServerField(std::string message);
 // The server's fields as it keeps them on the parameter server, under the node's private
 // namespace ("gamma", "epsilon_schedule", ...): keys the node's parameter check must let pass.
 std::vector<std::string> learningConfigKeys();
+// Puts the live-tuning fields under nh (the controller's private namespace), where the
+// dynamic_reconfigure server reads its first values: it then starts from them, with no moment in
+// which it serves others.
+void setLearningConfigParams(const LearningConfig& config, const ros::NodeHandle& nh);
 // What an earlier server left in source (the node's private namespace): the settings in use with
 // the fields present there replaced. A value of the wrong type leaves its field as it was, as the
 // server's own start does.
