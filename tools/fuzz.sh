@@ -22,7 +22,7 @@ mkdir -p "$WORK"
 
 # The core layers the parsers live in and rest on (the table file and the config readers are
 # learning's), as CMakeLists.txt lists them for their libraries.
-mapfile -t CORE < <(sed -n '/^add_core_layer(\(common\|io\|simulation\|learning\)/,/)$/p' "$SRC/CMakeLists.txt" |
+mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_\(common\|io\|simulation\|learning\)/,/)$/p' "$SRC/CMakeLists.txt" |
   grep -o 'src/[a-z_]*/[a-z_]*\.cpp')
 # Line tables only (as tools/sanitize.sh): a report's frames still name function, file and line,
 # for about 10 % less compile time.

@@ -145,8 +145,8 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
   const std::string mismatch = session.replaceTable(table);
   if (!mismatch.empty())
     throw ConfigError("the table does not fit the configuration: " + mismatch);
-  CartPoleSimulation simulation =
-      makeSimulation(suite_case.physics, suite_case.engine, suite_case.start_state_bound, seed, suite_case.perturbations);
+  CartPoleSimulation simulation = makeSimulation(suite_case.physics, suite_case.engine, suite_case.start_state_bound,
+                                                 seed, suite_case.perturbations);
   CaseResult result;
   result.name = suite_case.name;
   result.pass = suite_case.pass;
@@ -186,8 +186,7 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
   if (order.empty())
     for (std::size_t i = 0; i < suite.cases.size(); ++i)
       order.push_back(i);
-  if (order.size() != suite.cases.size() ||
-      std::set<std::size_t>(order.begin(), order.end()).size() != order.size() ||
+  if (order.size() != suite.cases.size() || std::set<std::size_t>(order.begin(), order.end()).size() != order.size() ||
       *std::max_element(order.begin(), order.end()) >= suite.cases.size())
     throw std::invalid_argument("evaluateSuite: the order must name each of the suite's cases once");
 
@@ -206,8 +205,8 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
         return;
       try
       {
-        results[p] = evaluateCase(table, judged, suite.cases[order[p]], suite.episodes, suite.seed,
-                                  how.stop_cases_when_decided);
+        results[p] =
+            evaluateCase(table, judged, suite.cases[order[p]], suite.episodes, suite.seed, how.stop_cases_when_decided);
       }
       catch (...)
       {

@@ -137,16 +137,16 @@ std::string learningSettingsText(const LearningSettings& s)
 }
 
 LogLines liveTuningLog(const LearningSettings& in_use, const LearningSettings& wanted, const std::string& error,
-                      bool restarted, bool learning)
+                       bool restarted, bool learning)
 {
   if (!error.empty())
   {
     if (restarted)
-      return {{LogLine::Level::Warn, "restarted; the live tuning left by the controller before the restart is refused (" +
-                                      error +
-                                      "): this run goes on with its configuration's: " + learningSettingsText(in_use)}};
-    return {{LogLine::Level::Warn, "live tuning refused (asked: " + learningChangesText(in_use, wanted) + "): " + error +
-                                    "; nothing changed, in use: " + learningSettingsText(in_use)}};
+      return {{LogLine::Level::Warn,
+               "restarted; the live tuning left by the controller before the restart is refused (" + error +
+                   "): this run goes on with its configuration's: " + learningSettingsText(in_use)}};
+    return {{LogLine::Level::Warn, "live tuning refused (asked: " + learningChangesText(in_use, wanted) +
+                                       "): " + error + "; nothing changed, in use: " + learningSettingsText(in_use)}};
   }
   const std::string changes = learningChangesText(in_use, wanted);
   if (changes.empty())
@@ -155,8 +155,8 @@ LogLines liveTuningLog(const LearningSettings& in_use, const LearningSettings& w
                                        : "evaluating, so none of it applies: actions stay greedy (epsilon 0), nothing "
                                          "is learnt (alpha 0, gamma unused)";
   if (restarted)
-    return {{LogLine::Level::Warn, "restarted; the live tuning of this run before the restart applies again: " + changes +
-                                    " (" + applies + ")"}};
+    return {{LogLine::Level::Warn, "restarted; the live tuning of this run before the restart applies again: " +
+                                       changes + " (" + applies + ")"}};
   return {{LogLine::Level::Info, "live tuning: " + changes + " (" + applies + ")"}};
 }
 

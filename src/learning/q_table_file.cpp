@@ -231,8 +231,7 @@ std::string formatQTable(const QTable& table)
     quoted << YAML::DoubleQuoted << table.trained_with;
     out << "trained_with: " << quoted.c_str() << "\n";
   }
-  out
-      << "# Training that produced this table.\n"
+  out << "# Training that produced this table.\n"
       << "episodes: " << table.episodes << "\n"
       << "steps: " << table.steps << "\n"
       << "rows: " << table.stateCount() << "\n"

@@ -272,8 +272,9 @@ void readPhysics(const ParameterSource& source, CartPoleParams& physics, double&
   EngineParams engine;
   readPhysics(source, physics, start_state_bound, engine);
   if (engine.kind != EngineKind::Equations)
-    throw ConfigError(source.describe("physics/engine") + " = '" + toString(engine.kind) +
-                      "' is not allowed here (allowed: equations; MuJoCo runs in train_headless and its robustness suite)");
+    throw ConfigError(
+        source.describe("physics/engine") + " = '" + toString(engine.kind) +
+        "' is not allowed here (allowed: equations; MuJoCo runs in train_headless and its robustness suite)");
 }
 
 void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound,
@@ -286,7 +287,7 @@ void readPhysics(const ParameterSource& source, CartPoleParams& physics, double&
   reader.read("pole_joint", engine.pole_joint);
   reader.read("actuator", engine.actuator);
   const bool mujoco = engine.kind == EngineKind::Mujoco;
-  const char* const equations_keys[] = {"gravity", "mass_cart", "mass_pole", "half_length",
+  const char* const equations_keys[] = {"gravity",    "mass_cart",     "mass_pole",    "half_length",
                                         "integrator", "cart_friction", "pole_friction"};
   const char* const model_keys[] = {"model", "cart_joint", "pole_joint", "actuator"};
   for (const char* name : mujoco ? std::vector<const char*>(std::begin(equations_keys), std::end(equations_keys))

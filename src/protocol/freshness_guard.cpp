@@ -65,11 +65,11 @@ bool FreshnessGuard::onMessage(Stamp stamp, bool valid, const std::string& publi
       if (refused_publisher_ != publisher)
       {
         refused_publisher_ = publisher;
-        log.push_back({LogLine::Level::Error,
-                       formatText("joint_states on %s come from two publishers, %s and %s: two drivers of one robot? "
-                                  "Only %s's states are taken; stop %s",
-                                  robot_.c_str(), publisher_.c_str(), publisher.c_str(), publisher_.c_str(),
-                                  publisher.c_str())});
+        log.push_back(
+            {LogLine::Level::Error,
+             formatText("joint_states on %s come from two publishers, %s and %s: two drivers of one robot? "
+                        "Only %s's states are taken; stop %s",
+                        robot_.c_str(), publisher_.c_str(), publisher.c_str(), publisher_.c_str(), publisher.c_str())});
       }
       return false;
     }
@@ -156,9 +156,10 @@ std::string FreshnessGuard::describeStop(WallClock::time_point now) const
       why = formatText("%llu without a stamp (0) after stamped ones", static_cast<unsigned long long>(count));
       break;
     case Cause::Frozen:
-      why = formatText("%llu with the stamp already decided on, %.3f s: frozen stamps (a driver republishing "
-                       "its last message?)",
-                       static_cast<unsigned long long>(count), last_s);
+      why = formatText(
+          "%llu with the stamp already decided on, %.3f s: frozen stamps (a driver republishing "
+          "its last message?)",
+          static_cast<unsigned long long>(count), last_s);
       break;
     case Cause::Older:
       why = formatText("%llu with stamps older than %.3f s, the last decided on (time went back, or a replay)",

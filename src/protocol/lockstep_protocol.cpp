@@ -299,8 +299,8 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
 }
 
 LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts& c, const std::string& robot,
-                    double stamp_s, const std::function<bool()>& dropped_ready,
-                    const std::function<bool()>& restart_ready)
+                     double stamp_s, const std::function<bool()>& dropped_ready,
+                     const std::function<bool()>& restart_ready)
 {
   using Level = LogLine::Level;
   const auto count = [](std::uint64_t n) { return static_cast<unsigned long long>(n); };
@@ -313,20 +313,20 @@ LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts&
                                  robot.c_str(), stamp_s, count(c.stale))});
   if (reaction.kind == Reaction::Kind::Stray && dropped_ready())
     log.push_back({Level::Warn, formatText("dropped joint_states on %s without a stamp among stamped ones. Dropped so "
-                                            "far: %llu",
-                                            robot.c_str(), count(c.stray))});
+                                           "far: %llu",
+                                           robot.c_str(), count(c.stray))});
   if (reaction.first_unstamped)
     log.push_back({Level::Warn, formatText("joint_states on %s carry no stamp (0): every message is taken as a new "
-                                            "state, and commands go out unstamped",
-                                            robot.c_str())});
+                                           "state, and commands go out unstamped",
+                                           robot.c_str())});
   if (reaction.sim_restarted && restart_ready())
     log.push_back({Level::Warn, formatText("%s: time went back to %.3f s: the sim restarted (or was reset); starting "
-                                            "a new episode. Restarts so far: %llu",
-                                            robot.c_str(), stamp_s, count(c.restarts))});
+                                           "a new episode. Restarts so far: %llu",
+                                           robot.c_str(), stamp_s, count(c.restarts))});
   if (reaction.waiting_for_start)
     log.push_back({Level::Info, formatText("%s: episode over; no reset service, so commanding 0 until the state is "
-                                            "back inside ~start_region (stand the pole up)",
-                                            robot.c_str())});
+                                           "back inside ~start_region (stand the pole up)",
+                                           robot.c_str())});
   return log;
 }
 

@@ -56,8 +56,8 @@ ResetCalls::Orders ResetCalls::onReturn(std::uint64_t generation, bool answered,
   }
   if (!failing_)
     orders.log.push_back({LogLine::Level::Warn, "reset call to " + service_ + " failed" +
-                                                (message.empty() ? "" : ": " + message) +
-                                                "; retrying until it answers"});
+                                                    (message.empty() ? "" : ": " + message) +
+                                                    "; retrying until it answers"});
   failing_ = true;
   wanted_ = true;
   retry_at_ = later(now, retry_after_);
@@ -88,7 +88,7 @@ ResetCalls::Orders ResetCalls::onTime(Clock::time_point now)
   char after[32];
   std::snprintf(after, sizeof after, "%.1f", std::chrono::duration<double>(give_up_after_).count());
   orders.log.push_back({LogLine::Level::Warn, "reset call to " + service_ + " has not returned after " + after +
-                                              " s; giving it up and retrying on a new connection"});
+                                                  " s; giving it up and retrying on a new connection"});
   failing_ = true;
   wanted_ = true;
   retry_at_ = now;

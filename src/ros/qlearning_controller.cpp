@@ -63,8 +63,8 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
   load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
   setUpRobots(state_queue);
-  watchdog_ = nh_.createSteadyTimer(ros::WallDuration(dispatch_->tickSeconds()), &QLearningControllerNode::onWatchdog,
-                                    this);
+  watchdog_ =
+      nh_.createSteadyTimer(ros::WallDuration(dispatch_->tickSeconds()), &QLearningControllerNode::onWatchdog, this);
   std::string served;
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
@@ -99,8 +99,8 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
         ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
     names.push_back(describe(robot));
   }
-  const RobotDispatchParams dispatch{names,          settings_.sync,  settings_.sim_timeout, settings_.freshness_timeout,
-                                     settings_.robot, settings_.protocol};
+  const RobotDispatchParams dispatch{
+      names, settings_.sync, settings_.sim_timeout, settings_.freshness_timeout, settings_.robot, settings_.protocol};
   dispatch_ = std::make_unique<RobotDispatch>(*session_, dispatch, WallClock::now());
 }
 

@@ -34,7 +34,8 @@ std::string jointList(const mjModel* m)
   for (int j = 0; j < m->njnt; ++j)
   {
     const char* name = mj_id2name(m, mjOBJ_JOINT, j);
-    list += (list.empty() ? "" : ", ") + std::string(name ? name : "(unnamed)") + " (" + jointKind(m->jnt_type[j]) + ")";
+    list +=
+        (list.empty() ? "" : ", ") + std::string(name ? name : "(unnamed)") + " (" + jointKind(m->jnt_type[j]) + ")";
   }
   return list.empty() ? "none" : list;
 }
@@ -192,7 +193,8 @@ double MujocoEngine::forceLimit() const
 void MujocoEngine::setFactors(const EpisodeFactors& factors)
 {
   const mjModel* m = loaded_.get();
-  for (const auto& [body, factor] : {std::pair<int, double>{cart_body_, factors.mass_cart}, {pole_body_, factors.mass_pole}})
+  for (const auto& [body, factor] :
+       {std::pair<int, double>{cart_body_, factors.mass_cart}, {pole_body_, factors.mass_pole}})
   {
     model_->body_mass[body] = m->body_mass[body] * factor;
     for (int k = 0; k < 3; ++k)

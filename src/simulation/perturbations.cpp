@@ -1,6 +1,5 @@
 #include "cartpole_qlearning/simulation/perturbations.h"
 
-
 #include <cmath>
 #include <sstream>
 

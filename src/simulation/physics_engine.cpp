@@ -18,9 +18,7 @@ std::string toString(EngineKind kind)
   return kind == EngineKind::Mujoco ? "mujoco" : "equations";
 }
 
-EquationsEngine::EquationsEngine(const CartPoleParams& params) : nominal_(params), dynamics_(params)
-{
-}
+EquationsEngine::EquationsEngine(const CartPoleParams& params) : nominal_(params), dynamics_(params) {}
 
 void EquationsEngine::setFactors(const EpisodeFactors& factors)
 {

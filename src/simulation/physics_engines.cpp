@@ -22,9 +22,10 @@ std::unique_ptr<PhysicsEngine> makePhysicsEngine(const CartPoleParams& physics, 
 #ifdef CARTPOLE_QLEARNING_WITH_MUJOCO
   return std::make_unique<MujocoEngine>(engine, physics.tau);
 #else
-  throw EngineError("physics/engine = 'mujoco' is not available: cartpole_qlearning was built without MuJoCo. "
-                    "Install it (Debian 12: sudo apt-get install libmujoco-dev, or scripts/setup.sh), then "
-                    "rebuild (catkin_make): CMake finds it and builds the MuJoCo engine");
+  throw EngineError(
+      "physics/engine = 'mujoco' is not available: cartpole_qlearning was built without MuJoCo. "
+      "Install it (Debian 12: sudo apt-get install libmujoco-dev, or scripts/setup.sh), then "
+      "rebuild (catkin_make): CMake finds it and builds the MuJoCo engine");
 #endif
 }
 

@@ -60,12 +60,11 @@ TEST(RobotProfile, TrainsUntilSolvedThenTheTableIsEvaluated)
 
   // Evaluation: the user's next command, against the same robot (the sim waits on its pending state).
   stats.clear();
-  TrainLaunch evaluation(
-      home, "evaluate",
-      // A lockstep sim holds no command: no freshness guard, as in the .test's training.
-      "robot:=" + robot + " mode:=evaluate load:=q_table.yaml episodes:=10 freshness_timeout:=0 " +
-          privateParam("evaluate_args"),
-      "robot.launch");
+  TrainLaunch evaluation(home, "evaluate",
+                         // A lockstep sim holds no command: no freshness guard, as in the .test's training.
+                         "robot:=" + robot + " mode:=evaluate load:=q_table.yaml episodes:=10 freshness_timeout:=0 " +
+                             privateParam("evaluate_args"),
+                         "robot.launch");
   const int status = evaluation.waitFor(120.0);
   const std::string output = evaluation.output();
   ASSERT_EQ(0, status) << output;

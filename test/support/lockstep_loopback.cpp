@@ -21,7 +21,7 @@ ControllerProtocolParams protocolParams(const TrainingConfig& config, std::size_
 LockstepLoopback::Robot::Robot(const TrainingConfig& config, std::uint64_t seed, TrainingSession& session,
                                std::size_t index)
   : simulation(makeSimulation(config.physics, config.engine, config.start_state_bound, robotSeed(seed, index),
-                               config.perturbations)),
+                              config.perturbations)),
     // No message is ever lost here, so no state is ever repeated.
     sim_protocol(tickOf(config.physics.tau), WallClock::duration::max()),
     controller_protocol(session, protocolParams(config, index))

@@ -79,10 +79,11 @@ std::string readText(const fs::path& path)
 TEST(CoreLayoutTest, TheCheckRefusesRosHeadersAndGeneratedMessages)
 {
   const auto core = [](const std::string& name) { return name == "learning/q_table.h"; };
-  EXPECT_TRUE(foreignIncludes("#include <vector>\n#include <Eigen/Core>\n#include \"cartpole_qlearning/learning/q_table.h\"\n"
-                              "#include <sys/stat.h>\n#include <yaml-cpp/yaml.h>\n",
-                              core)
-                  .empty());
+  EXPECT_TRUE(
+      foreignIncludes("#include <vector>\n#include <Eigen/Core>\n#include \"cartpole_qlearning/learning/q_table.h\"\n"
+                      "#include <sys/stat.h>\n#include <yaml-cpp/yaml.h>\n",
+                      core)
+          .empty());
   EXPECT_EQ(foreignIncludes("#include <vector>\n#include <ros/ros.h>\n", core),
             std::vector<std::string>{"line 2: #include <ros/ros.h>"});
   EXPECT_EQ(foreignIncludes("#include <sensor_msgs/JointState.h>\n", core).size(), 1u);
@@ -118,7 +119,8 @@ TEST(CoreLayoutTest, NoCoreFileIncludesAHeaderFromOutsideTheCoreOrFromALayerAbov
         for (const std::string& line : foreignIncludes(readText(entry.path()), allowed))
         {
           // The MuJoCo engine, its own library (physics_engines.h), alone includes MuJoCo's headers.
-          if (entry.path().filename() == "mujoco_engine.cpp" && text_match::contains(line, "#include <mujoco/[a-z]+\\.h>"))
+          if (entry.path().filename() == "mujoco_engine.cpp" &&
+              text_match::contains(line, "#include <mujoco/[a-z]+\\.h>"))
             continue;
           ADD_FAILURE() << entry.path().string() << " " << line << ": the " << layer
                         << " layer includes the standard library, POSIX, Eigen, yaml-cpp and the headers of its own "

@@ -60,8 +60,8 @@ struct ControllerSettings
 {
   TrainingConfig training;  // the shared sections, with ~stop_when_solved and ~max_episodes applied
   RunSettings run;
-  bool shutdown_when_finished = true;                // end the launch (or the node) when done
-  double sim_timeout = 2.0;                          // [s] wall: a robot silent this long is said to be gone
+  bool shutdown_when_finished = true;  // end the launch (or the node) when done
+  double sim_timeout = 2.0;            // [s] wall: a robot silent this long is said to be gone
   // [s] wall: efforts go out only this long after a fresh, valid state was decided on (0: off).
   double freshness_timeout = 0.1;
   std::string reset_service = "cartpole_sim/reset";  // "": a robot that cannot be reset on command

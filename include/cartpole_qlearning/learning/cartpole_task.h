@@ -10,8 +10,8 @@ namespace cartpole_qlearning
 {
 enum class RewardScheme
 {
-  Gymnasium,   // +1 every step, the terminating one included (CartPole-v1)
-  Seed,        // +1 while alive, -1 on the step that falls (the Q-learning tutorial's)
+  Gymnasium,    // +1 every step, the terminating one included (CartPole-v1)
+  Seed,         // +1 while alive, -1 on the step that falls (the Q-learning tutorial's)
   SuttonBarto,  // 0 while alive, -1 on the step that falls (Barto, Sutton and Anderson 1983)
   Alive         // +1 while alive, 0 on the step that falls (Gymnasium's InvertedPendulum-v5)
 };

@@ -47,7 +47,7 @@ std::string learningSettingsText(const LearningSettings& settings);
 // this run, served again); learning: training (else evaluating, where none of it applies).
 // Nothing is said of a change that changes nothing.
 LogLines liveTuningLog(const LearningSettings& in_use, const LearningSettings& wanted, const std::string& error,
-                      bool restarted, bool learning);
+                       bool restarted, bool learning);
 // A new run found values an earlier controller left on the parameter server and replaces them
 // by its configuration's (nothing said when they were the same).
 LogLines liveTuningReplacedLog(const LearningSettings& left, const LearningSettings& configured);

@@ -16,14 +16,15 @@ namespace cartpole_qlearning
 constexpr int kQTableFormatVersion = 3;
 
 // Saves atomically (see file_access.h: the target is either the old file or the complete new
-// one, whatever happens). Creates missing parent directories. Throws FileError (io/file_access.h: what is wrong, and nothing was changed).
+// one, whatever happens). Creates missing parent directories. Throws FileError (io/file_access.h: what is wrong, and
+// nothing was changed).
 void saveQTableFile(const QTable& table, const std::string& path);
 // The same for a path under a directory, as services take it: no links, no "..".
 void saveQTableUnder(const QTable& table, const std::string& directory, const std::string& path);
 
 // Reads and checks a file: format name, version, shape, counts, finite values and checksum.
-// Throws FileError (io/file_access.h: what is wrong, and nothing was changed) saying what is wrong. Whether it fits a given agent is the caller's
-// check (QTable::shapeMismatch), made before the live table is replaced.
+// Throws FileError (io/file_access.h: what is wrong, and nothing was changed) saying what is wrong. Whether it fits a
+// given agent is the caller's check (QTable::shapeMismatch), made before the live table is replaced.
 QTable loadQTableFile(const std::string& path);
 QTable loadQTableUnder(const std::string& directory, const std::string& path);
 

@@ -263,7 +263,7 @@ private:
 // (its joint_states topic), stamp_s is the state's stamp [s]. A dropped state and a restart are
 // said only when dropped_ready() and restart_ready() (the node's throttles) allow it.
 LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts& counts, const std::string& robot,
-                    double stamp_s, const std::function<bool()>& dropped_ready,
-                    const std::function<bool()>& restart_ready);
+                     double stamp_s, const std::function<bool()>& dropped_ready,
+                     const std::function<bool()>& restart_ready);
 
 }  // namespace cartpole_qlearning

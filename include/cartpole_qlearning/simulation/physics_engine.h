@@ -29,10 +29,10 @@ std::string toString(EngineKind kind);
 struct EngineParams
 {
   EngineKind kind = EngineKind::Equations;
-  std::string model;                     // the MJCF file (an absolute path, or one relative to the working folder)
-  std::string cart_joint = "slider";     // a slide joint: x and x_dot are its qpos and qvel
-  std::string pole_joint = "hinge";      // a hinge joint on a body the cart carries: theta and theta_dot
-  std::string actuator = "slide";        // a motor on cart_joint: an effort F is ctrl = F / gear
+  std::string model;                  // the MJCF file (an absolute path, or one relative to the working folder)
+  std::string cart_joint = "slider";  // a slide joint: x and x_dot are its qpos and qvel
+  std::string pole_joint = "hinge";   // a hinge joint on a body the cart carries: theta and theta_dot
+  std::string actuator = "slide";     // a motor on cart_joint: an effort F is ctrl = F / gear
 };
 
 // A model that cannot serve as the cart-pole (it fails to load, a joint or actuator is missing

@@ -224,7 +224,8 @@ TEST(RobustnessSuite, ACaseStoppedWhenDecidedGivesTheFullVerdictAlsoAtTheThresho
         const CaseResult full = evaluateCase(tables[t], config, original, suite.episodes, suite.seed);
         ASSERT_EQ(full.run, suite.episodes);
         // Thresholds around what the table does: at it (passes by nothing) and one over (fails by one).
-        for (std::uint64_t pass : {full.balanced, full.balanced + 1, std::uint64_t{0}, suite.episodes, full.balanced / 2})
+        for (std::uint64_t pass :
+             {full.balanced, full.balanced + 1, std::uint64_t{0}, suite.episodes, full.balanced / 2})
         {
           if (pass > suite.episodes)
             continue;

@@ -202,7 +202,8 @@ TEST_F(QTableFileTest, WrongVersionIsRefusedWithTheVersion)
   }
   catch (const FileError& e)
   {
-    EXPECT_NE(std::string::npos, std::string(e.what()).find("version 4 is not supported (this build reads versions 1 to 3)"))
+    EXPECT_NE(std::string::npos,
+              std::string(e.what()).find("version 4 is not supported (this build reads versions 1 to 3)"))
         << e.what();
   }
 }

@@ -197,7 +197,8 @@ TEST_F(RobotDispatchTest, ASilentRobotIsStoppedAndSaidOnceAndDropsOutOfTheRounds
   RobotDispatch::Orders orders = dispatch.onTick(kT0 + milliseconds(1000));
   EXPECT_EQ(std::vector<std::size_t>{1}, orders.stop) << "robot 1 silent since the start; robot 0 heard 0.5 s ago";
   EXPECT_EQ(
-      "no joint_states on /robot_1/joint_states for 1.0 s: is the robot's driver (or its cartpole_sim) running? Waiting for it\n"
+      "no joint_states on /robot_1/joint_states for 1.0 s: is the robot's driver (or its cartpole_sim) running? "
+      "Waiting for it\n"
       "/robot_1/joint_states is silent; the rounds go on without it until it is back\n",
       text(orders.log));
   // The round of robot 0 alone goes on.

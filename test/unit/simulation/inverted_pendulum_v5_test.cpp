@@ -70,8 +70,12 @@ TEST_F(InvertedPendulumV5, ResetMatchesGymnasium)
   // frame_skip 2 of the model's timestep; reset_noise_scale 0.01 on every qpos and qvel.
   ASSERT_TRUE(says("frame_skip: int = 2,"));
   ASSERT_TRUE(says("reset_noise_scale: float = 0.01,"));
-  ASSERT_TRUE(says("qpos = self.init_qpos + self.np_random.uniform(\n            size=self.model.nq, low=noise_low, high=noise_high"));
-  ASSERT_TRUE(says("qvel = self.init_qvel + self.np_random.uniform(\n            size=self.model.nv, low=noise_low, high=noise_high"));
+  ASSERT_TRUE(
+      says("qpos = self.init_qpos + self.np_random.uniform(\n            size=self.model.nq, low=noise_low, "
+           "high=noise_high"));
+  ASSERT_TRUE(
+      says("qvel = self.init_qvel + self.np_random.uniform(\n            size=self.model.nv, low=noise_low, "
+           "high=noise_high"));
   EXPECT_EQ(config_.engine.model, dir_ + "/envs/mujoco/assets/inverted_pendulum.xml");
   const MujocoEngine engine(config_.engine, config_.physics.tau);
   EXPECT_EQ(2, engine.frameSkip());

@@ -109,8 +109,8 @@ TEST(MujocoEngine, AHingeTurnedTheOtherWayGivesTheSameStates)
   {
     turned.step(i % 2 ? 7.0 : -3.0, 0.0);
     plain.step(i % 2 ? 7.0 : -3.0, 0.0);
-    EXPECT_TRUE(turned.state().isApprox(plain.state(), 1e-12)) << i << ": " << turned.state().transpose() << " vs "
-                                                              << plain.state().transpose();
+    EXPECT_TRUE(turned.state().isApprox(plain.state(), 1e-12))
+        << i << ": " << turned.state().transpose() << " vs " << plain.state().transpose();
   }
 }
 
@@ -287,7 +287,8 @@ TEST(MujocoEngine, EachLoadErrorNamesTheKeyAndTheModel)
   expectError(loadError(p), "model", p.model, "cannot be loaded");
   p = projectModel();
   p.cart_joint = "rail";
-  expectError(loadError(p), "cart_joint = 'rail'", kModel, "no such joint (its joints: cart_joint (slide), pole_joint (hinge))");
+  expectError(loadError(p), "cart_joint = 'rail'", kModel,
+              "no such joint (its joints: cart_joint (slide), pole_joint (hinge))");
   p = projectModel();
   p.cart_joint = "pole_joint";
   expectError(loadError(p), "cart_joint = 'pole_joint'", kModel, "a hinge joint; the cart's must be a slide joint");
