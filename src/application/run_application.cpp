@@ -64,6 +64,14 @@ struct RunApplication::Parts
   BestTableKeeper keeper;
   RunMeters meters;
   std::vector<std::string> state_names;  // as the trace names the rows
+  // A table to load has this run's shape (useTable refuses any other): its file is at most this
+  // long. Fixed for the run, so readTable() reads it without a lock. (After session: initialised
+  // from it.)
+  const std::uint64_t load_bytes_limit =
+      maxQTableFileBytes(session.table().stateCount(), session.table().actionCount());
+  // The run's table's shape, for copies made apart from the table in use. Fixed, as above.
+  const FeatureParams features = session.table().features();
+  const std::vector<double> actions = session.table().actions();
 
   int launcher = 0;
   bool finished = false;
@@ -263,14 +271,42 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
 
 ServiceAnswer RunApplication::save(const std::string& path)
 {
-  return parts_->tables.serveSave(parts_->session.table(), path);
+  QTable copy = tableOfThisShape();
+  copyTableInto(copy);
+  return saveCopy(copy, path);
 }
 
 ServiceAnswer RunApplication::load(const std::string& path)
 {
+  return useTable(readTable(path));
+}
+
+QTable RunApplication::tableOfThisShape() const
+{
+  return QTable(parts_->features, parts_->actions);
+}
+
+void RunApplication::copyTableInto(QTable& copy) const
+{
+  // Same shape: the assignment copies the values into the memory the copy has (no allocation).
+  copy = parts_->session.table();
+}
+
+ServiceAnswer RunApplication::saveCopy(const QTable& copy, const std::string& path) const
+{
+  return parts_->tables.serveSave(copy, path);
+}
+
+TableRead RunApplication::readTable(const std::string& path) const
+{
+  return parts_->tables.readForService(path, parts_->load_bytes_limit);
+}
+
+ServiceAnswer RunApplication::useTable(TableRead read)
+{
   Parts& p = *parts_;
   std::uint64_t episodes = 0;
-  ServiceAnswer answer = p.tables.serveLoad(path, [&](QTable table) {
+  ServiceAnswer answer = p.tables.useForService(std::move(read), [&](QTable table) {
     episodes = table.episodes;
     return p.useTable(std::move(table));
   });

@@ -8,6 +8,17 @@
 
 namespace cartpole_qlearning
 {
+namespace
+{
+ServiceAnswer refusedLoad(const std::string& why)
+{
+  ServiceAnswer answer;
+  answer.message = "refused, the table in use is unchanged: " + why;
+  answer.log.push_back({LogLine::Level::Warn, "load_q_table: " + answer.message});
+  return answer;
+}
+}  // namespace
+
 TableStore::TableStore(std::string folder, std::string default_table, AbsolutePaths absolute)
   : folder_(std::move(folder)), default_table_(std::move(default_table)), absolute_(absolute)
 {
@@ -24,10 +35,10 @@ std::string TableStore::resolve(const std::string& path) const
   return isUsersFile(named) ? named : resolvePathUnder(folder_, named);
 }
 
-QTable TableStore::load(const std::string& path) const
+QTable TableStore::load(const std::string& path, std::uint64_t max_bytes) const
 {
   const std::string& named = path.empty() ? default_table_ : path;
-  return isUsersFile(named) ? loadQTableFile(named) : loadQTableUnder(folder_, named);
+  return isUsersFile(named) ? loadQTableFile(named, max_bytes) : loadQTableUnder(folder_, named, max_bytes);
 }
 
 void TableStore::save(const QTable& table, const std::string& path) const
@@ -71,27 +82,46 @@ ServiceAnswer TableStore::serveSave(const QTable& table, const std::string& path
 
 ServiceAnswer TableStore::serveLoad(const std::string& path, const std::function<std::string(QTable)>& replace) const
 {
-  ServiceAnswer answer;
+  return useForService(readForService(path), replace);
+}
+
+TableRead TableStore::readForService(const std::string& path, std::uint64_t max_bytes) const
+{
+  TableRead read;
   try
   {
-    const std::string resolved = resolveForService(path);
-    QTable table = path.empty() ? load("") : loadQTableUnder(folder_, path);
-    const std::uint64_t episodes = table.episodes;
-    const std::uint64_t steps = table.steps;
-    const std::string mismatch = replace(std::move(table));
-    if (!mismatch.empty())
-      throw FileError(resolved + " does not fit this controller: " + mismatch);
-    answer.success = true;
-    answer.message = "loaded " + resolved + " (" + std::to_string(episodes) + " episodes, " + std::to_string(steps) +
-                     " steps of training)";
-    answer.log.push_back({LogLine::Level::Info, "load_q_table: " + answer.message});
+    read.resolved = resolveForService(path);
+    read.table = path.empty() ? load("", max_bytes) : loadQTableUnder(folder_, path, max_bytes);
   }
-  catch (const std::exception& e)  // FileError, or anything else: never out of a service
+  catch (const std::exception& e)  // FileError, or anything else (std::bad_alloc): never out of a service
   {
-    answer.message = std::string("refused, the table in use is unchanged: ") + e.what();
-    answer.log.push_back({LogLine::Level::Warn, "load_q_table: " + answer.message});
+    read.refusal = refusedLoad(e.what());
   }
-  return answer;
+  return read;
+}
+
+ServiceAnswer TableStore::useForService(TableRead read, const std::function<std::string(QTable)>& replace) const
+{
+  if (!read.table)
+    return read.refusal;
+  try
+  {
+    const std::uint64_t episodes = read.table->episodes;
+    const std::uint64_t steps = read.table->steps;
+    const std::string mismatch = replace(std::move(*read.table));
+    if (!mismatch.empty())
+      throw FileError(read.resolved + " does not fit this controller: " + mismatch);
+    ServiceAnswer answer;
+    answer.success = true;
+    answer.message = "loaded " + read.resolved + " (" + std::to_string(episodes) + " episodes, " +
+                     std::to_string(steps) + " steps of training)";
+    answer.log.push_back({LogLine::Level::Info, "load_q_table: " + answer.message});
+    return answer;
+  }
+  catch (const std::exception& e)
+  {
+    return refusedLoad(e.what());
+  }
 }
 
 }  // namespace cartpole_qlearning

@@ -91,6 +91,10 @@ std::string AgentParams::validate() const
   if (actions.size() > kMaxActions)
     return "actions lists " + std::to_string(actions.size()) + " efforts, which is not allowed (at most " +
            std::to_string(kMaxActions) + ")";
+  const std::uint64_t rows = featureParams().rowCount(actions.size());
+  if (rows * actions.size() > kMaxTableValues)
+    return "a table of " + std::to_string(rows) + " rows of " + std::to_string(actions.size()) +
+           " actions is not allowed (more than the " + std::to_string(kMaxTableValues) + " values a table may hold)";
   for (std::size_t i = 0; i < actions.size(); ++i)
   {
     if (!std::isfinite(actions[i]))

@@ -15,6 +15,14 @@ FeatureParams binsOf(const DiscretiserParams& discretiser)
 }
 }  // namespace
 
+std::uint64_t maxQTableFileBytes(std::uint64_t rows, std::uint64_t actions)
+{
+  constexpr std::uint64_t kHeaderBytes = std::uint64_t(1) << 20;
+  constexpr std::uint64_t kRowBytes = 8;     // "  - [" and "]\n"
+  constexpr std::uint64_t kValueBytes = 26;  // "-2.2250738585072014e-308, "
+  return kHeaderBytes + 2 * rows * (kRowBytes + kValueBytes * actions);
+}
+
 QTable::QTable(const DiscretiserParams& discretiser, const std::vector<double>& actions)
   : QTable(binsOf(discretiser), actions)
 {

@@ -5,11 +5,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <charconv>
 #include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <locale>
+#include <optional>
 #include <sstream>
+#include <string_view>
 
 namespace cartpole_qlearning
 {
@@ -87,23 +90,32 @@ std::string checksumOf(const QTable& table)
   return sum.text();
 }
 
-// The shortest decimal (15 to 17 significant digits, classic locale) that reads back as the
-// same double: exact, and 2.4 stays "2.4" rather than "2.3999999999999999".
-std::string exact(double value)
+// The shortest decimal (15 to 17 significant digits, as printf's %g writes them) that reads back
+// as the same double: exact, and 2.4 stays "2.4" rather than "2.3999999999999999". With to_chars
+// and from_chars (locale-free), not string streams: a table of 2,000,000 values took 6 s to write
+// through streams.
+void appendExact(std::string& text, double value)
 {
+  char buffer[64];
   for (int precision = 15;; ++precision)
   {
-    std::ostringstream out;
-    out.imbue(std::locale::classic());
-    out.precision(precision);
-    out << value;
-    std::istringstream in(out.str());
-    in.imbue(std::locale::classic());
+    const std::to_chars_result written =
+        std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::general, precision);
     double back = 0.0;
-    in >> back;
-    if (precision == 17 || (!in.fail() && std::memcmp(&back, &value, sizeof value) == 0))
-      return out.str();
+    const std::from_chars_result read = std::from_chars(buffer, written.ptr, back);
+    if (precision == 17 || (read.ec == std::errc() && std::memcmp(&back, &value, sizeof value) == 0))
+    {
+      text.append(buffer, written.ptr);
+      return;
+    }
   }
+}
+
+std::string exact(double value)
+{
+  std::string text;
+  appendExact(text, value);
+  return text;
 }
 
 template <typename Container>
@@ -242,14 +254,20 @@ std::string formatQTable(const QTable& table)
   else
     out << "# One row per state: the bins combined in mixed radix, x most significant.\n";
   out << "values:\n";
+  std::string text = out.str();
+  text.reserve(text.size() + table.stateCount() * (8 + 26 * table.actionCount()));
   for (std::size_t s = 0; s < table.stateCount(); ++s)
   {
-    out << "  - [";
+    text += "  - [";
     for (std::size_t a = 0; a < table.actionCount(); ++a)
-      out << (a ? ", " : "") << exact(table.at(s, a));
-    out << "]\n";
+    {
+      if (a > 0)
+        text += ", ";
+      appendExact(text, table.at(s, a));
+    }
+    text += "]\n";
   }
-  return out.str();
+  return text;
 }
 
 namespace
@@ -270,17 +288,87 @@ std::array<unsigned, kStateDimensions> readCounts(const YAML::Node& root, const 
 }
 }  // namespace
 
-QTable parseQTable(const std::string& text)
+namespace
 {
-  YAML::Node root;
+YAML::Node loadYaml(const std::string& text)
+{
   try
   {
-    root = YAML::Load(text);
+    return YAML::Load(text);
   }
   catch (const YAML::Exception& e)
   {
     refuse(std::string("not valid YAML (corrupt or truncated): ") + e.what());
   }
+}
+
+// The rows as formatQTable writes them, a line "  - [v, v, ...]" each to the end of the text,
+// read straight from it: yaml-cpp makes a node of every number (a table of 2,000,000 values took
+// 40 s and 1.5 GB to load that way). nullopt when the text is laid out otherwise (by hand: other
+// spacing, comments, block lists, a line cut short) or holds a number that is not finite: then
+// yaml-cpp reads the whole file and says what is wrong, as it always did. Complete rows of our
+// layout that are too few or too many are refused here.
+std::optional<std::vector<double>> rowsAsWritten(std::string_view text, std::size_t row_count, std::size_t actions)
+{
+  std::vector<double> values;
+  values.reserve(row_count * actions);
+  const char* at = text.data();
+  const char* const end = at + text.size();
+  std::size_t rows = 0;
+  while (at != end)
+  {
+    if (end - at < 5 || std::memcmp(at, "  - [", 5) != 0)
+      return std::nullopt;
+    at += 5;
+    for (;;)
+    {
+      double value = 0.0;
+      const std::from_chars_result read = std::from_chars(at, end, value);
+      if (read.ec != std::errc() || !std::isfinite(value))
+        return std::nullopt;
+      values.push_back(value);
+      at = read.ptr;
+      if (at != end && *at == ']')
+        break;
+      if (end - at < 2 || at[0] != ',' || at[1] != ' ')
+        return std::nullopt;
+      at += 2;
+    }
+    if (end - at < 2 || at[1] != '\n')
+      return std::nullopt;
+    at += 2;
+    ++rows;
+    if (values.size() != rows * actions)
+      return std::nullopt;  // yaml-cpp's reading names the row
+  }
+  if (rows != row_count)
+    refuse("values has " + std::to_string(rows) + " rows, expected " + std::to_string(row_count) +
+           " (the file is truncated or its shape is wrong)");
+  return values;
+}
+}  // namespace
+
+QTable parseQTable(const std::string& text)
+{
+  // The header (everything before the rows) through yaml-cpp, the rows as written (see
+  // rowsAsWritten); a file laid out otherwise goes through yaml-cpp whole.
+  const std::size_t values_at = text.rfind("\nvalues:\n");
+  bool rows_apart = values_at != std::string::npos;
+  YAML::Node root;
+  if (rows_apart)
+  {
+    try
+    {
+      root = loadYaml(text.substr(0, values_at + 1));
+    }
+    catch (const FileError&)
+    {
+      rows_apart = false;
+    }
+    rows_apart = rows_apart && root.IsMap() && !root["values"];
+  }
+  if (!rows_apart)
+    root = loadYaml(text);
   if (!root.IsMap())
     refuse("not a Q-table file (expected a YAML mapping with 'format: " + std::string(kFormatName) + "')");
   const YAML::Node format = required(root, "format");
@@ -335,20 +423,38 @@ QTable parseQTable(const std::string& text)
            ")");
 
   // Every count is checked against the rows the file really holds before the table (up to
-  // kMaxStates rows of kMaxActions values: 8 GB) is allocated, so a short file that claims a
-  // huge table costs nothing.
+  // kMaxTableValues values: 160 MB) is allocated, so a short file that claims a huge table costs
+  // nothing.
   const std::size_t row_count = features.rowCount(actions.size());
+  if (static_cast<std::uint64_t>(row_count) * actions.size() > kMaxTableValues)
+    refuse(std::to_string(row_count) + " rows of " + std::to_string(actions.size()) + " values are more than the " +
+           std::to_string(kMaxTableValues) + " a table may hold");
   const char* const rows_key = version1 ? "states" : "rows";
   const std::uint64_t rows_logged = readCount(required(root, rows_key), rows_key);
   if (rows_logged != row_count)
     refuse(std::string(rows_key) + " is " + std::to_string(rows_logged) + " but the " +
            (features.kind == FeatureKind::Tiles ? "tilings and tiles" : "bins") + " give " + std::to_string(row_count));
-  const YAML::Node rows = required(root, "values");
-  if (!rows.IsSequence())
-    refuse("values is not a list of rows");
-  if (rows.size() != row_count)
-    refuse("values has " + std::to_string(rows.size()) + " rows, expected " + std::to_string(row_count) +
-           " (the file is truncated or its shape is wrong)");
+  std::optional<std::vector<double>> values;
+  if (rows_apart)
+    values = rowsAsWritten(std::string_view(text).substr(values_at + 9), row_count, actions.size());
+  if (!values)
+  {
+    if (rows_apart)
+      root = loadYaml(text);
+    const YAML::Node rows = required(root, "values");
+    if (!rows.IsSequence())
+      refuse("values is not a list of rows");
+    if (rows.size() != row_count)
+      refuse("values has " + std::to_string(rows.size()) + " rows, expected " + std::to_string(row_count) +
+             " (the file is truncated or its shape is wrong)");
+    values.emplace();
+    values->reserve(row_count * actions.size());
+    for (std::size_t s = 0; s < rows.size(); ++s)
+    {
+      const std::vector<double> row = readNumbers(rows[s], "values row " + std::to_string(s), actions.size());
+      values->insert(values->end(), row.begin(), row.end());
+    }
+  }
 
   QTable table(features, actions);
   table.episodes = readCount(required(root, "episodes"), "episodes");
@@ -370,14 +476,7 @@ QTable parseQTable(const std::string& text)
     if (table.tau == 0.0 && table.trained_with.empty())
       refuse("a version 3 file says tau or trained_with (or both)");
   }
-  std::vector<double> values;
-  values.reserve(table.stateCount() * table.actionCount());
-  for (std::size_t s = 0; s < rows.size(); ++s)
-  {
-    const std::vector<double> row = readNumbers(rows[s], "values row " + std::to_string(s), table.actionCount());
-    values.insert(values.end(), row.begin(), row.end());
-  }
-  table.setValues(std::move(values));
+  table.setValues(std::move(*values));
 
   const YAML::Node checksum = required(root, "checksum");
   const std::string expected = checksumOf(table);
@@ -424,14 +523,15 @@ QTable parseQTableFrom(const std::string& text, const std::string& shown)
 }
 }  // namespace
 
-QTable loadQTableFile(const std::string& path)
+QTable loadQTableFile(const std::string& path, std::uint64_t max_bytes)
 {
-  return parseQTableFrom(readFile(path), path);
+  return parseQTableFrom(readFile(path, std::min(max_bytes, kMaxFileBytes)), path);
 }
 
-QTable loadQTableUnder(const std::string& directory, const std::string& path)
+QTable loadQTableUnder(const std::string& directory, const std::string& path, std::uint64_t max_bytes)
 {
-  return parseQTableFrom(readFileUnder(directory, path), resolvePathUnder(directory, path));
+  return parseQTableFrom(readFileUnder(directory, path, std::min(max_bytes, kMaxFileBytes)),
+                         resolvePathUnder(directory, path));
 }
 
 }  // namespace cartpole_qlearning

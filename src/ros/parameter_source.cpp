@@ -1,6 +1,13 @@
 #include "parameter_source.h"
 
+#include "cartpole_qlearning/ros/conversions.h"
+
+#include <ros/names.h>
+#include <ros/package.h>
+
 #include <xmlrpcpp/XmlRpcValue.h>
+
+#include <cstdlib>
 
 namespace cartpole_qlearning
 {
@@ -134,6 +141,24 @@ std::vector<std::string> RosParameterSource::keysUnder(const std::string& sectio
   if (nh_.getParam(section.empty() ? nh_.getNamespace() : section, v))
     collect(v, section, keys);
   return keys;
+}
+
+ControllerSettings readControllerParameters(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
+                                            bool shutdown_by_default)
+{
+  ControllerContext context;
+  context.name_space = nh.getNamespace();
+  const char* home = std::getenv("HOME");
+  context.home = home ? home : "";
+  context.shutdown_by_default = shutdown_by_default;
+  context.name_error = [](const std::string& name) {
+    std::string error;
+    return ros::names::validate(name, error) ? std::string() : error;
+  };
+  // Live tuning's values, which the controller's dynamic_reconfigure server keeps there.
+  context.other_keys = learningConfigKeys();
+  context.suite_folders = {ros::package::getPath("cartpole_qlearning") + "/config"};
+  return readControllerSettings(RosParameterSource(nh), RosParameterSource(pnh), context);
 }
 
 }  // namespace cartpole_qlearning

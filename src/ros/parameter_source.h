@@ -2,6 +2,7 @@
 // learning keys with the same reader, defaults and checks as train_headless reads the YAML.
 #pragma once
 
+#include "cartpole_qlearning/application/node_settings.h"
 #include "cartpole_qlearning/learning/training_config.h"
 
 #include <ros/node_handle.h>
@@ -31,5 +32,11 @@ private:
 // Throws ConfigError "parameter /ns/node/name = value is not allowed (allowed)".
 [[noreturn]] void refuseParameter(const ros::NodeHandle& nh, const std::string& name, const std::string& value,
                                   const std::string& allowed);
+
+// The controller's settings from the parameter server: the learner's namespace (nh) and the
+// node's private one (pnh), with the live tuning's keys and the package's suite folder known.
+// Throws ConfigError naming a bad parameter.
+ControllerSettings readControllerParameters(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
+                                            bool shutdown_by_default);
 
 }  // namespace cartpole_qlearning

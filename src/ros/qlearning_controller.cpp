@@ -7,11 +7,7 @@
 #include "reset_caller.h"
 #include "start_up.h"
 
-#include <ros/names.h>
-#include <ros/package.h>
-
 #include <cstdio>
-#include <cstdlib>
 #include <optional>
 #include <utility>
 
@@ -44,7 +40,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   : nh_(nh), pnh_(pnh), name_(nodeLogger("qlearning_controller", pnh.getNamespace())), shutdown_(std::move(shutdown))
 {
   std::unique_lock<std::mutex> lock(mutex_);
-  readParameters(shutdown_by_default);
+  settings_ = readControllerParameters(nh_, pnh_, shutdown_by_default);
   session_ = std::make_unique<TrainingSession>(settings_.training.task, settings_.training.agent, settings_.run.seed,
                                                settings_.run.learning, settings_.robots.size());
   if (settings_.run.trace && settings_.run.learning)
@@ -60,8 +56,12 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   }
   startRun();
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
-  save_srv_ = pnh_.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
-  load_srv_ = pnh_.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
+  ros::NodeHandle services_nh(pnh_);
+  services_nh.setCallbackQueue(&services_queue_);
+  save_srv_ = services_nh.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
+  load_srv_ = services_nh.advertiseService("load_q_table", &QLearningControllerNode::onLoad, this);
+  services_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &services_queue_);
+  services_spinner_->start();
   setUpRobots(state_queue);
   watchdog_ =
       nh_.createSteadyTimer(ros::WallDuration(dispatch_->tickSeconds()), &QLearningControllerNode::onWatchdog, this);
@@ -106,8 +106,10 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
 
 QLearningControllerNode::~QLearningControllerNode()
 {
-  // First, with mutex_ free: a reconfigure call under way ends (it takes mutex_), no other starts.
+  // First, with mutex_ free: a reconfigure call or a save under way ends (they take mutex_), no
+  // other starts.
   reconfigure_.reset();
+  services_spinner_.reset();
   // Resets end here; a call under way is given up, not waited for (it may hang for minutes), so
   // the save below still happens. Under mutex_: a state callback or the watchdog may be asking
   // for a reset at this moment (in a nodelet they run on other threads).
@@ -127,23 +129,6 @@ QLearningControllerNode::~QLearningControllerNode()
   // loaded machine) would lose what is still buffered (seen in a new Debian 12 root: the line
   // cut after the path).
   std::fflush(stdout);
-}
-
-void QLearningControllerNode::readParameters(bool shutdown_by_default)
-{
-  ControllerContext context;
-  context.name_space = nh_.getNamespace();
-  const char* home = std::getenv("HOME");
-  context.home = home ? home : "";
-  context.shutdown_by_default = shutdown_by_default;
-  context.name_error = [](const std::string& name) {
-    std::string error;
-    return ros::names::validate(name, error) ? std::string() : error;
-  };
-  // Live tuning's values, which the controller's dynamic_reconfigure server keeps there.
-  context.other_keys = learningConfigKeys();
-  context.suite_folders = {ros::package::getPath("cartpole_qlearning") + "/config"};
-  settings_ = readControllerSettings(RosParameterSource(nh_), RosParameterSource(pnh_), context);
 }
 
 std::string QLearningControllerNode::describe(const Robot& robot) const
@@ -277,15 +262,20 @@ void QLearningControllerNode::startRun()
 
 bool QLearningControllerNode::onSave(SaveQTable::Request& request, SaveQTable::Response& response)
 {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  say(toResponse(app_->save(request.path), response));
+  QTable copy = app_->tableOfThisShape();
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    app_->copyTableInto(copy);
+  }
+  say(toResponse(app_->saveCopy(copy, request.path), response));
   return true;
 }
 
 bool QLearningControllerNode::onLoad(LoadQTable::Request& request, LoadQTable::Response& response)
 {
+  TableRead read = app_->readTable(request.path);
   const std::lock_guard<std::mutex> lock(mutex_);
-  say(toResponse(app_->load(request.path), response));
+  say(toResponse(app_->useTable(std::move(read)), response));
   return true;
 }
 

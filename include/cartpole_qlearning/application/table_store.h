@@ -6,9 +6,12 @@
 #pragma once
 
 #include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/io/file_access.h"
 #include "cartpole_qlearning/learning/q_table.h"
 
+#include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 
 namespace cartpole_qlearning
@@ -19,6 +22,14 @@ struct ServiceAnswer
   bool success = false;
   std::string message;
   LogLines log;
+};
+
+// A table read for ~load_q_table, not yet in use: the table, or the answer that refuses it.
+struct TableRead
+{
+  std::optional<QTable> table;
+  std::string resolved;   // the file, as messages name it
+  ServiceAnswer refusal;  // without a table
 };
 
 // What an absolute path the user gives (not a service's caller) names.
@@ -39,7 +50,7 @@ public:
   // escapes the folder (and is not the user's).
   std::string resolve(const std::string& path) const;
   // Reads and writes a table at such a path. Throw FileError.
-  QTable load(const std::string& path) const;
+  QTable load(const std::string& path, std::uint64_t max_bytes = kMaxFileBytes) const;
   void save(const QTable& table, const std::string& path) const;
 
   // A path through a service, made absolute: "" the default table, anything else under the
@@ -48,8 +59,15 @@ public:
   // ~save_q_table: writes the table there, saying what or why nothing. Never throws.
   ServiceAnswer serveSave(const QTable& table, const std::string& path) const;
   // ~load_q_table: reads the table there and hands it to `replace`, which puts it in use when it
-  // fits and otherwise says what differs (and changes nothing). Never throws.
+  // fits and otherwise says what differs (and changes nothing). Never throws. The same as
+  // useForService(readForService(path), replace): a controller makes the two steps apart, reading
+  // the file (seconds for a large table) while it goes on serving states.
   ServiceAnswer serveLoad(const std::string& path, const std::function<std::string(QTable)>& replace) const;
+  // Reads and checks the table there; a file over max_bytes is refused before it is read. Touches
+  // nothing but the file: safe beside any use of the table in use. Never throws.
+  TableRead readForService(const std::string& path, std::uint64_t max_bytes = kMaxFileBytes) const;
+  // Hands a table read to `replace`, or answers with its refusal. Never throws.
+  ServiceAnswer useForService(TableRead read, const std::function<std::string(QTable)>& replace) const;
 
   const std::string& folder() const
   {

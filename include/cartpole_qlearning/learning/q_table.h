@@ -14,6 +14,15 @@ namespace cartpole_qlearning
 {
 // The most actions (table columns) a config or a file may have.
 constexpr std::size_t kMaxActions = 100;
+// The most values (rows times actions) a table may hold: kMaxStates rows of 2 actions, 160 MB in
+// memory, whose file (up to some 520 MB) is still read whole under kMaxFileBytes. Without it
+// kMaxStates rows of kMaxActions values (8 GB) were allowed, a table no machine here could load.
+constexpr std::uint64_t kMaxTableValues = 20000000;
+// The largest file a table of `rows` rows of `actions` values may have: its header (up to 1 MiB,
+// with the text of the config that trained it) and each row written with every value at its
+// longest (24 characters and a separator), twice over for hand-made layouts. A file over it is
+// refused before a byte is read.
+std::uint64_t maxQTableFileBytes(std::uint64_t rows, std::uint64_t actions);
 
 class QTable
 {

@@ -25,8 +25,10 @@ void saveQTableUnder(const QTable& table, const std::string& directory, const st
 // Reads and checks a file: format name, version, shape, counts, finite values and checksum.
 // Throws FileError (io/file_access.h: what is wrong, and nothing was changed) saying what is wrong. Whether it fits a
 // given agent is the caller's check (QTable::shapeMismatch), made before the live table is replaced.
-QTable loadQTableFile(const std::string& path);
-QTable loadQTableUnder(const std::string& directory, const std::string& path);
+// A file over max_bytes (maxQTableFileBytes of the table the caller expects) is refused before it
+// is read.
+QTable loadQTableFile(const std::string& path, std::uint64_t max_bytes = kMaxFileBytes);
+QTable loadQTableUnder(const std::string& directory, const std::string& path, std::uint64_t max_bytes = kMaxFileBytes);
 
 // Where a controller in this ROS namespace keeps its tables unless told otherwise, and where
 // train_headless saves a relative --save path: $ROS_HOME/cartpole_qlearning<namespace>

@@ -28,6 +28,7 @@
 #include <dynamic_reconfigure/server.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
+#include <ros/spinner.h>
 #include <sensor_msgs/JointState.h>
 
 #include <chrono>
@@ -68,7 +69,6 @@ private:
   // helpers it holds, which are the node's own and not installed).
   struct Robot;
 
-  void readParameters(bool shutdown_by_default);
   // Serves the learning settings in use on ~set_parameters (dynamic_reconfigure). Called with
   // mutex_ free: the server calls onReconfigure at once, which takes it.
   void startLiveTuning();
@@ -122,6 +122,11 @@ private:
   WallThrottle bad_state_warning_{1.0};
 
   ros::Publisher stats_pub_;
+  // ~save_q_table and ~load_q_table run on a thread of their own: writing or reading a large
+  // table takes seconds, and states must be answered meanwhile (a node's states and timer share
+  // one thread). Only the copy of the table to save and the swap of a table read hold mutex_.
+  ros::CallbackQueue services_queue_;
+  std::unique_ptr<ros::AsyncSpinner> services_spinner_;
   ros::ServiceServer save_srv_;
   ros::ServiceServer load_srv_;
   ros::SteadyTimer watchdog_;

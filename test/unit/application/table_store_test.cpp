@@ -144,4 +144,39 @@ TEST_F(TableStoreTest, ALoadReplacesTheTableInUseOnlyWhenItFits)
   EXPECT_EQ(0u, replaced);
 }
 
+TEST_F(TableStoreTest, AServiceLoadReadsTheFileApartFromPuttingItInUse)
+{
+  // A controller reads while it serves states and puts the table in use afterwards: the read
+  // alone touches nothing, and a file over the bound is refused unread, saying its size.
+  const TableStore tables(dir_.string(), "q_table.yaml", AbsolutePaths::MustLieInTheFolder);
+  tables.save(table(7), "seven.yaml");
+  TableRead read = tables.readForService("seven.yaml");
+  ASSERT_TRUE(read.table.has_value()) << read.refusal.message;
+  EXPECT_EQ(7u, read.table->episodes);
+  EXPECT_EQ((dir_ / "seven.yaml").string(), read.resolved);
+  std::uint64_t replaced = 0;
+  const ServiceAnswer used = tables.useForService(std::move(read), [&](QTable t) {
+    replaced = t.episodes;
+    return std::string();
+  });
+  EXPECT_TRUE(used.success) << used.message;
+  EXPECT_EQ(7u, replaced);
+
+  const std::uint64_t size = fs::file_size(dir_ / "seven.yaml");
+  TableRead too_large = tables.readForService("seven.yaml", size - 1);
+  EXPECT_FALSE(too_large.table.has_value());
+  EXPECT_NE(std::string::npos, too_large.refusal.message.find(std::to_string(size) + " bytes, more than"))
+      << too_large.refusal.message;
+  replaced = 0;
+  const ServiceAnswer refused = tables.useForService(std::move(too_large), [&](QTable t) {
+    replaced = t.episodes;
+    return std::string();
+  });
+  EXPECT_FALSE(refused.success);
+  EXPECT_EQ(0u, replaced);
+  EXPECT_EQ(0u, refused.message.rfind("refused, the table in use is unchanged: ", 0)) << refused.message;
+  ASSERT_EQ(1u, refused.log.size());
+  EXPECT_EQ(LogLine::Level::Warn, refused.log[0].level);
+}
+
 }  // namespace

@@ -256,6 +256,120 @@ TEST_F(QTableFileTest, AHeaderClaimingAHugeTableIsRefusedBeforeAnythingIsAllocat
   EXPECT_THROW(loadQTableFile(path("wide.yaml")), FileError);
 }
 
+TEST_F(QTableFileTest, NoTableMayHoldMoreValuesThanTheLimit)
+{
+  // 5,000,000 states of 4 actions is the most; of 5 actions, one table too many.
+  AgentParams agent;
+  agent.discretiser.bins = {5, 100, 100, 100};
+  agent.actions = {-10.0, -5.0, 5.0, 10.0};
+  EXPECT_EQ("", agent.validate());
+  agent.actions.push_back(0.0);
+  EXPECT_NE(std::string::npos, agent.validate().find("more than the 20000000 values a table may hold"))
+      << agent.validate();
+  // A file claiming such a table is refused from its header.
+  saveQTableFile(awkwardTable(), path("t.yaml"));
+  std::string text = readFile(path("t.yaml"));
+  const std::size_t bins = text.find("bins: [");
+  text.replace(bins, text.find('\n', bins) - bins, "bins: [10, 100, 100, 100]");
+  const std::size_t actions = text.find("actions: [");
+  text.replace(actions, text.find('\n', actions) - actions, "actions: [-10, 0, 10]");
+  write(path("wide.yaml"), text);
+  try
+  {
+    loadQTableFile(path("wide.yaml"));
+    FAIL() << "a table of 30,000,000 values was accepted";
+  }
+  catch (const FileError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("20000000 a table may hold")) << e.what();
+  }
+}
+
+TEST_F(QTableFileTest, AFileLargerThanItsTableCouldBeIsRefusedUnread)
+{
+  // The bound for 72 rows of 2 values is about 1 MiB; a file of 3 MiB (a valid table padded
+  // with a comment) is refused before reading, naming its size, and loads without the bound.
+  saveQTableFile(awkwardTable(), path("t.yaml"));
+  const std::uint64_t bound = maxQTableFileBytes(72, 2);
+  EXPECT_GE(bound, readFile(path("t.yaml")).size());
+  write(path("padded.yaml"), "# " + std::string(3u << 20, 'x') + "\n" + readFile(path("t.yaml")));
+  try
+  {
+    loadQTableFile(path("padded.yaml"), bound);
+    FAIL() << "a file of 3 MiB was read for a table of 72 rows";
+  }
+  catch (const FileError& e)
+  {
+    EXPECT_NE(std::string::npos,
+              std::string(e.what()).find(std::to_string((3u << 20) + 3 + readFile(path("t.yaml")).size()) + " bytes"))
+        << e.what();
+  }
+  EXPECT_TRUE(bitIdentical(awkwardTable().values(), loadQTableFile(path("padded.yaml")).values()));
+  // The bound holds for the longest values there are, in the widest table.
+  QTable longest(DiscretiserParams(), std::vector<double>(kMaxActions, -1.0));
+  longest.setValues(std::vector<double>(longest.values().size(), -std::numeric_limits<double>::min()));
+  EXPECT_GE(maxQTableFileBytes(longest.stateCount(), kMaxActions), formatQTable(longest).size());
+}
+
+TEST_F(QTableFileTest, RowsLaidOutByHandLoadAsTheSameTable)
+{
+  // The rows as written are read straight from the text; any other YAML layout of them (block
+  // lists, comments, other spacing) goes through yaml-cpp and gives the same table.
+  const QTable table = awkwardTable();
+  saveQTableFile(table, path("t.yaml"));
+  const std::string text = readFile(path("t.yaml"));
+  const std::size_t rows = text.find("values:\n") + 8;
+  std::string by_hand = text.substr(0, rows) + "  # edited by hand\n";
+  std::istringstream lines(text.substr(rows));
+  for (std::string line; std::getline(lines, line);)
+  {
+    by_hand += "  -\n";
+    std::istringstream values(line.substr(line.find('[') + 1, line.find(']') - line.find('[') - 1));
+    for (std::string value; std::getline(values, value, ',');)
+      by_hand += "    - " + value.substr(value.find_first_not_of(' ')) + "\n";
+  }
+  write(path("by_hand.yaml"), by_hand);
+  const QTable loaded = loadQTableFile(path("by_hand.yaml"));
+  EXPECT_TRUE(bitIdentical(table.values(), loaded.values()));
+  EXPECT_EQ(table.episodes, loaded.episodes);
+  // Rows of our layout that are too few are refused, counting them.
+  write(path("short.yaml"), text.substr(0, text.rfind("  - [")));
+  try
+  {
+    loadQTableFile(path("short.yaml"));
+    FAIL() << "71 rows of 72 were accepted";
+  }
+  catch (const FileError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("values has 71 rows, expected 72")) << e.what();
+  }
+}
+
+TEST_F(QTableFileTest, NumbersAreWrittenAsPrintfsShortestExactG)
+{
+  // 15 to 17 significant digits, %g's layout: what version 1 and 2 files always held.
+  QTable table(DiscretiserParams(), {-10.0, 10.0});
+  std::vector<double> values(table.values().size(), 0.0);
+  const std::vector<std::pair<double, std::string>> expected = {{0.1, "0.1"},
+                                                                {2.4, "2.4"},
+                                                                {1e-05, "1e-05"},
+                                                                {100000.0, "100000"},
+                                                                {0.1 + 0.2, "0.30000000000000004"},
+                                                                {1e20, "1e+20"},
+                                                                {-0.0, "-0"},
+                                                                {123456789012345678.0, "1.2345678901234568e+17"}};
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    values[i] = expected[i].first;
+  table.setValues(values);
+  const std::string text = formatQTable(table);
+  for (std::size_t i = 0; i + 1 < expected.size(); i += 2)
+  {
+    const std::string row = "  - [" + expected[i].second + ", " + expected[i + 1].second + "]\n";
+    EXPECT_NE(std::string::npos, text.find(row)) << row;
+  }
+  EXPECT_TRUE(bitIdentical(values, parseQTable(text).values()));
+}
+
 TEST_F(QTableFileTest, ATableOfAnotherShapeIsRefusedByTheSessionAndTheLiveTableIsUntouched)
 {
   TrainingSession session(TaskParams(), AgentParams(), 0);
