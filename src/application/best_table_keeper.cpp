@@ -1,5 +1,6 @@
 #include "cartpole_qlearning/application/best_table_keeper.h"
 
+#include <algorithm>
 #include <fstream>
 #include <utility>
 
@@ -16,6 +17,23 @@ unsigned long long count(std::uint64_t value)
 bool better(const SuiteResult& a, const SuiteResult& b)
 {
   return std::make_pair(a.passed(), a.worstBalanced()) > std::make_pair(b.passed(), b.worstBalanced());
+}
+
+// How to find out, case by case and as soon as it is decided, whether a table can beat `best`
+// (a whole verdict): beating it takes every case at its target. Against a passing best, a table
+// must pass and balance more than its worst case (pass and worst + 1, the larger); against a
+// failing one, pass or balance more than its worst case, which takes at least the smaller of the
+// two in every case. So every table that better() would rank above the best reaches its targets,
+// and most tables stop at their first case short of one, after a few episodes of it.
+SuiteRun againstTheBest(const SuiteResult& best, std::vector<std::size_t> order)
+{
+  SuiteRun run = SuiteRun::untilDecided(std::move(order));
+  const std::uint64_t above = best.worstBalanced() + 1;
+  const bool passing = best.passed();
+  run.target = [above, passing](const SuiteCase& c) {
+    return passing ? std::max(c.pass, above) : std::min(c.pass, above);
+  };
+  return run;
 }
 }  // namespace
 
@@ -46,6 +64,9 @@ LogLines BestTableKeeper::loadSuite()
       throw ConfigError("training/suite = '" + name + "' is not allowed (no such file in " +
                         (where.empty() ? std::string("no folder") : where) + ")");
     suite_ = std::make_unique<RobustnessSuite>(loadRobustnessSuite(suite_path_, config_));
+    order_.clear();
+    for (std::size_t i = 0; i < suite_->cases.size(); ++i)
+      order_.push_back(i);
   }
   catch (const ConfigError& e)
   {
@@ -69,7 +90,25 @@ std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSessio
   const EpisodeSummary& s = session.lastEpisode();
   if (!evaluatesDuringTraining() || (s.episode % config_.limits.suite_every != 0 && !training_ends))
     return std::nullopt;
-  // On a copy of the table: the suite runs greedily and learns nothing.
+  // Against the best so far first, each case only until it is decided whether this table can beat
+  // it: most cannot, and that result (a verdict cut short, said plainly) is this evaluation's. A
+  // table that can is evaluated whole and compared on whole verdicts, as every table was: the
+  // table kept is the one whole evaluations of every table would keep. (The suite runs greedily
+  // on the table, learning nothing.)
+  if (best_)
+  {
+    SuiteResult quick = evaluateSuite(session.table(), config_, *suite_, againstTheBest(best_->result, order_));
+    failedCaseFirst(order_, quick, *suite_);
+    if (!quick.reachedTargets())
+    {
+      log.push_back({LogLine::Level::Info,
+                     formatText("robustness at episode %llu (%llu steps): %s; no better than the best so far "
+                                "(episode %llu, worst case %llu balanced)",
+                                count(s.episode), count(s.total_steps), quick.summary().c_str(), count(best_->episode),
+                                count(best_->result.worstBalanced()))});
+      return quick;
+    }
+  }
   SuiteResult result = evaluateSuite(session.table(), config_, *suite_);
   if (!best_ || better(result, best_->result))
     best_ = BestTable{session.table(), result, s.episode};
@@ -80,6 +119,9 @@ std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSessio
 
 SuiteResult BestTableKeeper::settle(TrainingSession& session, std::optional<SuiteResult> last, LogLines& log)
 {
+  // The last table's whole verdict, to compare with the best's and to print.
+  if (last && !last->complete())
+    last = evaluateSuite(session.table(), config_, *suite_);
   if (best_ && last && better(best_->result, *last))
   {
     // The best table seen is what the run saves (and what the session holds from now on).

@@ -139,7 +139,7 @@ RobustnessSuite loadRobustnessSuite(const std::string& path, const TrainingConfi
 }
 
 CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
-                        std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided)
+                        std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided, std::uint64_t target)
 {
   TrainingSession session(config.task, config.agent, seed, false);
   const std::string mismatch = session.replaceTable(table);
@@ -151,8 +151,10 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
   result.name = suite_case.name;
   result.pass = suite_case.pass;
   result.episodes = episodes;
-  // Decided once pass episodes balanced, or once more fell than the case allows.
-  const std::uint64_t falls_to_fail = episodes >= suite_case.pass ? episodes - suite_case.pass + 1 : 0;
+  result.target = target;
+  // Decided once target episodes balanced, or once more fell than that allows.
+  const std::uint64_t decided_at = result.decidedAgainst();
+  const std::uint64_t falls_to_fail = episodes >= decided_at ? episodes - decided_at + 1 : 0;
   double returns = 0.0;
   for (std::uint64_t e = 0; e < episodes; ++e)
   {
@@ -170,7 +172,7 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
     result.balanced += s.truncated && !s.terminated;
     returns += s.episode_return;
     result.run = e + 1;
-    if (stop_when_decided && (result.balanced >= suite_case.pass || result.run - result.balanced >= falls_to_fail))
+    if (stop_when_decided && (result.balanced >= decided_at || result.run - result.balanced >= falls_to_fail))
       break;
   }
   result.mean_return = result.run > 0 ? returns / static_cast<double>(result.run) : 0.0;
@@ -205,8 +207,9 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
         return;
       try
       {
-        results[p] =
-            evaluateCase(table, judged, suite.cases[order[p]], suite.episodes, suite.seed, how.stop_cases_when_decided);
+        const SuiteCase& c = suite.cases[order[p]];
+        results[p] = evaluateCase(table, judged, c, suite.episodes, suite.seed, how.stop_cases_when_decided,
+                                  how.target ? how.target(c) : c.pass);
       }
       catch (...)
       {
@@ -216,7 +219,7 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
         first_failure = 0;
         return;
       }
-      if (!results[p].passed())
+      if (!results[p].reachedTarget())
       {
         std::size_t seen = first_failure.load();
         while (p < seen && !first_failure.compare_exchange_weak(seen, p))
@@ -252,7 +255,7 @@ void failedCaseFirst(std::vector<std::size_t>& order, const SuiteResult& result,
 {
   for (const CaseResult& c : result.cases)
   {
-    if (c.passed())
+    if (c.reachedTarget())
       continue;
     for (std::size_t p = 0; p < order.size(); ++p)
     {
@@ -278,6 +281,23 @@ bool SuiteResult::passed() const
   return !stoppedEarly() && std::all_of(cases.begin(), cases.end(), [](const CaseResult& c) { return c.passed(); });
 }
 
+bool SuiteResult::failed() const
+{
+  return std::any_of(cases.begin(), cases.end(),
+                     [](const CaseResult& c) { return c.balanced + (c.episodes - c.run) < c.pass; });
+}
+
+bool SuiteResult::complete() const
+{
+  return !stoppedEarly() && std::none_of(cases.begin(), cases.end(), [](const CaseResult& c) { return c.cutShort(); });
+}
+
+bool SuiteResult::reachedTargets() const
+{
+  return !stoppedEarly() &&
+         std::all_of(cases.begin(), cases.end(), [](const CaseResult& c) { return c.reachedTarget(); });
+}
+
 std::uint64_t SuiteResult::worstBalanced() const
 {
   std::uint64_t worst = std::numeric_limits<std::uint64_t>::max();
@@ -294,9 +314,12 @@ std::string SuiteResult::summary() const
     text += (text.empty() ? "" : ", ") + c.name + " " + std::to_string(c.balanced) + "/" + std::to_string(c.run);
     if (c.cutShort())
       text += " (stopped at " + std::to_string(c.run) + " of " + std::to_string(c.episodes) + ": " +
-              (c.passed() ? "passes" : "fails") + ")";
+              (c.decidedAgainst() == c.pass
+                   ? (c.passed() ? "passes" : "fails")
+                   : (c.reachedTarget() ? "reached " : "cannot reach ") + std::to_string(c.decidedAgainst())) +
+              ")";
   }
-  text += std::string(": ") + (passed() ? "PASSED" : "FAILED");
+  text += std::string(": ") + (passed() ? "PASSED" : failed() ? "FAILED" : "not decided");
   if (stoppedEarly())
     text += " (stopped at " + (cases.empty() ? std::string("the start") : cases.back().name) + ", " +
             std::to_string(cases_in_suite - cases.size()) + " of " + std::to_string(cases_in_suite) + " cases not run)";

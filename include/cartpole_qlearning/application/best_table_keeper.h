@@ -38,7 +38,9 @@ public:
 
   // The suite's verdict on the session's table when it is due at the session's last episode (at
   // suite_every's cadence, and when training ends), said; the table is kept when it is the best
-  // so far. Nothing when not due.
+  // so far. Nothing when not due. Once there is a best, the verdict of a table that cannot beat it
+  // is cut short (SuiteResult::complete() false: passed() is then false, and the whole verdict
+  // would have failed too unless the best passes).
   std::optional<SuiteResult> evaluateWhenDue(const TrainingSession& session, bool training_ends, LogLines& log);
   // Training ends (needs the suite): the table it saves is the best seen when that beats the last
   // (the session then holds it), said. Returns the verdict of that table (`last`, the best's, or
@@ -68,6 +70,8 @@ private:
   std::unique_ptr<RobustnessSuite> suite_;  // none: no verdict (training/suite none, or not found)
   std::string suite_path_;
   std::optional<BestTable> best_;
+  // The order the next evaluation runs the cases in: the last to fall short first.
+  std::vector<std::size_t> order_;
 };
 
 }  // namespace cartpole_qlearning

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -54,9 +55,20 @@ struct CaseResult
   std::uint64_t balanced = 0;  // reached the task's step limit without falling
   std::uint64_t pass = 0;
   double mean_return = 0.0;  // over the episodes run
+  // The balanced episodes the run was decided against when SuiteRun::target said other than pass
+  // (0: pass).
+  std::uint64_t target = 0;
   bool passed() const
   {
     return balanced >= pass;
+  }
+  std::uint64_t decidedAgainst() const
+  {
+    return target > 0 ? target : pass;
+  }
+  bool reachedTarget() const
+  {
+    return balanced >= decidedAgainst();
   }
   bool cutShort() const
   {
@@ -69,11 +81,14 @@ struct CaseResult
 // could not change it, and a case's result does not depend on which thread ran it.
 struct SuiteRun
 {
-  // A case stops at its deciding episode: its (episodes - pass + 1)-th fall, or its pass-th
+  // A case stops at its deciding episode: its (episodes - target + 1)-th fall, or its target-th
   // balanced episode.
   bool stop_cases_when_decided = false;
-  // The suite stops at its first failing case, in `order`; the cases after it are not run.
+  // The suite stops at its first case below its target, in `order`; the cases after it are not run.
   bool stop_at_first_failure = false;
+  // The balanced episodes each case is decided against; empty: the case's pass. (Training asks
+  // whether a table can beat the best so far, which may take more or fewer than pass.)
+  std::function<std::uint64_t(const SuiteCase&)> target;
   // The cases' indices in the order to run them (each once); empty: as the suite lists them.
   std::vector<std::size_t> order;
   // Cases run side by side on this many threads (0: one per core).
@@ -100,11 +115,18 @@ struct SuiteResult
   std::vector<CaseResult> cases;  // in the order run; a suite stopped at a failure lists the cases run
   std::size_t cases_in_suite = 0;
   bool passed() const;
+  // A case run can no longer pass, whatever its episodes not run would give. (A suite stopped
+  // against targets other than pass may be neither passed() nor failed(): not decided.)
+  bool failed() const;
   // The suite stopped at a failing case before running them all.
   bool stoppedEarly() const
   {
     return cases.size() < cases_in_suite;
   }
+  // Every case run to its last episode: the verdict and worstBalanced() are the whole ones.
+  bool complete() const;
+  // Every case reached its target (with a stopped suite: false).
+  bool reachedTargets() const;
   // The fewest balanced episodes of any case, and that case's name.
   std::uint64_t worstBalanced() const;
   // "nominal 100/100, one_step_late 97/100, ... : PASSED" on one line; a case cut short reads
@@ -118,13 +140,17 @@ struct SuiteResult
 // limit, thresholds, reward) and the agent's features and actions the table was made for;
 // evaluateSuite runs each case with the suite's step limit in place of the task's.
 // Throws ConfigError when the table does not fit the configuration.
+// stop_when_decided: stop once the case has `target` balanced episodes or can no longer reach
+// it (0: the case's pass).
 CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
-                        std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided = false);
+                        std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided = false,
+                        std::uint64_t target = 0);
 SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite,
                           const SuiteRun& how = SuiteRun::complete());
 
-// The order for the next evaluation during training: the case that failed last comes first (the
-// likeliest to fail again), the others keep their order. order: the indices of the suite's cases.
+// The order for the next evaluation during training: the case that fell short of its target last
+// comes first (the likeliest to again), the others keep their order. order: the indices of the
+// suite's cases.
 void failedCaseFirst(std::vector<std::size_t>& order, const SuiteResult& result, const RobustnessSuite& suite);
 
 // A mean return as printed with this many decimals: rounded there, a zero without its sign.

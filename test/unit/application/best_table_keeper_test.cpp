@@ -147,6 +147,67 @@ TEST_F(BestTableKeeperTest, TrainingEndsOnTheBestTableSeenNotTheLast)
   EXPECT_EQ(10u, first_of_equals.best()->episode);
 }
 
+TEST_F(BestTableKeeperTest, TheTableKeptIsTheOneWholeVerdictsWouldKeepThoughMostAreCutShort)
+{
+  // Tables along three training runs, each judged by the keeper (against the best so far, cut
+  // short when it cannot beat it) and, beside it, by whole verdicts with the same ranking: the
+  // best table and the table saved at the end are the same after every one. Cases with different
+  // pass counts, so that a failing best's worst case lies above some cases' pass.
+  std::ofstream(dir_ / "suite.yaml") << "episodes: 20\ncases:\n"
+                                        "  - {name: nominal, pass: 19}\n"
+                                        "  - {name: wide, pass: 10, physics: {start_state_bound: 0.1}}\n"
+                                        "  - {name: pushes, pass: 15, perturbations: {push_probability: 0.05, "
+                                        "push_force: 2.0}}\n";
+  const RobustnessSuite suite = loadRobustnessSuite((dir_ / "suite.yaml").string(), config_);
+  const auto better = [](const SuiteResult& a, const SuiteResult& b) {
+    return std::make_pair(a.passed(), a.worstBalanced()) > std::make_pair(b.passed(), b.worstBalanced());
+  };
+  std::size_t cut_short = 0;
+  std::size_t judged = 0;
+  for (std::uint64_t seed = 0; seed < 3; ++seed)
+  {
+    BestTableKeeper keeper(config_, true, {});
+    keeper.loadSuite();
+    std::optional<BestTable> reference;
+    SuiteResult last_whole;
+    std::optional<SuiteResult> last;
+    TrainingSession session(config_.task, config_.agent, 0);
+    for (std::uint64_t episodes = 10; episodes <= 400; episodes += 10)
+    {
+      TrainingConfig config = config_;
+      config.limits.max_episodes = episodes;
+      config.limits.suite = "none";
+      HeadlessTrainer trainer(config, seed);
+      trainer.run();
+      ASSERT_EQ("", session.resume(trainer.session().table(), {}));
+      LogLines log;
+      last = keeper.evaluateWhenDue(session, false, log);
+      ASSERT_TRUE(last.has_value());
+      ++judged;
+      cut_short += last->complete() ? 0 : 1;
+      last_whole = evaluateSuite(session.table(), config_, suite);
+      if (!reference || better(last_whole, reference->result))
+        reference = BestTable{session.table(), last_whole, session.lastEpisode().episode};
+      ASSERT_EQ(reference->episode, keeper.best()->episode) << "seed " << seed << ", episode " << episodes;
+      EXPECT_EQ(reference->result.summary(), keeper.best()->result.summary());
+      // A verdict cut short never says PASSED, nor FAILED of a table that passes.
+      if (!last->complete())
+      {
+        EXPECT_TRUE(!last->passed() && (!last->failed() || !last_whole.passed())) << last->summary();
+      }
+    }
+    // The end: the table saved is the best unless the last is better, on whole verdicts.
+    LogLines log;
+    const std::vector<double> expected =
+        better(reference->result, last_whole) ? reference->table.values() : session.table().values();
+    const SuiteResult saved = keeper.settle(session, last, log);
+    EXPECT_EQ(expected, session.table().values()) << "seed " << seed;
+    EXPECT_TRUE(saved.complete());
+  }
+  // The point of it: most verdicts needed only a part of the suite.
+  EXPECT_GT(cut_short, judged / 2) << cut_short << " of " << judged << " cut short";
+}
+
 TEST_F(BestTableKeeperTest, WithoutTheSuiteDuringTrainingTheSavedTableIsEvaluatedAtTheEnd)
 {
   config_.limits.suite_every = 0;
