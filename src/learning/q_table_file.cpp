@@ -126,6 +126,30 @@ bool knowsHowToRun(const QTable& table)
   return table.tau > 0.0 || !table.trained_with.empty();
 }
 
+// The configuration as a literal block, readable as the config file it is, when that reads back
+// as the very text (the checksum covers every character); else one double-quoted line, which
+// always does.
+std::string trainedWithText(const std::string& text)
+{
+  YAML::Emitter block;
+  block << YAML::BeginMap << YAML::Key << "trained_with" << YAML::Value << YAML::Literal << text << YAML::EndMap;
+  try
+  {
+    const YAML::Node back = YAML::Load(block.c_str())["trained_with"];
+    if (back.IsScalar() && back.Scalar() == text)
+    {
+      const std::string emitted = block.c_str();
+      return emitted.substr(emitted.find(':') + 2);
+    }
+  }
+  catch (const YAML::Exception&)
+  {
+  }
+  YAML::Emitter quoted;
+  quoted << YAML::DoubleQuoted << text;
+  return quoted.c_str();
+}
+
 [[noreturn]] void refuse(const std::string& what)
 {
   throw FileError(what);
@@ -226,11 +250,7 @@ std::string formatQTable(const QTable& table)
   if (table.tau > 0.0)
     out << "tau: " << exact(table.tau) << "\n";
   if (!table.trained_with.empty())
-  {
-    YAML::Emitter quoted;
-    quoted << YAML::DoubleQuoted << table.trained_with;
-    out << "trained_with: " << quoted.c_str() << "\n";
-  }
+    out << "trained_with: " << trainedWithText(table.trained_with) << "\n";
   out << "# Training that produced this table.\n"
       << "episodes: " << table.episodes << "\n"
       << "steps: " << table.steps << "\n"
