@@ -489,9 +489,9 @@ std::string controllerStartText(const ControllerSettings& settings, const QTable
                                                   : "evaluating (greedy, no learning) in episodes of " +
                                                         std::to_string(settings.training.task.max_episode_steps) +
                                                         " steps with " + settings.run.config_origin;
-  std::string text = doing + ", seed " +
-                     std::to_string(settings.run.seed) + ", " + rows + " x " + std::to_string(table.actionCount()) +
-                     " actions, tables under " + table_directory + "; serving " + served;
+  std::string text = doing + ", seed " + std::to_string(settings.run.seed) + ", " + rows + " x " +
+                     std::to_string(table.actionCount()) + " actions, tables under " + table_directory + "; serving " +
+                     served;
   if (settings.robots.size() > 1)
     text += settings.sync ? " in lockstep rounds" : ", each as its states come";
   return text + "; " +

@@ -17,8 +17,8 @@ namespace cartpole_qlearning
 // What every mode but --policy runs with: the configuration, where it came from, the table folder.
 struct HeadlessSetup
 {
-  TrainingConfig config;  // --max-episodes applied; evaluating, --max-steps as task/max_episode_steps
-  std::string config_path;  // "": the table's own configuration
+  TrainingConfig config;       // --max-episodes applied; evaluating, --max-steps as task/max_episode_steps
+  std::string config_path;     // "": the table's own configuration
   std::string config_origin;   // as messages name the configuration (RunSettings::config_origin)
   std::string config_warning;  // what the table's own leaves to the defaults (RunSettings::config_warning)
   std::string table_dir;

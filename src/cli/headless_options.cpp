@@ -216,7 +216,8 @@ HeadlessCommandLine parseHeadlessOptions(const std::vector<std::string>& args)
     {
       o.max_steps_given = true;
       if (!parseCount(args[++i], o.max_steps) || o.max_steps == 0 || o.max_steps > std::numeric_limits<int>::max())
-        return refuse(arg, args[i], "must be a whole number in [1, " + std::to_string(std::numeric_limits<int>::max()) + "]");
+        return refuse(arg, args[i],
+                      "must be a whole number in [1, " + std::to_string(std::numeric_limits<int>::max()) + "]");
     }
     else if (arg == "--episodes" && has_value)
     {

@@ -135,7 +135,9 @@ std::string trainedWithText(const std::string& text)
   block << YAML::BeginMap << YAML::Key << "trained_with" << YAML::Value << YAML::Literal << text << YAML::EndMap;
   try
   {
-    const YAML::Node back = YAML::Load(block.c_str())["trained_with"];
+    // Followed by a line, as in the file: a block that ends the document loses its last line
+    // break, one followed by more keeps it.
+    const YAML::Node back = YAML::Load(std::string(block.c_str()) + "\n#\n")["trained_with"];
     if (back.IsScalar() && back.Scalar() == text)
     {
       const std::string emitted = block.c_str();
@@ -250,7 +252,10 @@ std::string formatQTable(const QTable& table)
   if (table.tau > 0.0)
     out << "tau: " << exact(table.tau) << "\n";
   if (!table.trained_with.empty())
-    out << "trained_with: " << trainedWithText(table.trained_with) << "\n";
+  {
+    const std::string text = trainedWithText(table.trained_with);
+    out << "trained_with: " << text << (text.back() == '\n' ? "" : "\n");
+  }
   out << "# Training that produced this table.\n"
       << "episodes: " << table.episodes << "\n"
       << "steps: " << table.steps << "\n"

@@ -89,8 +89,8 @@ std::string tableContradiction(const TrainingConfig& config, const std::string& 
       differ("learning/tiles", listText(wanted.tiles), listText(has.tiles));
     }
     // Tiles use the bounds of the dimensions they split only: what tiles them alike counts.
-    const bool same_bounds = has.kind == FeatureKind::Bins ? wanted.discretiser == has.discretiser
-                                                           : wanted.tileCoder() == has.tileCoder();
+    const bool same_bounds =
+        has.kind == FeatureKind::Bins ? wanted.discretiser == has.discretiser : wanted.tileCoder() == has.tileCoder();
     if (!same_bounds)
     {
       differ("learning/lower_bounds", listText(wanted.discretiser.lower), listText(has.discretiser.lower));

@@ -170,8 +170,9 @@ TEST(HeadlessOptions, EachRuleRefusesWhatDoesNotGoTogether)
   EXPECT_EQ("--resume with --replay: a replay learns from its file alone", refusal("--replay r.yaml --resume x"));
   EXPECT_EQ("", parse("--replay r.yaml --robots 1 --seed 2 --save s.yaml --config c.yaml --quiet").error);
   EXPECT_EQ("--suite: runs a table: give it with --evaluate TABLE", refusal("--suite s.yaml"));
-  const std::string suite = " with --suite: the suite file gives each case's episodes and their length, run on one "
-                            "robot";
+  const std::string suite =
+      " with --suite: the suite file gives each case's episodes and their length, run on one "
+      "robot";
   for (const std::string option : {"--episodes 3", "--max-steps 9", "--robots 2", "--returns"})
     EXPECT_EQ(words(option)[0] + suite, refusal("--evaluate t.yaml --suite s.yaml " + option));
   EXPECT_EQ("", parse("--evaluate t.yaml --suite s.yaml --robots 1 --seed 3 --quiet").error);
@@ -188,7 +189,7 @@ TEST(HeadlessOptions, TheRulesAreCheckedInTheTablesOrder)
   // Within a rule, its list's order: --load before --save.
   EXPECT_EQ("--load with --evaluate: an evaluation learns nothing and writes nothing",
             refusal("--evaluate t.yaml --save s --load l"));
-  EXPECT_EQ(9u, headlessOptionRules().size());
+  EXPECT_EQ(10u, headlessOptionRules().size());
   for (const OptionRule& rule : headlessOptionRules())
   {
     EXPECT_FALSE(rule.others.empty()) << rule.option.name;

@@ -313,8 +313,8 @@ TEST_F(TrainHeadlessTest, ATableAloneIsEvaluatedWithItsOwnConfigurationInEpisode
   // Trained in episodes of 200 steps (robust.yaml's length), saved with what it takes to run it.
   const std::string short_config =
       file("short.yaml", "task:\n  max_episode_steps: 200\n  solved_mean_return: 195\nphysics:\n  tau: 0.02\n");
-  ASSERT_EQ(0, trainHeadless("--config " + short_config + " --seed 0 --quiet --no-run-folder --save trained.yaml")
-                   .status);
+  ASSERT_EQ(0,
+            trainHeadless("--config " + short_config + " --seed 0 --quiet --no-run-folder --save trained.yaml").status);
   const std::string saved = fileText((tables() / "trained.yaml").string());
   EXPECT_NE(std::string::npos, saved.find("\ntau: 0.02\n")) << saved;
   EXPECT_NE(std::string::npos, saved.find("max_episode_steps: 200")) << saved;
@@ -332,13 +332,13 @@ TEST_F(TrainHeadlessTest, ATableAloneIsEvaluatedWithItsOwnConfigurationInEpisode
   const std::string tiles = CARTPOLE_CONFIG_DIR "/tiles.yaml";
   const CommandRun contradicted = trainHeadless("--config " + tiles + " --evaluate trained.yaml");
   EXPECT_EQ(2, contradicted.status) << contradicted.output;
-  EXPECT_NE(std::string::npos, contradicted.output.find("learning/features is tiles in " + tiles +
-                                                        " but bins in the table " +
-                                                        (tables() / "trained.yaml").string()))
+  EXPECT_NE(std::string::npos,
+            contradicted.output.find("learning/features is tiles in " + tiles + " but bins in the table " +
+                                     (tables() / "trained.yaml").string()))
       << contradicted.output;
   // The suite too runs the table alone.
-  const CommandRun suite = trainHeadless("--quiet --evaluate trained.yaml --suite " +
-                                         std::string(CARTPOLE_CONFIG_DIR) + "/../test/data/short_suite.yaml");
+  const CommandRun suite = trainHeadless("--quiet --evaluate trained.yaml --suite " + std::string(CARTPOLE_CONFIG_DIR) +
+                                         "/../test/data/short_suite.yaml");
   EXPECT_EQ(0, suite.status) << suite.output;
   EXPECT_EQ(0u, suite.lastLine().find("suite=")) << suite.output;
 }
@@ -404,9 +404,10 @@ TEST_F(TrainHeadlessTest, EvaluateOnASuiteRefusesBadInputWithExit2)
   refused(
       config() + " --evaluate t.yaml --suite " + file("bad.yaml", "cases:\n  - {name: a, perturbations: {lag: 1}}\n"),
       "case a: unknown key perturbations/lag");
-  // A table made for other features.
+  // A table made for other features: both named.
   refused(std::string("--config ") + CARTPOLE_CONFIG_DIR "/tiles.yaml --evaluate t.yaml" + suite,
-          "the table does not fit the configuration");
+          "--evaluate t.yaml: learning/features is tiles in " CARTPOLE_CONFIG_DIR "/tiles.yaml but bins in the table " +
+              (tables() / "t.yaml").string());
 }
 
 TEST_F(TrainHeadlessTest, LoadTrainsFurtherFromTheTablesCounters)

@@ -33,10 +33,10 @@ std::string launchOutput(const std::string& home, const std::string& name, const
 long verdictSteps(const std::string& output, unsigned episodes)
 {
   text_match::Groups m;
-  if (!text_match::contains(output,
-                            "EVALUATED " + std::to_string(episodes) +
-                                " episodes: [0-9]+ balanced to the step limit \\(([0-9]+) steps\\)",
-                            &m))
+  if (!text_match::contains(
+          output,
+          "EVALUATED " + std::to_string(episodes) + " episodes: [0-9]+ balanced to the step limit \\(([0-9]+) steps\\)",
+          &m))
     return -1;
   return std::stol(m[1]);
 }
@@ -57,12 +57,14 @@ TEST(TableAlone, RobotAndEvaluateLaunchRunATableWithItsOwnConfigurationInTheEval
   const std::string table = home + "/cartpole_qlearning/cartpole/q_table.yaml";
 
   // robot.launch with no config: the table's own, in 500-step episodes; no episode ends balanced at 200.
-  const std::string robot = "mode:=evaluate load:=q_table.yaml episodes:=3 freshness_timeout:=0 "
-                            "reset_service:=cartpole_sim/reset";
+  const std::string robot =
+      "mode:=evaluate load:=q_table.yaml episodes:=3 freshness_timeout:=0 "
+      "reset_service:=cartpole_sim/reset";
   int status = -1;
   const std::string alone = launchOutput(home, "alone", robot, "robot.launch", status);
   EXPECT_EQ(0, status) << alone;
-  EXPECT_NE(std::string::npos, alone.find("in episodes of 500 steps with the table's own configuration (" + table + ")"))
+  EXPECT_NE(std::string::npos,
+            alone.find("in episodes of 500 steps with the table's own configuration (" + table + ")"))
       << alone;
   EXPECT_EQ(500, verdictSteps(alone, 3)) << alone;
   EXPECT_FALSE(text_match::contains(alone, "evaluation episode [0-9]+: 200 steps, return [-0-9.]+, balanced")) << alone;

@@ -44,7 +44,7 @@ struct RunSettings
   // "" the run's folder/episodes.csv (training; none when evaluating), "none" no file, else a
   // path (relative: under q_table_dir; absolute: the user's own).
   std::string stats_csv;
-  std::string run_id;                      // the launch's own id: a respawn finds its run by it
+  std::string run_id;  // the launch's own id: a respawn finds its run by it
   // Where the training configuration came from, as messages name it ("config/robust.yaml",
   // "parameter server (/cartpole)", "the table's own configuration").
   std::string config_origin = "the configuration";

@@ -141,9 +141,11 @@ TEST(ControllerSettings, ReadsValidParametersAndTheSharedSections)
   EXPECT_EQ(0.9, s.training.agent.gamma);
   EXPECT_EQ(3u, s.training.agent.discretiser.bins[2]);
 
+  // (With a configuration beside it: the table is opened when the run starts, not here.)
   const ControllerSettings e = readController(
       "{mode: evaluate, evaluation_episodes: 0, sim_timeout: 0.5, reset_service: '', sync: false, trace: true, "
-      "run_id: abc, load_on_start: t.yaml, stats_csv: none, start_region: [1, 2, 0.1, 0.2]}");
+      "run_id: abc, load_on_start: t.yaml, stats_csv: none, start_region: [1, 2, 0.1, 0.2]}",
+      "learning: {gamma: 0.9}");
   EXPECT_FALSE(e.run.learning);
   EXPECT_EQ(0u, e.run.evaluation_episodes);
   EXPECT_EQ(0.5, e.sim_timeout);
@@ -617,10 +619,10 @@ struct TableFolder
 TEST(ControllerSettings, AnEvaluationOfATableAloneRunsWithTheTablesOwnConfiguration)
 {
   const TableFolder folder;
-  const TrainingConfig trained =
-      readTrainingConfig(*parseYamlParameters("{physics: {tau: 0.01}, task: {max_episode_steps: 200, x_threshold: 1.5}, "
-                                              "learning: {bins: [3, 3, 6, 12], actions: [-5, 0, 5]}}",
-                                              "robust.yaml"));
+  const TrainingConfig trained = readTrainingConfig(
+      *parseYamlParameters("{physics: {tau: 0.01}, task: {max_episode_steps: 200, x_threshold: 1.5}, "
+                           "learning: {bins: [3, 3, 6, 12], actions: [-5, 0, 5]}}",
+                           "robust.yaml"));
   QTable table(trained.agent.featureParams(), trained.agent.actions);
   table.tau = trained.physics.tau;
   table.trained_with = trainingConfigText(trained);
@@ -664,8 +666,7 @@ TEST(ControllerSettings, AnEvaluationsEpisodesAreItsOwnLengthNeverTheTrainings)
   const std::string shared = "{task: {max_episode_steps: 200}}";
   EXPECT_EQ(200u, readController("", shared).training.task.max_episode_steps);
   EXPECT_EQ(kEvaluationMaxSteps, readController("mode: evaluate", shared).training.task.max_episode_steps);
-  EXPECT_EQ(3000u,
-            readController("{mode: evaluate, max_steps: 3000}", shared).training.task.max_episode_steps);
+  EXPECT_EQ(3000u, readController("{mode: evaluate, max_steps: 3000}", shared).training.task.max_episode_steps);
   // Posing as a suite case: the suite's.
   const std::string suite = std::string(CARTPOLE_CONFIG_DIR) + "/robust_suite.yaml";
   const ControllerSettings posed =
