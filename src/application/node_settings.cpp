@@ -199,6 +199,7 @@ void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& r
   // Over a second the pole has fallen between two decisions.
   priv.readSeconds("decision_period", robot.decision_period, 0.0, 1.0, false);
 }
+
 // An evaluation of a table with no configuration beside it: the table's own (table_config.h).
 void useTablesOwnConfig(RunSettings& run, TrainingConfig& training)
 {
