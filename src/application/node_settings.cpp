@@ -3,10 +3,13 @@
 #include "cartpole_qlearning/io/file_access.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
+#include "cartpole_qlearning/application/table_store.h"
+#include "cartpole_qlearning/learning/table_config.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <utility>
 
@@ -196,6 +199,29 @@ void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& r
   // Over a second the pole has fallen between two decisions.
   priv.readSeconds("decision_period", robot.decision_period, 0.0, 1.0, false);
 }
+
+// An evaluation of a table with no configuration beside it: the table's own (table_config.h).
+void useTablesOwnConfig(RunSettings& run, TrainingConfig& training)
+{
+  const TableStore tables(run.q_table_dir, run.q_table_path,
+                          run.own_absolute_paths ? AbsolutePaths::AreTheUsersFiles : AbsolutePaths::MustLieInTheFolder);
+  std::string path = run.load_on_start;
+  TableConfig own;
+  try
+  {
+    path = tables.resolve(run.load_on_start);
+    own = tableConfig(tables.load(run.load_on_start), path);
+  }
+  catch (const FileError& e)
+  {
+    // As RunApplication::start says it for a table that cannot be used.
+    throw ConfigError("cannot start from the table '" + run.load_on_start +
+                      "' (~load_on_start, which the launch files' q_table or load argument sets): " + e.what());
+  }
+  training = own.config;
+  run.config_origin = "the table's own configuration (" + path + ")";
+  run.config_warning = own.defaults_used;
+}
 }  // namespace
 
 std::vector<std::string> robotNamespaces(std::size_t count)
@@ -217,13 +243,11 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   run.name_space = context.name_space;
   settings.shutdown_when_finished = context.shutdown_by_default;
 
+  run.config_origin = shared.origin();
+
   // The same reader and checks as the shared sections; a key it does not know (a typo) stops
   // the node instead of being ignored.
   SectionReader priv(source, "");
-  // The launch files' stop_when_solved and max_episodes arrive as private parameters; they
-  // override the shared training/ keys for this controller only.
-  priv.read("stop_when_solved", settings.training.limits.stop_when_solved);
-  priv.read("max_episodes", settings.training.limits.max_episodes, 1);
 
   std::string mode = "train";
   priv.readChoice("mode", mode, {"train", "evaluate"});
@@ -258,6 +282,12 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   }
   priv.read("load_on_start", run.load_on_start);
   expand_home("load_on_start", run.load_on_start);
+  if (!run.learning && !run.load_on_start.empty() && !holdsTrainingConfig(shared))
+    useTablesOwnConfig(run, settings.training);
+  // The launch files' stop_when_solved and max_episodes arrive as private parameters; they
+  // override the shared training/ keys for this controller only.
+  priv.read("stop_when_solved", settings.training.limits.stop_when_solved);
+  priv.read("max_episodes", settings.training.limits.max_episodes, 1);
   priv.read("stats_csv", run.stats_csv);
   expand_home("stats_csv", run.stats_csv);
   if (run.stats_csv != "none" && !run.stats_csv.empty() && run.stats_csv.front() != '/')
@@ -278,9 +308,11 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   priv.know("run/folder");
   priv.read("evaluation_episodes", run.evaluation_episodes, 0);
   // What the sim poses as (evaluate.launch suite_case:=NAME), for the verdict to say.
+  unsigned max_steps = kEvaluationMaxSteps;
   if (const auto found = readSuiteCase(priv, settings.training))
   {
     const auto& [suite, suite_case] = *found;
+    max_steps = suite.max_episode_steps;
     if (run.learning)
       priv.fail("suite_case", "'" + suite_case.name + "'", "only with mode evaluate: the verdict says the case");
     if (source.keysUnder("evaluation_episodes").empty())
@@ -289,6 +321,12 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
     // The case's pass count, for as many episodes as the verdict comes after (rounded up).
     run.evaluation_pass = (suite_case.pass * run.evaluation_episodes + suite.episodes - 1) / suite.episodes;
   }
+  priv.read("max_steps", max_steps, 1, std::numeric_limits<int>::max());
+  if (run.learning && !source.keysUnder("max_steps").empty())
+    priv.fail("max_steps", std::to_string(max_steps),
+              "only with mode evaluate: training's episodes are task/max_episode_steps long");
+  if (!run.learning)
+    settings.training.task.max_episode_steps = max_steps;
   priv.read("checkpoint_every", run.checkpoint_every, 0);
   priv.read("save_on_shutdown", run.save_on_shutdown);
   priv.read("shutdown_when_finished", settings.shutdown_when_finished);
@@ -446,9 +484,15 @@ std::string controllerStartText(const ControllerSettings& settings, const QTable
   const std::string rows = features.kind == FeatureKind::Tiles ? std::to_string(features.tilings) + " tilings, " +
                                                                      std::to_string(table.stateCount()) + " tiles"
                                                                : std::to_string(table.stateCount()) + " states";
-  std::string text = std::string(settings.run.learning ? "training" : "evaluating (greedy, no learning)") + ", seed " +
-                     std::to_string(settings.run.seed) + ", " + rows + " x " + std::to_string(table.actionCount()) +
-                     " actions, tables under " + table_directory + "; serving " + served;
+  // An evaluation says how long its episodes are and whose configuration it runs with: neither
+  // need be the training's.
+  const std::string doing = settings.run.learning ? "training"
+                                                  : "evaluating (greedy, no learning) in episodes of " +
+                                                        std::to_string(settings.training.task.max_episode_steps) +
+                                                        " steps with " + settings.run.config_origin;
+  std::string text = doing + ", seed " + std::to_string(settings.run.seed) + ", " + rows + " x " +
+                     std::to_string(table.actionCount()) + " actions, tables under " + table_directory + "; serving " +
+                     served;
   if (settings.robots.size() > 1)
     text += settings.sync ? " in lockstep rounds" : ", each as its states come";
   return text + "; " +

@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/application/run_application.h"
 
 #include "cartpole_qlearning/io/file_access.h"
+#include "cartpole_qlearning/learning/table_config.h"
 #include "cartpole_qlearning/learning/trace.h"
 
 #include <utility>
@@ -40,6 +41,9 @@ struct RunApplication::Parts
   {
     if (settings.trace && settings.learning)
       state_names = stateNames(config.agent);
+    // Every table this run saves (the services, checkpoints, the final and shutdown saves, the
+    // best table) then says what it takes to run it.
+    session.stampTables(config.physics.tau, trainingConfigText(config));
   }
 
   // Puts a loaded table in use. Training goes on with the table's counts: episode numbers,
@@ -99,7 +103,12 @@ void RunApplication::Parts::loadOnStart(LogLines& log)
   try
   {
     path = tables.resolve(settings.load_on_start);
-    const std::string mismatch = useTable(tables.load(settings.load_on_start));
+    QTable table = tables.load(settings.load_on_start);
+    // Named with both sources: which of the two is not what the user meant is theirs to say.
+    const std::string contradiction = tableContradiction(config, settings.config_origin, table, path);
+    if (!contradiction.empty())
+      throw FileError(contradiction);
+    const std::string mismatch = useTable(std::move(table));
     if (!mismatch.empty())
       throw FileError(path + " does not fit this controller: " + mismatch);
   }
@@ -108,6 +117,8 @@ void RunApplication::Parts::loadOnStart(LogLines& log)
     throw ConfigError("cannot start from the table '" + settings.load_on_start +
                       "' (~load_on_start, which the launch files' q_table or load argument sets): " + e.what());
   }
+  if (!settings.config_warning.empty())
+    say(log, LogLine::Level::Warn, settings.config_warning);
   say(log, LogLine::Level::Info,
       formatText("loaded %s (%llu episodes, %llu steps of training)", path.c_str(), count(session.table().episodes),
                  count(session.table().steps)));

@@ -17,13 +17,16 @@ namespace cartpole_qlearning
 // What every mode but --policy runs with: the configuration, where it came from, the table folder.
 struct HeadlessSetup
 {
-  TrainingConfig config;  // --max-episodes applied
-  std::string config_path;
+  TrainingConfig config;       // --max-episodes applied; evaluating, --max-steps as task/max_episode_steps
+  std::string config_path;     // "": the table's own configuration
+  std::string config_origin;   // as messages name the configuration (RunSettings::config_origin)
+  std::string config_warning;  // what the table's own leaves to the defaults (RunSettings::config_warning)
   std::string table_dir;
 };
 
-// The configuration (--config, else the package's), checked against the options (--trace and
-// --replay need bins, a relative --save stays in the table folder): nullopt after saying why.
+// The configuration (--config; else, evaluating, the table's own; else the package's), checked
+// against the options (--trace and --replay need bins, a relative --save stays in the table
+// folder): nullopt after saying why.
 std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options);
 // The package's folder ("" when ROS cannot find it).
 std::string packagePath();

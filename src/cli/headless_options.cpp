@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <limits>
 
 namespace cartpole_qlearning
 {
@@ -44,6 +45,7 @@ const RuleOption kReturns{"--returns", [](const HeadlessOptions& o) { return o.p
 const RuleOption kTrace{"--trace", [](const HeadlessOptions& o) { return o.trace; }};
 const RuleOption kEvaluate{"--evaluate", [](const HeadlessOptions& o) { return o.evaluating(); }};
 const RuleOption kEpisodes{"--episodes", [](const HeadlessOptions& o) { return o.episodes_given; }};
+const RuleOption kMaxSteps{"--max-steps", [](const HeadlessOptions& o) { return o.max_steps_given; }};
 const RuleOption kSuite{"--suite", [](const HeadlessOptions& o) { return !o.suite_path.empty(); }};
 const RuleOption kReplay{"--replay", [](const HeadlessOptions& o) { return !o.replay_path.empty(); }};
 const RuleOption kPolicy{"--policy", [](const HeadlessOptions& o) { return !o.policy_path.empty(); }};
@@ -107,6 +109,10 @@ const std::vector<OptionRule>& headlessOptionRules()
        "a policy is drawn from the table alone (its file says its features)"},
       {Kind::OneOf, kLoad, {kResume}, "give one: --resume goes on from a run's own checkpoint"},
       {Kind::Requires, kEvaluate, {kEpisodes}, "counts --evaluate's episodes (training: --max-episodes)"},
+      {Kind::Requires,
+       kEvaluate,
+       {kMaxSteps},
+       "is how long --evaluate's episodes are (training's: the config's task/max_episode_steps)"},
       {Kind::Excludes,
        kEvaluate,
        {kLoad, kResume, kSave, kMaxEpisodes, kCheckpointEvery, kNoRunFolder, kStatsCsv, kTrace, kReplay},
@@ -118,8 +124,8 @@ const std::vector<OptionRule>& headlessOptionRules()
       {Kind::Requires, kEvaluate, {kSuite}, "runs a table: give it with --evaluate TABLE"},
       {Kind::Excludes,
        kSuite,
-       {kEpisodes, kRobots, kReturns},
-       "the suite file gives each case's episodes, run on one robot"},
+       {kEpisodes, kMaxSteps, kRobots, kReturns},
+       "the suite file gives each case's episodes and their length, run on one robot"},
       {Kind::Excludes, kNoRunFolder, {kCheckpoints}, "checkpoints go into the run's folder"},
   };
   return rules;
@@ -205,6 +211,13 @@ HeadlessCommandLine parseHeadlessOptions(const std::vector<std::string>& args)
       o.checkpoint_given = true;
       if (!parseCount(args[++i], o.checkpoint_every))
         return refuse(arg, args[i], "must be a whole number >= 0; 0: no checkpoints");
+    }
+    else if (arg == "--max-steps" && has_value)
+    {
+      o.max_steps_given = true;
+      if (!parseCount(args[++i], o.max_steps) || o.max_steps == 0 || o.max_steps > std::numeric_limits<int>::max())
+        return refuse(arg, args[i],
+                      "must be a whole number in [1, " + std::to_string(std::numeric_limits<int>::max()) + "]");
     }
     else if (arg == "--episodes" && has_value)
     {

@@ -39,6 +39,8 @@ struct HeadlessOptions
   std::string evaluate_path;
   std::uint64_t evaluation_episodes = 100;
   bool episodes_given = false;
+  std::uint64_t max_steps = kEvaluationMaxSteps;  // --evaluate: an episode's length (never the config's)
+  bool max_steps_given = false;
   std::string suite_path;
 
   std::string replay_path;

@@ -31,6 +31,8 @@ HeadlessRun::HeadlessRun(const HeadlessOptions& options, const HeadlessSetup& se
     trainer_(setup.config, seed, options.robots, !options.evaluating()),
     robot_names_(robotNamespaces(options.robots))
 {
+  settings_.config_origin = setup.config_origin;
+  settings_.config_warning = setup.config_warning;
 }
 
 HeadlessRun::~HeadlessRun() = default;

@@ -5,6 +5,7 @@
 #include "cartpole_qlearning/io/file_access.h"
 #include "cartpole_qlearning/application/table_store.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
+#include "cartpole_qlearning/learning/table_config.h"
 
 #include <ros/package.h>
 
@@ -21,8 +22,26 @@ std::string packagePath()
 std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options)
 {
   HeadlessSetup setup;
+  setup.table_dir = defaultTableDirectory(options.name_space);
   setup.config_path = options.config_path;
-  if (setup.config_path.empty())
+  if (options.evaluating() && setup.config_path.empty())
+  {
+    // A table alone is enough: it carries the configuration that trained it.
+    try
+    {
+      const std::string path = tablePath(setup.table_dir, options.evaluate_path);
+      const TableConfig own = tableConfig(loadTable(setup.table_dir, options.evaluate_path), path);
+      setup.config = own.config;
+      setup.config_origin = "the table's own configuration (" + path + ")";
+      setup.config_warning = own.defaults_used;
+    }
+    catch (const FileError& e)
+    {
+      std::cerr << "train_headless: --evaluate " << options.evaluate_path << ": " << e.what() << "\n";
+      return std::nullopt;
+    }
+  }
+  else if (setup.config_path.empty())
   {
     const std::string share = packagePath();
     if (share.empty())
@@ -33,17 +52,24 @@ std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options)
     }
     setup.config_path = share + "/config/cartpole.yaml";
   }
-  try
+  if (!setup.config_path.empty())
   {
-    const auto source = loadYamlParameters(setup.config_path);
-    refuseUnknownSections(*source);
-    setup.config = readTrainingConfig(*source);
+    try
+    {
+      const auto source = loadYamlParameters(setup.config_path);
+      refuseUnknownSections(*source);
+      setup.config = readTrainingConfig(*source);
+      setup.config_origin = setup.config_path;
+    }
+    catch (const ConfigError& e)
+    {
+      std::cerr << "train_headless: " << e.what() << "\n";
+      return std::nullopt;
+    }
   }
-  catch (const ConfigError& e)
-  {
-    std::cerr << "train_headless: " << e.what() << "\n";
-    return std::nullopt;
-  }
+  // An evaluation's episodes are its own length; a suite's cases, the suite's.
+  if (options.evaluating() && options.suite_path.empty())
+    setup.config.task.max_episode_steps = static_cast<unsigned>(options.max_steps);
   if (options.max_episodes > 0)
     setup.config.limits.max_episodes = options.max_episodes;
   const bool replay = !options.replay_path.empty();
@@ -54,7 +80,6 @@ std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options)
               << " has tiles)\n";
     return std::nullopt;
   }
-  setup.table_dir = defaultTableDirectory(options.name_space);
   // A relative --save must stay in the table folder, as over a service: said before training.
   if (!options.save_path.empty() && options.save_path.front() != '/')
   {

@@ -46,6 +46,9 @@ int replayMode(const HeadlessOptions& options, const HeadlessSetup& setup)
   const std::string& save_path = options.save_path;
   if (save_path.empty())
     return 0;
+  // What it takes to run it, as every saved table says (training_session.h's stampTables).
+  agent.table().tau = config.physics.tau;
+  agent.table().trained_with = trainingConfigText(config);
   try
   {
     saveTable(agent.table(), setup.table_dir, save_path);

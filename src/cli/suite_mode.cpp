@@ -1,6 +1,8 @@
 #include "headless_modes.h"
 
 #include "cartpole_qlearning/application/robustness_suite.h"
+#include "cartpole_qlearning/io/file_access.h"
+#include "cartpole_qlearning/learning/table_config.h"
 
 #include <cstdio>
 #include <iostream>
@@ -29,6 +31,10 @@ int suiteMode(const HeadlessOptions& options, const HeadlessSetup& setup)
   try
   {
     const QTable table = loadTable(setup.table_dir, table_path);
+    const std::string contradiction =
+        tableContradiction(setup.config, setup.config_origin, table, tablePath(setup.table_dir, table_path));
+    if (!contradiction.empty())
+      throw FileError(contradiction);
     result = evaluateSuite(table, setup.config, suite);
   }
   catch (const std::runtime_error& e)  // FileError, ConfigError: the table cannot be read or does not fit

@@ -138,6 +138,32 @@ bool knowsHowToRun(const QTable& table)
   return table.tau > 0.0 || !table.trained_with.empty();
 }
 
+// The configuration as a literal block, readable as the config file it is, when that reads back
+// as the very text (the checksum covers every character); else one double-quoted line, which
+// always does.
+std::string trainedWithText(const std::string& text)
+{
+  YAML::Emitter block;
+  block << YAML::BeginMap << YAML::Key << "trained_with" << YAML::Value << YAML::Literal << text << YAML::EndMap;
+  try
+  {
+    // Followed by a line, as in the file: a block that ends the document loses its last line
+    // break, one followed by more keeps it.
+    const YAML::Node back = YAML::Load(std::string(block.c_str()) + "\n#\n")["trained_with"];
+    if (back.IsScalar() && back.Scalar() == text)
+    {
+      const std::string emitted = block.c_str();
+      return emitted.substr(emitted.find(':') + 2);
+    }
+  }
+  catch (const YAML::Exception&)
+  {
+  }
+  YAML::Emitter quoted;
+  quoted << YAML::DoubleQuoted << text;
+  return quoted.c_str();
+}
+
 [[noreturn]] void refuse(const std::string& what)
 {
   throw FileError(what);
@@ -239,9 +265,8 @@ std::string formatQTable(const QTable& table)
     out << "tau: " << exact(table.tau) << "\n";
   if (!table.trained_with.empty())
   {
-    YAML::Emitter quoted;
-    quoted << YAML::DoubleQuoted << table.trained_with;
-    out << "trained_with: " << quoted.c_str() << "\n";
+    const std::string text = trainedWithText(table.trained_with);
+    out << "trained_with: " << text << (text.back() == '\n' ? "" : "\n");
   }
   out << "# Training that produced this table.\n"
       << "episodes: " << table.episodes << "\n"

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -462,6 +463,161 @@ TrainingConfig readTrainingConfig(const ParameterSource& source)
                         std::to_string(config.physics.force_mag) + ")");
   }
   return config;
+}
+
+bool holdsTrainingConfig(const ParameterSource& source)
+{
+  for (const char* section : {"physics", "perturbations", "task", "learning", "training"})
+  {
+    if (!source.keysUnder(section).empty())
+      return true;
+  }
+  return false;
+}
+
+namespace
+{
+// The shortest text that reads back as the same double, whatever the locale.
+std::string exactText(double value)
+{
+  char text[32];
+  const auto result = std::to_chars(text, text + sizeof text, value);
+  return std::string(text, result.ptr);
+}
+
+template <typename Container>
+void emitNumbers(YAML::Emitter& out, const Container& values)
+{
+  out << YAML::Flow << YAML::BeginSeq;
+  for (const auto value : values)
+    out << exactText(static_cast<double>(value));
+  out << YAML::EndSeq;
+}
+
+void emitSchedule(YAML::Emitter& out, const char* name, const ScheduleParams& schedule)
+{
+  out << YAML::Key << name << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "schedule" << YAML::Value << toString(schedule.type);
+  for (const auto& [key, value] : {std::pair<const char*, double>{"start", schedule.start},
+                                   {"min", schedule.min},
+                                   {"decay_episodes", schedule.decay_episodes},
+                                   {"decay_rate", schedule.decay_rate},
+                                   {"log_divisor", schedule.log_divisor}})
+    out << YAML::Key << key << YAML::Value << exactText(value);
+  out << YAML::EndMap;
+}
+
+void emitNumber(YAML::Emitter& out, const char* key, double value)
+{
+  out << YAML::Key << key << YAML::Value << exactText(value);
+}
+}  // namespace
+
+std::string trainingConfigText(const TrainingConfig& config)
+{
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+
+  // Only the keys the engine takes (readPhysics refuses the others beside it).
+  const CartPoleParams& physics = config.physics;
+  const EngineParams& engine = config.engine;
+  out << YAML::Key << "physics" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "engine" << YAML::Value << toString(engine.kind);
+  if (engine.kind == EngineKind::Mujoco)
+  {
+    for (const auto& [key, value] : {std::pair<const char*, const std::string*>{"model", &engine.model},
+                                     {"cart_joint", &engine.cart_joint},
+                                     {"pole_joint", &engine.pole_joint},
+                                     {"actuator", &engine.actuator}})
+      out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
+  }
+  else
+  {
+    emitNumber(out, "gravity", physics.gravity);
+    emitNumber(out, "mass_cart", physics.mass_cart);
+    emitNumber(out, "mass_pole", physics.mass_pole);
+    emitNumber(out, "half_length", physics.half_length);
+    out << YAML::Key << "integrator" << YAML::Value << toString(physics.integrator);
+    emitNumber(out, "cart_friction", physics.cart_friction);
+    emitNumber(out, "pole_friction", physics.pole_friction);
+  }
+  emitNumber(out, "force_mag", physics.force_mag);
+  emitNumber(out, "tau", physics.tau);
+  emitNumber(out, "start_state_bound", config.start_state_bound);
+  out << YAML::EndMap;
+
+  const PerturbationParams& p = config.perturbations;
+  out << YAML::Key << "perturbations" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "delay_steps" << YAML::Value;
+  if (p.delay_steps == p.delay_steps_max)
+    out << p.delay_steps;
+  else
+    emitNumbers(out, std::array<unsigned, 2>{{p.delay_steps, p.delay_steps_max}});
+  out << YAML::Key << "noise_std" << YAML::Value;
+  emitNumbers(out, p.noise_std);
+  out << YAML::Key << "noise_fraction" << YAML::Value;
+  emitNumbers(out, p.noise_fraction);
+  for (const auto& [key, range] : {std::pair<const char*, const ScaleRange*>{"mass_cart", &p.mass_cart},
+                                   {"mass_pole", &p.mass_pole},
+                                   {"half_length", &p.half_length},
+                                   {"motor", &p.motor}})
+  {
+    out << YAML::Key << key << YAML::Value;
+    emitNumbers(out, std::array<double, 2>{{range->low, range->high}});
+  }
+  emitNumber(out, "push_probability", p.push_probability);
+  emitNumber(out, "push_force", p.push_force);
+  out << YAML::EndMap;
+
+  const TaskParams& task = config.task;
+  out << YAML::Key << "task" << YAML::Value << YAML::BeginMap;
+  emitNumber(out, "x_threshold", task.x_threshold);
+  emitNumber(out, "theta_threshold_deg", task.theta_threshold_deg);
+  out << YAML::Key << "max_episode_steps" << YAML::Value << task.max_episode_steps;
+  out << YAML::Key << "reward" << YAML::Value << toString(task.reward);
+  emitNumber(out, "solved_mean_return", task.solved_mean_return);
+  out << YAML::Key << "solved_window" << YAML::Value << task.solved_window;
+  out << YAML::EndMap;
+
+  const AgentParams& agent = config.agent;
+  out << YAML::Key << "learning" << YAML::Value << YAML::BeginMap;
+  emitNumber(out, "gamma", agent.gamma);
+  out << YAML::Key << "actions" << YAML::Value;
+  emitNumbers(out, agent.actions);
+  out << YAML::Key << "features" << YAML::Value << toString(agent.features);
+  out << YAML::Key << "bins" << YAML::Value;
+  emitNumbers(out, agent.discretiser.bins);
+  out << YAML::Key << "tilings" << YAML::Value << agent.tilings;
+  out << YAML::Key << "tiles" << YAML::Value;
+  emitNumbers(out, agent.tiles);
+  out << YAML::Key << "previous_action" << YAML::Value << agent.previous_action;
+  out << YAML::Key << "lower_bounds" << YAML::Value;
+  emitNumbers(out, agent.discretiser.lower);
+  out << YAML::Key << "upper_bounds" << YAML::Value;
+  emitNumbers(out, agent.discretiser.upper);
+  emitSchedule(out, "epsilon", agent.epsilon);
+  emitSchedule(out, "alpha", agent.alpha);
+  if (!agent.state_names.empty())
+  {
+    out << YAML::Key << "state_names" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (const std::string& name : agent.state_names)
+      out << YAML::DoubleQuoted << name;
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndMap;
+
+  const TrainingLimits& limits = config.limits;
+  out << YAML::Key << "training" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "max_episodes" << YAML::Value << limits.max_episodes;
+  out << YAML::Key << "stop_when_solved" << YAML::Value << limits.stop_when_solved;
+  out << YAML::Key << "progress_every" << YAML::Value << limits.progress_every;
+  out << YAML::Key << "suite" << YAML::Value << YAML::DoubleQuoted << limits.suite;
+  out << YAML::Key << "suite_every" << YAML::Value << limits.suite_every;
+  out << YAML::Key << "until" << YAML::Value << (limits.until == TrainUntil::Solved ? "solved" : "suite_passes");
+  out << YAML::EndMap;
+
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
 }
 
 }  // namespace cartpole_qlearning

@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/learning/training_session.h"
 
 #include <cstdio>
+#include <sstream>
 #include <stdexcept>
 
 namespace cartpole_qlearning
@@ -139,8 +140,28 @@ std::string TrainingSession::setLearning(const LearningSettings& settings)
   return error;
 }
 
+void TrainingSession::stampTables(double tau, const std::string& trained_with)
+{
+  stamp_tau_ = tau;
+  stamp_trained_with_ = trained_with;
+  agent_.table().tau = tau;
+  agent_.table().trained_with = trained_with;
+}
+
 std::string TrainingSession::replaceTable(QTable table)
 {
+  // Values learnt at another step answer another question: the shape alone does not show it.
+  if (stamp_tau_ > 0.0 && table.tau > 0.0 && table.tau != stamp_tau_)
+  {
+    std::ostringstream out;
+    out << "tau " << table.tau << " differs from " << stamp_tau_;
+    return out.str();
+  }
+  if (learning_ && (stamp_tau_ > 0.0 || !stamp_trained_with_.empty()))
+  {
+    table.tau = stamp_tau_;
+    table.trained_with = stamp_trained_with_;
+  }
   return agent_.replaceTable(std::move(table));
 }
 

@@ -82,6 +82,8 @@ TEST(HeadlessOptions, EveryOptionGoesIntoItsField)
   EXPECT_EQ(20u, e.evaluation_episodes);
   EXPECT_TRUE(e.episodes_given);
   EXPECT_EQ("s.yaml", e.suite_path);
+  EXPECT_EQ(kEvaluationMaxSteps, e.max_steps);
+  EXPECT_EQ(3000u, parse("--evaluate t.yaml --max-steps 3000").options.max_steps);
 
   const HeadlessOptions p = parse("--policy t.yaml --grid 11 --axes x,theta --at x_dot=1 --previous 0").options;
   EXPECT_EQ("t.yaml", p.policy_path);
@@ -120,6 +122,8 @@ TEST(HeadlessOptions, BadValuesAreRefusedNamingTheOptionTheValueAndWhatIsAllowed
   EXPECT_EQ("--checkpoint-every often is not allowed (must be a whole number >= 0; 0: no checkpoints)",
             refusal("--checkpoint-every often"));
   EXPECT_EQ("--episodes 0 is not allowed (must be a whole number >= 1)", refusal("--evaluate t.yaml --episodes 0"));
+  EXPECT_EQ("--max-steps 0 is not allowed (must be a whole number in [1, 2147483647])",
+            refusal("--evaluate t.yaml --max-steps 0"));
   EXPECT_EQ("--grid 1 is not allowed (must be a whole number in [2, 1000])", refusal("--policy t.yaml --grid 1"));
   EXPECT_EQ("--grid 1001 is not allowed (must be a whole number in [2, 1000])", refusal("--policy t.yaml --grid 1001"));
   EXPECT_EQ("--ns 'a/../b' is not allowed (must be a ROS namespace)", refusal("--ns a/../b"));
@@ -153,6 +157,8 @@ TEST(HeadlessOptions, EachRuleRefusesWhatDoesNotGoTogether)
   EXPECT_EQ("--load and --resume: give one: --resume goes on from a run's own checkpoint",
             refusal("--load a.yaml --resume runs/b"));
   EXPECT_EQ("--episodes: counts --evaluate's episodes (training: --max-episodes)", refusal("--episodes 5"));
+  EXPECT_EQ("--max-steps: is how long --evaluate's episodes are (training's: the config's task/max_episode_steps)",
+            refusal("--max-steps 3000"));
   const std::string evaluation = " with --evaluate: an evaluation learns nothing and writes nothing";
   for (const std::string option : {"--load l", "--resume r", "--save s", "--max-episodes 3", "--checkpoint-every 0",
                                    "--no-run-folder", "--stats-csv c", "--trace", "--replay r"})
@@ -164,8 +170,10 @@ TEST(HeadlessOptions, EachRuleRefusesWhatDoesNotGoTogether)
   EXPECT_EQ("--resume with --replay: a replay learns from its file alone", refusal("--replay r.yaml --resume x"));
   EXPECT_EQ("", parse("--replay r.yaml --robots 1 --seed 2 --save s.yaml --config c.yaml --quiet").error);
   EXPECT_EQ("--suite: runs a table: give it with --evaluate TABLE", refusal("--suite s.yaml"));
-  const std::string suite = " with --suite: the suite file gives each case's episodes, run on one robot";
-  for (const std::string option : {"--episodes 3", "--robots 2", "--returns"})
+  const std::string suite =
+      " with --suite: the suite file gives each case's episodes and their length, run on one "
+      "robot";
+  for (const std::string option : {"--episodes 3", "--max-steps 9", "--robots 2", "--returns"})
     EXPECT_EQ(words(option)[0] + suite, refusal("--evaluate t.yaml --suite s.yaml " + option));
   EXPECT_EQ("", parse("--evaluate t.yaml --suite s.yaml --robots 1 --seed 3 --quiet").error);
   EXPECT_EQ("--checkpoint-every with --no-run-folder: checkpoints go into the run's folder",
@@ -181,7 +189,7 @@ TEST(HeadlessOptions, TheRulesAreCheckedInTheTablesOrder)
   // Within a rule, its list's order: --load before --save.
   EXPECT_EQ("--load with --evaluate: an evaluation learns nothing and writes nothing",
             refusal("--evaluate t.yaml --save s --load l"));
-  EXPECT_EQ(9u, headlessOptionRules().size());
+  EXPECT_EQ(10u, headlessOptionRules().size());
   for (const OptionRule& rule : headlessOptionRules())
   {
     EXPECT_FALSE(rule.others.empty()) << rule.option.name;

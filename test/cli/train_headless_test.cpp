@@ -308,6 +308,41 @@ TEST_F(TrainHeadlessTest, EvaluateRunsATableGreedilyAndEndsWithItsVerdict)
   EXPECT_LT(std::stod(verdict[1]), 100.0);
 }
 
+TEST_F(TrainHeadlessTest, ATableAloneIsEvaluatedWithItsOwnConfigurationInEpisodesOfItsOwnLength)
+{
+  // Trained in episodes of 200 steps (robust.yaml's length), saved with what it takes to run it.
+  const std::string short_config =
+      file("short.yaml", "task:\n  max_episode_steps: 200\n  solved_mean_return: 195\nphysics:\n  tau: 0.02\n");
+  ASSERT_EQ(0,
+            trainHeadless("--config " + short_config + " --seed 0 --quiet --no-run-folder --save trained.yaml").status);
+  const std::string saved = fileText((tables() / "trained.yaml").string());
+  EXPECT_NE(std::string::npos, saved.find("\ntau: 0.02\n")) << saved;
+  EXPECT_NE(std::string::npos, saved.find("max_episode_steps: 200")) << saved;
+
+  // No --config: the table's own, and 500-step episodes, not the training's 200.
+  const CommandRun alone = trainHeadless("--evaluate trained.yaml --episodes 3");
+  ASSERT_EQ(0, alone.status) << alone.output;
+  EXPECT_NE(std::string::npos, alone.output.find("balanced to the step limit (500 steps)")) << alone.output;
+  EXPECT_NE(std::string::npos, alone.output.find("evaluation episode 3: ")) << alone.output;
+  const CommandRun shorter = trainHeadless("--evaluate trained.yaml --episodes 3 --max-steps 80");
+  ASSERT_EQ(0, shorter.status) << shorter.output;
+  EXPECT_NE(std::string::npos, shorter.output.find("balanced to the step limit (80 steps)")) << shorter.output;
+
+  // A config that contradicts it is refused, naming both.
+  const std::string tiles = CARTPOLE_CONFIG_DIR "/tiles.yaml";
+  const CommandRun contradicted = trainHeadless("--config " + tiles + " --evaluate trained.yaml");
+  EXPECT_EQ(2, contradicted.status) << contradicted.output;
+  EXPECT_NE(std::string::npos,
+            contradicted.output.find("learning/features is tiles in " + tiles + " but bins in the table " +
+                                     (tables() / "trained.yaml").string()))
+      << contradicted.output;
+  // The suite too runs the table alone.
+  const CommandRun suite = trainHeadless("--quiet --evaluate trained.yaml --suite " + std::string(CARTPOLE_CONFIG_DIR) +
+                                         "/../test/data/short_suite.yaml");
+  EXPECT_EQ(0, suite.status) << suite.output;
+  EXPECT_EQ(0u, suite.lastLine().find("suite=")) << suite.output;
+}
+
 TEST_F(TrainHeadlessTest, EvaluateOnASuitePrintsEachCaseAndEndsWithTheSuitesVerdict)
 {
   namespace cq = cartpole_qlearning;
@@ -369,9 +404,10 @@ TEST_F(TrainHeadlessTest, EvaluateOnASuiteRefusesBadInputWithExit2)
   refused(
       config() + " --evaluate t.yaml --suite " + file("bad.yaml", "cases:\n  - {name: a, perturbations: {lag: 1}}\n"),
       "case a: unknown key perturbations/lag");
-  // A table made for other features.
+  // A table made for other features: both named.
   refused(std::string("--config ") + CARTPOLE_CONFIG_DIR "/tiles.yaml --evaluate t.yaml" + suite,
-          "the table does not fit the configuration");
+          "--evaluate t.yaml: learning/features is tiles in " CARTPOLE_CONFIG_DIR "/tiles.yaml but bins in the table " +
+              (tables() / "t.yaml").string());
 }
 
 TEST_F(TrainHeadlessTest, LoadTrainsFurtherFromTheTablesCounters)

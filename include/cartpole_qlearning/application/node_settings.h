@@ -23,6 +23,11 @@ std::vector<std::string> robotNamespaces(std::size_t count);
 
 // What the application around the learner needs (run_application.h): the controller node fills
 // it from its private parameters, train_headless from its command line.
+// An evaluation's episodes are this many steps long unless it is told otherwise (~max_steps,
+// train_headless --max-steps) or poses as a suite case (the suite's): never the training
+// configuration's task/max_episode_steps, which is how long training's episodes were.
+constexpr unsigned kEvaluationMaxSteps = 500;
+
 struct RunSettings
 {
   bool learning = true;  // ~mode: train (true) or evaluate (greedy, no learning)
@@ -39,7 +44,13 @@ struct RunSettings
   // "" the run's folder/episodes.csv (training; none when evaluating), "none" no file, else a
   // path (relative: under q_table_dir; absolute: the user's own).
   std::string stats_csv;
-  std::string run_id;                      // the launch's own id: a respawn finds its run by it
+  std::string run_id;  // the launch's own id: a respawn finds its run by it
+  // Where the training configuration came from, as messages name it ("config/robust.yaml",
+  // "parameter server (/cartpole)", "the table's own configuration").
+  std::string config_origin = "the configuration";
+  // What the run takes from the defaults because its table does not say it (tableConfig's
+  // defaults_used): said as a warning at the start. "": nothing.
+  std::string config_warning;
   std::uint64_t evaluation_episodes = 10;  // evaluate: the verdict after this many episodes (0: never)
   // evaluate: what the robot poses as ("case one_step_late of .../robust_suite.yaml"; "": not
   // said) and the balanced episodes its verdict needs to pass.
@@ -89,7 +100,9 @@ struct ControllerContext
 
 // Reads the shared sections from `shared` and the private parameters from `priv`. Throws
 // ConfigError naming the parameter, its value and what is allowed, on a bad value or an
-// unknown private key.
+// unknown private key. An evaluation of a table (~mode evaluate, ~load_on_start) with no
+// configuration in `shared` runs with the table's own (table_config.h); one given beside it is
+// checked against the table when the run starts (RunApplication::start).
 ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& priv,
                                           const ControllerContext& context);
 

@@ -81,8 +81,10 @@ public:
   std::uint64_t episodes = 0;
   std::uint64_t steps = 0;
   // What it takes to run the table besides its features and actions: the step it learnt [s]
-  // (0: not known, a file written before version 3) and the configuration that trained it, as
-  // its user named it ("": not known).
+  // (0: not known, a file written before version 3) and the configuration that trained it, a
+  // YAML document of its sections (training_config.h's trainingConfigText; "": not known).
+  // Every run stamps the tables it saves (TrainingSession::stampTables); table_config.h runs a
+  // table with them alone.
   double tau = 0.0;
   std::string trained_with;
 

@@ -285,4 +285,14 @@ AgentParams readAgent(const ParameterSource& source);
 TrainingLimits readLimits(const ParameterSource& source);
 TrainingConfig readTrainingConfig(const ParameterSource& source);
 
+// Whether the source sets any key of the sections physics, perturbations, task, learning and
+// training (a config was loaded there), or leaves them all at their defaults.
+bool holdsTrainingConfig(const ParameterSource& source);
+
+// The configuration as a YAML document of those sections, every key with the value in use
+// (defaults included, numbers exact): what a table says trained it (q_table.h's trained_with).
+// parseYamlParameters and readTrainingConfig give the same configuration back, and the same
+// configuration gives the same text however it was read (a file, the parameter server).
+std::string trainingConfigText(const TrainingConfig& config);
+
 }  // namespace cartpole_qlearning

@@ -155,8 +155,14 @@ public:
   {
     return agent_.table();
   }
-  // Installs a loaded table (checked against this agent's shape; on a mismatch returns what
-  // differs and changes nothing). The schedules resume from the table's episode count.
+  // What a table this session trains says of how to run it (q_table.h): the step it learns and
+  // the configuration (training_config.h's trainingConfigText). Put on the table in use now and,
+  // while learning, on every table installed later (a table trained further is this
+  // configuration's); an evaluation keeps an installed table's own, as it learnt nothing.
+  void stampTables(double tau, const std::string& trained_with);
+  // Installs a loaded table (checked against this agent's shape, and against the stamped step
+  // when both say one; on a mismatch returns what differs and changes nothing). The schedules
+  // resume from the table's episode count.
   std::string replaceTable(QTable table);
   // Continues a run from its checkpoint: the table (checked as replaceTable does; on a mismatch
   // returns what differs and changes nothing), the session's episode and step counts from the
@@ -201,6 +207,8 @@ private:
 
   CartPoleTask task_;
   QLearningAgent agent_;
+  double stamp_tau_ = 0.0;  // stampTables' (0: none)
+  std::string stamp_trained_with_;
   LearningSettings learning_settings_;
   bool learning_;
   std::vector<Episode> episodes_;

@@ -4,13 +4,17 @@
 #include "cartpole_qlearning/application/node_settings.h"
 
 #include "cartpole_qlearning/application/headless_trainer.h"
+#include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
 
 #include <gtest/gtest.h>
 
 #include <cctype>
+#include <filesystem>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 using namespace cartpole_qlearning;
 
@@ -137,9 +141,11 @@ TEST(ControllerSettings, ReadsValidParametersAndTheSharedSections)
   EXPECT_EQ(0.9, s.training.agent.gamma);
   EXPECT_EQ(3u, s.training.agent.discretiser.bins[2]);
 
+  // (With a configuration beside it: the table is opened when the run starts, not here.)
   const ControllerSettings e = readController(
       "{mode: evaluate, evaluation_episodes: 0, sim_timeout: 0.5, reset_service: '', sync: false, trace: true, "
-      "run_id: abc, load_on_start: t.yaml, stats_csv: none, start_region: [1, 2, 0.1, 0.2]}");
+      "run_id: abc, load_on_start: t.yaml, stats_csv: none, start_region: [1, 2, 0.1, 0.2]}",
+      "learning: {gamma: 0.9}");
   EXPECT_FALSE(e.run.learning);
   EXPECT_EQ(0u, e.run.evaluation_episodes);
   EXPECT_EQ(0.5, e.sim_timeout);
@@ -587,7 +593,89 @@ TEST(ControllerSettings, TheStartLineSaysWhatTheControllerDoes)
       controllerStartText(s, table, "/t", "/cartpole/joint_states"));
   const ControllerSettings e = readController("{mode: evaluate, seed: 3, robots: 2, sync: false, reset_service: ''}");
   EXPECT_EQ(
-      "evaluating (greedy, no learning), seed 3, 72 states x 2 actions, tables under /t; serving a, b, each as "
+      "evaluating (greedy, no learning) in episodes of 500 steps with /cartpole, seed 3, 72 states x 2 actions, "
+      "tables under /t; serving a, b, each as "
       "its states come; no reset service: episodes start when the state is in ~start_region",
       controllerStartText(e, table, "/t", "a, b"));
+}
+
+namespace
+{
+// A folder of tables for the controller's ~q_table_dir, removed at the end.
+struct TableFolder
+{
+  TableFolder() : path("/tmp/node_settings_test_" + std::to_string(::getpid()))
+  {
+    std::filesystem::create_directories(path);
+  }
+  ~TableFolder()
+  {
+    std::filesystem::remove_all(path);
+  }
+  std::string path;
+};
+}  // namespace
+
+TEST(ControllerSettings, AnEvaluationOfATableAloneRunsWithTheTablesOwnConfiguration)
+{
+  const TableFolder folder;
+  const TrainingConfig trained = readTrainingConfig(
+      *parseYamlParameters("{physics: {tau: 0.01}, task: {max_episode_steps: 200, x_threshold: 1.5}, "
+                           "learning: {bins: [3, 3, 6, 12], actions: [-5, 0, 5]}}",
+                           "robust.yaml"));
+  QTable table(trained.agent.featureParams(), trained.agent.actions);
+  table.tau = trained.physics.tau;
+  table.trained_with = trainingConfigText(trained);
+  saveQTableFile(table, folder.path + "/t.yaml");
+  const std::string evaluate = "{mode: evaluate, load_on_start: t.yaml, q_table_dir: " + folder.path + "}";
+
+  // No configuration beside it: the table's, its step deciding when to act.
+  const ControllerSettings alone = readController(evaluate);
+  EXPECT_EQ(trained.agent.discretiser.bins, alone.training.agent.discretiser.bins);
+  EXPECT_EQ(trained.agent.actions, alone.training.agent.actions);
+  EXPECT_EQ(1.5, alone.training.task.x_threshold);
+  EXPECT_EQ(0.01, alone.robot.decision_period);
+  EXPECT_EQ("the table's own configuration (" + folder.path + "/t.yaml)", alone.run.config_origin);
+  EXPECT_EQ("", alone.run.config_warning);
+
+  // A configuration beside it is the run's (RunApplication checks that it fits the table).
+  const ControllerSettings given = readController(evaluate, "{learning: {gamma: 0.5}}");
+  EXPECT_EQ(AgentParams().discretiser.bins, given.training.agent.discretiser.bins);
+  EXPECT_EQ("/cartpole", given.run.config_origin);
+  // Training takes the configuration, never the table's.
+  EXPECT_EQ(AgentParams().discretiser.bins,
+            readController("{mode: train, load_on_start: t.yaml, q_table_dir: " + folder.path + "}")
+                .training.agent.discretiser.bins);
+
+  // A table that cannot be read stops the node, naming the parameter.
+  EXPECT_SAYS(controllerError("{mode: evaluate, load_on_start: none.yaml, q_table_dir: " + folder.path + "}"),
+              "cannot start from the table 'none.yaml' (~load_on_start, which the launch files' q_table or load "
+              "argument sets): ");
+  // A table without its configuration: its features, the rest the defaults, and said so.
+  saveQTableFile(QTable(trained.agent.featureParams(), trained.agent.actions), folder.path + "/v2.yaml");
+  const ControllerSettings v2 =
+      readController("{mode: evaluate, load_on_start: v2.yaml, q_table_dir: " + folder.path + "}");
+  EXPECT_EQ(trained.agent.discretiser.bins, v2.training.agent.discretiser.bins);
+  EXPECT_EQ(0.02, v2.training.physics.tau);
+  EXPECT_NE(std::string::npos, v2.run.config_warning.find("does not say which configuration trained it"));
+}
+
+TEST(ControllerSettings, AnEvaluationsEpisodesAreItsOwnLengthNeverTheTrainings)
+{
+  // The training configuration's 200 steps are training's episodes.
+  const std::string shared = "{task: {max_episode_steps: 200}}";
+  EXPECT_EQ(200u, readController("", shared).training.task.max_episode_steps);
+  EXPECT_EQ(kEvaluationMaxSteps, readController("mode: evaluate", shared).training.task.max_episode_steps);
+  EXPECT_EQ(3000u, readController("{mode: evaluate, max_steps: 3000}", shared).training.task.max_episode_steps);
+  // Posing as a suite case: the suite's.
+  const std::string suite = std::string(CARTPOLE_CONFIG_DIR) + "/robust_suite.yaml";
+  const ControllerSettings posed =
+      readController("{mode: evaluate, suite: " + suite + ", suite_case: nominal}", shared);
+  EXPECT_EQ(loadRobustnessSuite(suite, TrainingConfig()).max_episode_steps, posed.training.task.max_episode_steps);
+  EXPECT_EQ(60u, readController("{mode: evaluate, suite: " + suite + ", suite_case: nominal, max_steps: 60}", shared)
+                     .training.task.max_episode_steps);
+  EXPECT_SAYS(controllerError("max_steps: 3000"),
+              "max_steps = 3000 is not allowed (only with mode evaluate: training's episodes are "
+              "task/max_episode_steps long)");
+  EXPECT_SAYS(controllerError("{mode: evaluate, max_steps: 0}"), "max_steps = 0 is not allowed");
 }

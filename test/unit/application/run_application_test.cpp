@@ -4,6 +4,7 @@
 // the services' paths. Clocks are injected; tables go to a temporary folder.
 #include "cartpole_qlearning/application/headless_trainer.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
+#include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/application/run_application.h"
 
@@ -873,6 +874,8 @@ TEST_F(RunApplicationTest, EveryRunSaysWhatItsSavedTableIsWorthAndTheDefaultOneT
   const TrainingConfig config;
   const std::vector<EpisodeEnd> ends = train(config);
   HeadlessTrainer alone(config, settings_.seed);
+  // Stamped as every run's tables are: the step and the configuration change no value.
+  alone.session().stampTables(config.physics.tau, trainingConfigText(config));
   alone.run();
   saveQTableFile(alone.session().table(), (dir_ / "alone.yaml").string());
   EXPECT_EQ(text(dir_ / "alone.yaml"), text(dir_ / "q_table.yaml"));
@@ -1092,4 +1095,78 @@ TEST_F(RunApplicationTest, ABestTableThatCannotBeReadIsSaidAndTheBestLookedForAf
             log(resumed, "the run's best table (episode " + std::to_string(best_at) + ") cannot be used").level)
       << all(resumed);
   EXPECT_FALSE(says(resumed, "still the one to beat"));
+}
+
+TEST_F(RunApplicationTest, EverySavedTableSaysWhatItTakesToRunIt)
+{
+  const std::string expected = trainingConfigText(config_);
+  settings_.checkpoint_every = 1;
+  Run run = startRun();
+  episode(run);  // a checkpoint
+  const fs::path checkpoint = dir_ / folderName() / "q_table.yaml";
+  ASSERT_TRUE(run.app->save("service.yaml").success);
+  for (const fs::path& file : {checkpoint, dir_ / "service.yaml"})
+  {
+    const QTable table = loadQTableFile(file.string());
+    EXPECT_EQ(config_.physics.tau, table.tau) << file;
+    EXPECT_EQ(expected, table.trained_with) << file;
+  }
+  // The final save (and the default table) too.
+  episode(run, true);
+  episode(run, true, true);
+  ASSERT_TRUE(run.app->finished());
+  for (const fs::path& file : {checkpoint, dir_ / "q_table.yaml"})
+    EXPECT_EQ(expected, loadQTableFile(file.string()).trained_with) << file;
+
+  // On shutdown, and when trained further from a table another configuration trained.
+  QTable earlier = loadQTableFile((dir_ / "q_table.yaml").string());
+  earlier.trained_with = "task: {max_episode_steps: 5}\n";
+  saveQTableFile(earlier, (dir_ / "earlier.yaml").string());
+  settings_.load_on_start = "earlier.yaml";
+  settings_.run_id = "another_run";
+  Run further = startRun();
+  episode(further);
+  ASSERT_EQ(1u, further.app->shutdown().size());
+  EXPECT_EQ(expected, loadQTableFile((dir_ / further.app->runFolder() / "q_table.yaml").string()).trained_with);
+}
+
+TEST_F(RunApplicationTest, ATableThatContradictsTheConfigurationIsRefusedNamingBoth)
+{
+  TrainingConfig other = config_;
+  other.agent.discretiser.bins = {{3, 3, 6, 12}};
+  other.physics.tau = 0.01;
+  QTable table(other.agent.featureParams(), other.agent.actions);
+  table.tau = 0.01;
+  saveQTableFile(table, (dir_ / "other.yaml").string());
+  settings_.load_on_start = "other.yaml";
+  settings_.config_origin = "config/mine.yaml";
+  for (const bool learning : {true, false})
+  {
+    settings_.learning = learning;
+    try
+    {
+      startRun();
+      FAIL() << "started with a table another configuration trained";
+    }
+    catch (const ConfigError& e)
+    {
+      const std::string path = (dir_ / "other.yaml").string();
+      EXPECT_NE(
+          std::string::npos,
+          std::string(e.what()).find("learning/bins is [1, 1, 6, 12] in config/mine.yaml but [3, 3, 6, 12] in "
+                                     "the table " +
+                                     path + "; physics/tau is 0.02 in config/mine.yaml but 0.01 in the table " + path))
+          << e.what();
+    }
+  }
+}
+
+TEST_F(RunApplicationTest, AnEvaluationSaysWhatItsTableLeavesToTheDefaults)
+{
+  saveQTableFile(QTable(config_.agent.featureParams(), config_.agent.actions), (dir_ / "v2.yaml").string());
+  settings_.learning = false;
+  settings_.load_on_start = "v2.yaml";
+  settings_.config_warning = "the table says no configuration";
+  const Run run = startRun();
+  EXPECT_EQ(LogLine::Level::Warn, log(run.started, "the table says no configuration").level);
 }

@@ -1,4 +1,5 @@
 #include "cartpole_qlearning/learning/q_table_file.h"
+#include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/learning/training_session.h"
 
 #include "test_support.h"
@@ -652,4 +653,21 @@ TEST_F(QTableFileTest, ATableThatKnowsNeitherIsTheVersion2FileItAlwaysWas)
   v3.replace(v3.find("version: 2"), 10, "version: 3");
   write(path("v3.yaml"), v3);
   EXPECT_THROW(loadQTableFile(path("v3.yaml")), FileError);
+}
+
+TEST_F(QTableFileTest, TheConfigurationThatTrainedATableReadsAsTheConfigFileItIs)
+{
+  QTable table = awkwardTable();
+  table.tau = 0.02;
+  table.trained_with = trainingConfigText(TrainingConfig());
+  saveQTableFile(table, path("t.yaml"));
+  const std::string text = readFile(path("t.yaml"));
+  // A literal block, one key a line, not one escaped line.
+  EXPECT_NE(std::string::npos, text.find("trained_with: |")) << text;
+  EXPECT_NE(std::string::npos, text.find("\n    tau: 0.02\n")) << text;
+  EXPECT_EQ(table.trained_with, loadQTableFile(path("t.yaml")).trained_with);
+  // Text a block cannot hold as it is (leading spaces, no final line break) is written quoted.
+  table.trained_with = "  indented\n\n";
+  saveQTableFile(table, path("odd.yaml"));
+  EXPECT_EQ(table.trained_with, loadQTableFile(path("odd.yaml")).trained_with);
 }

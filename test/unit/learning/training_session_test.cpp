@@ -214,3 +214,34 @@ TEST(CartPoleSimulation, RandomStartsStayWithinTheBoundAndFollowTheSeed)
   a.step(25.0);
   EXPECT_EQ(10.0, a.appliedForce());
 }
+
+TEST(TrainingSession, ATrainedTableSaysTheStepAndConfigurationItLearntWith)
+{
+  TrainingSession session(TaskParams(), AgentParams(), 0);
+  session.stampTables(0.02, "learning: {gamma: 0.99}\n");
+  EXPECT_EQ(0.02, session.table().tau);
+  EXPECT_EQ("learning: {gamma: 0.99}\n", session.table().trained_with);
+  // A table trained further from here is this configuration's, whatever it said before.
+  QTable other(AgentParams().featureParams(), AgentParams().actions);
+  other.trained_with = "learning: {gamma: 0.5}\n";
+  other.tau = 0.02;
+  ASSERT_EQ("", session.replaceTable(other));
+  EXPECT_EQ("learning: {gamma: 0.99}\n", session.table().trained_with);
+  ASSERT_EQ("", session.resume(QTable(AgentParams().featureParams(), AgentParams().actions), {}));
+  EXPECT_EQ(0.02, session.table().tau);
+  // Values learnt at another step do not fit, though the shape does.
+  other.tau = 0.01;
+  EXPECT_EQ("tau 0.01 differs from 0.02", session.replaceTable(other));
+  EXPECT_EQ("learning: {gamma: 0.99}\n", session.table().trained_with);
+}
+
+TEST(TrainingSession, AnEvaluatedTableKeepsWhatItSaysOfItsTraining)
+{
+  TrainingSession session(TaskParams(), AgentParams(), 0, false);
+  session.stampTables(0.02, "task: {}\n");
+  QTable trained(AgentParams().featureParams(), AgentParams().actions);
+  trained.trained_with = "learning: {gamma: 0.5}\n";
+  ASSERT_EQ("", session.replaceTable(trained));
+  EXPECT_EQ("learning: {gamma: 0.5}\n", session.table().trained_with);
+  EXPECT_EQ(0.0, session.table().tau);
+}
