@@ -250,8 +250,9 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   SectionReader priv(source, "");
 
   std::string mode = "train";
-  priv.readChoice("mode", mode, {"train", "evaluate"});
+  priv.readChoice("mode", mode, {"train", "evaluate", "control"});
   run.learning = mode == "train";
+  run.control = mode == "control";
   priv.read("seed", run.seed, 0);
 
   run.q_table_dir = defaultTableDirectory(context.name_space);
@@ -322,11 +323,25 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
     run.evaluation_pass = (suite_case.pass * run.evaluation_episodes + suite.episodes - 1) / suite.episodes;
   }
   priv.read("max_steps", max_steps, 1, std::numeric_limits<int>::max());
-  if (run.learning && !source.keysUnder("max_steps").empty())
+  if ((run.learning || run.control) && !source.keysUnder("max_steps").empty())
     priv.fail("max_steps", std::to_string(max_steps),
-              "only with mode evaluate: training's episodes are task/max_episode_steps long");
+              run.control ? "not with mode control, which has no step limit: only with mode evaluate"
+                          : "only with mode evaluate: training's episodes are task/max_episode_steps long");
   if (!run.learning)
     settings.training.task.max_episode_steps = max_steps;
+  if (run.control)
+  {
+    // No step limit (a stretch ends only with a fall; 2^32 - 1 steps are 2.7 years at 50 Hz) and no verdict.
+    settings.training.task.max_episode_steps = std::numeric_limits<unsigned>::max();
+    run.evaluation_episodes = 0;
+    if (!run.evaluation_case.empty())
+      priv.fail("suite_case", "'" + run.evaluation_case + "'", "only with mode evaluate: the verdict says the case");
+    if (run.load_on_start.empty())
+      priv.fail("mode", "control", "needs ~load_on_start: a trained table to drive the robot with");
+  }
+  priv.readSeconds("report_every", run.report_every, 0.0, 3600.0, true);
+  if (!run.control && !source.keysUnder("report_every").empty())
+    priv.fail("report_every", SectionReader::numberText(run.report_every), "only with mode control");
   priv.read("checkpoint_every", run.checkpoint_every, 0);
   priv.read("save_on_shutdown", run.save_on_shutdown);
   priv.read("shutdown_when_finished", settings.shutdown_when_finished);
@@ -486,10 +501,13 @@ std::string controllerStartText(const ControllerSettings& settings, const QTable
                                                                : std::to_string(table.stateCount()) + " states";
   // An evaluation says how long its episodes are and whose configuration it runs with: neither
   // need be the training's.
-  const std::string doing = settings.run.learning ? "training"
-                                                  : "evaluating (greedy, no learning) in episodes of " +
-                                                        std::to_string(settings.training.task.max_episode_steps) +
-                                                        " steps with " + settings.run.config_origin;
+  const std::string doing =
+      settings.run.learning ? "training"
+      : settings.run.control
+          ? "controlling (greedy, no learning, no step limit: a fall commands 0 until a start) with " +
+                settings.run.config_origin
+          : "evaluating (greedy, no learning) in episodes of " +
+                std::to_string(settings.training.task.max_episode_steps) + " steps with " + settings.run.config_origin;
   std::string text = doing + ", seed " + std::to_string(settings.run.seed) + ", " + rows + " x " +
                      std::to_string(table.actionCount()) + " actions, tables under " + table_directory + "; serving " +
                      served;

@@ -128,6 +128,21 @@ std::vector<geometry_msgs::TransformStamped> transformsFromState(const CartPoleS
   return {cart, pole};
 }
 
+ControlStats controlStats(const ControlStatsValues& values, const std::string& robot, const ros::Time& stamp)
+{
+  ControlStats msg;
+  msg.header.stamp = stamp;
+  msg.robot = robot;
+  msg.seconds = values.seconds;
+  msg.balanced_seconds = values.balanced_seconds;
+  msg.longest_seconds = values.longest_seconds;
+  msg.current_seconds = values.current_seconds;
+  msg.falls = values.falls;
+  msg.decisions = values.decisions;
+  msg.clamped = values.clamped;
+  return msg;
+}
+
 EpisodeStats learnerEpisodeStats(const EpisodeSummary& s, const std::string& robot, const ros::Time& stamp,
                                  double steps_per_second)
 {

@@ -2,6 +2,7 @@
 
 #include "cartpole_qlearning/ros/conversions.h"
 #include "command_publisher.h"
+#include "control_reporter.h"
 #include "launch_control.h"
 #include "parameter_source.h"
 #include "reset_caller.h"
@@ -56,6 +57,10 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   }
   startRun();
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
+  if (settings_.run.control)
+    control_ = std::make_unique<ControlReporter>(nh_, settings_.robots, settings_.training.physics.tau,
+                                                 settings_.training.physics.force_mag, settings_.run.report_every,
+                                                 [this](const LogLines& log) { say(log); });
   ros::NodeHandle services_nh(pnh_);
   services_nh.setCallbackQueue(&services_queue_);
   save_srv_ = services_nh.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
@@ -125,6 +130,8 @@ QLearningControllerNode::~QLearningControllerNode()
   // ROS may be shut down already: said on the console.
   for (const LogLine& log : app_ ? app_->shutdown() : LogLines())
     std::printf("%s\n", prefixed(log).c_str());
+  for (const LogLine& log : control_ ? control_->summaries() : LogLines())
+    std::printf("%s\n", prefixed(log).c_str());
   // Out now: under roslaunch stdout is a pipe, and a process killed after its slow exit (a
   // loaded machine) would lose what is still buffered (seen in a new Debian 12 root: the line
   // cut after the path).
@@ -192,6 +199,9 @@ void QLearningControllerNode::serve(const RobotDispatch::Turn& turn)
     robot.command.publish(reaction.effort, stamp);
   if (reaction.episode_ended && !reaction.answer)
     robot.command.stop();
+  if (control_)
+    control_->onReaction(turn.robot, reaction, reaction.episode_ended && session_->lastEpisode().terminated,
+                         turn.stamp);
   if (reaction.episode_ended)
     endEpisode(robot, stamp, reaction.training_finished);
   // Reset calls run on threads of their own (ResetCaller): a blocking call from this callback would

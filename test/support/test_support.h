@@ -227,6 +227,13 @@ public:
   {
     return fileText(log_);
   }
+  // Ctrl-C, as a user stops a launch; the exit status as waitFor gives it.
+  int interrupt(double seconds)
+  {
+    if (pid_ > 0)
+      ::kill(pid_, SIGINT);
+    return waitFor(seconds);
+  }
 
 private:
   pid_t pid_ = -1;

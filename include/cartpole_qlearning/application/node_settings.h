@@ -30,7 +30,11 @@ constexpr unsigned kEvaluationMaxSteps = 500;
 
 struct RunSettings
 {
-  bool learning = true;  // ~mode: train (true) or evaluate (greedy, no learning)
+  bool learning = true;  // ~mode: train (true) or evaluate or control (greedy, no learning)
+  // ~mode control: the table drives the robot with no episodes' step limit, no verdict and no
+  // learning; a fall commands 0 until a start, and ControlMeter says how it goes.
+  bool control = false;
+  double report_every = 10.0;  // [s] control: a report this often (robot time)
   std::uint64_t seed = 0;
   std::string name_space = "/cartpole";  // the learner's namespace: its table folder by default, its run folders' names
   // Tables are read and written under this folder (a relative path there; one that escapes it is

@@ -3,7 +3,9 @@
 // master and no logging: a refused message comes back with the text the node logs.
 #pragma once
 
+#include "cartpole_qlearning/ControlStats.h"
 #include "cartpole_qlearning/EpisodeStats.h"
+#include "cartpole_qlearning/application/control_meter.h"
 #include "cartpole_qlearning/LearningConfig.h"
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
 #include "cartpole_qlearning/learning/learning_settings.h"
@@ -76,6 +78,8 @@ std::vector<geometry_msgs::TransformStamped> transformsFromState(const CartPoleS
 
 // episode_stats at an episode's end. On the learner's topic: episode, mean return and total
 // steps over all robots; on a robot's own topic: that robot's. steps_per_second is the caller's.
+// ~mode control's report (ControlMeter) as a message.
+ControlStats controlStats(const ControlStatsValues& values, const std::string& robot, const ros::Time& stamp);
 EpisodeStats learnerEpisodeStats(const EpisodeSummary& summary, const std::string& robot, const ros::Time& stamp,
                                  double steps_per_second);
 EpisodeStats robotEpisodeStats(const EpisodeSummary& summary, const std::string& robot, const ros::Time& stamp,

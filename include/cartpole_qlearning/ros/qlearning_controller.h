@@ -41,6 +41,8 @@
 
 namespace cartpole_qlearning
 {
+class ControlReporter;
+
 class QLearningControllerNode
 {
 public:
@@ -122,6 +124,8 @@ private:
   WallThrottle bad_state_warning_{1.0};
 
   ros::Publisher stats_pub_;
+  // ~mode control: how each robot is held, said and published on control_stats (none otherwise).
+  std::unique_ptr<ControlReporter> control_;
   // ~save_q_table and ~load_q_table run on a thread of their own: writing or reading a large
   // table takes seconds, and states must be answered meanwhile (a node's states and timer share
   // one thread). Only the copy of the table to save and the swap of a table read hold mutex_.

@@ -170,9 +170,31 @@ TEST(ControllerSettings, PrivateLimitsOverrideTheSharedOnes)
               "qlearning_controller: max_episodes = 0 is not allowed (must be a whole number >= 1)");
 }
 
+TEST(ControllerSettings, ControlDrivesWithATableAndNoStepLimitNorVerdict)
+{
+  const std::string shared = "{task: {max_episode_steps: 200}}";
+  const ControllerSettings control = readController("{mode: control, load_on_start: robust.yaml}", shared);
+  EXPECT_TRUE(control.run.control);
+  EXPECT_FALSE(control.run.learning);
+  EXPECT_EQ(std::numeric_limits<unsigned>::max(), control.training.task.max_episode_steps);
+  EXPECT_EQ(0u, control.run.evaluation_episodes);
+  EXPECT_EQ(10.0, control.run.report_every);
+  EXPECT_EQ(2.5, readController("{mode: control, load_on_start: t.yaml, report_every: 2.5}", shared).run.report_every);
+  EXPECT_FALSE(readController("mode: evaluate", shared).run.control);
+  // What control cannot take, each refused naming it.
+  EXPECT_SAYS(controllerError("mode: control", shared),
+              "mode = control is not allowed (needs ~load_on_start: a trained table to drive the robot with)");
+  EXPECT_SAYS(controllerError("{mode: control, load_on_start: t.yaml, max_steps: 500}", shared),
+              "max_steps = 500 is not allowed (not with mode control, which has no step limit");
+  EXPECT_SAYS(controllerError("{mode: control, load_on_start: t.yaml, report_every: 0}", shared),
+              "report_every = 0");
+  EXPECT_SAYS(controllerError("{mode: evaluate, report_every: 5}", shared),
+              "report_every = 5 is not allowed (only with mode control)");
+}
+
 TEST(ControllerSettings, RefusesAnUnknownMode)
 {
-  EXPECT_SAYS(controllerError("mode: fly"), "mode = 'fly' is not allowed (allowed: train, evaluate)");
+  EXPECT_SAYS(controllerError("mode: fly"), "mode = 'fly' is not allowed (allowed: train, evaluate, control)");
 }
 
 TEST(ControllerSettings, RefusesANegativeSeed)

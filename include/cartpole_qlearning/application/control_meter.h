@@ -1,0 +1,57 @@
+// What a robot owner wants to know of a table that drives a robot (~mode control): how long it
+// has kept the pole up, its longest stretch, how often the pole fell, how many commands were
+// beyond the motor. Time is counted in decisions on new states times the decision step (tau):
+// the robot's own clock, whatever the wall clock does (a lockstep sim runs faster than real time).
+#pragma once
+
+#include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/protocol/lockstep_protocol.h"
+
+#include <cstdint>
+#include <string>
+
+namespace cartpole_qlearning
+{
+struct ControlStatsValues
+{
+  double seconds = 0.0;           // decisions on new states x tau, balancing or waiting for a start
+  double balanced_seconds = 0.0;  // of which inside an episode (the pole up)
+  double longest_seconds = 0.0;   // the longest stretch without a fall
+  double current_seconds = 0.0;   // the stretch going on (0 while waiting for a start)
+  std::uint64_t falls = 0;
+  std::uint64_t decisions = 0;
+  std::uint64_t clamped = 0;  // decisions whose effort was beyond physics/force_mag
+};
+
+class ControlMeter
+{
+public:
+  // robot: as the log names it ("" the learner's own); tau: the decision step [s]; force_mag:
+  // the motor's limit [N]; report_every: a report line every this much robot time [s].
+  ControlMeter(std::string robot, double tau, double force_mag, double report_every);
+
+  // One of the robot's states as the protocol reacted to it; fell: the episode it ended ended
+  // on the task's thresholds (TrainingSession::lastEpisode().terminated). Returns what to say:
+  // the fall, or the periodic report when due; empty otherwise (publish the stats when not).
+  LogLines onReaction(const Reaction& reaction, bool fell);
+  // The line said at the end (the controller stopping).
+  LogLine summary() const;
+
+  const ControlStatsValues& stats() const
+  {
+    return stats_;
+  }
+
+private:
+  std::string reportText() const;
+
+  std::string robot_;
+  double tau_;
+  double force_mag_;
+  std::uint64_t report_every_;  // in decisions
+  bool in_episode_ = false;
+  std::uint64_t since_report_ = 0;
+  ControlStatsValues stats_;
+};
+
+}  // namespace cartpole_qlearning

@@ -1,0 +1,102 @@
+// robot.launch mode:=control as a robot owner runs it (control_robot.test): a table trained by
+// train_headless --config config/robust.yaml drives the sim posing as a robot it never met for five
+// minutes of the robot's time (lockstep: 15,000 decisions). What must hold: control_stats reports
+// the time, the longest stretch and the falls, and they add up with what the log says; every
+// fall is followed by a reset and control goes on; Ctrl-C ends it with a zero command and a last
+// line that says how it went. How long the table keeps the pole up is printed (issue 26: tables
+// that hold for minutes are the long suite's work), not asserted.
+#include "cartpole_qlearning/ControlStats.h"
+
+#include "ros_test_support.h"
+#include "rostest_main.h"
+#include "test_support.h"
+#include "text_match.h"
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
+#include <filesystem>
+#include <mutex>
+#include <string>
+
+using cartpole_qlearning::ControlStats;
+using cartpole_qlearning::test::runCommand;
+using cartpole_qlearning::test::spinUntil;
+using cartpole_qlearning::test::TrainLaunch;
+
+namespace
+{
+const cartpole_qlearning::test::ScratchFolder kRosHome("ros_home");
+
+std::size_t occurrences(const std::string& text, const std::string& what)
+{
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1))
+    ++n;
+  return n;
+}
+}  // namespace
+
+TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZero)
+{
+  const std::string home = kRosHome.path();
+  ASSERT_FALSE(home.empty());
+  std::filesystem::create_directories(home);
+  const auto trained = runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + CARTPOLE_CONFIG_DIR +
+                                  "/robust.yaml --seed 0 --quiet --no-run-folder --save robust.yaml");
+  ASSERT_EQ(0, trained.status) << trained.output;
+
+  ros::NodeHandle nh;
+  ControlStats last;
+  int reports = 0;
+  double last_effort = -1.0;
+  int commands = 0;
+  const ros::Subscriber stats = nh.subscribe<ControlStats>(
+      "/cartpole/control_stats", 1000, boost::function<void(const cartpole_qlearning::ControlStatsConstPtr&)>(
+                                           [&](const cartpole_qlearning::ControlStatsConstPtr& m) {
+                                             last = *m;
+                                             ++reports;
+                                           }));
+  const ros::Subscriber command = nh.subscribe<sensor_msgs::JointState>(
+      "/cartpole/joint_command", 1000,
+      boost::function<void(const sensor_msgs::JointStateConstPtr&)>([&](const sensor_msgs::JointStateConstPtr& m) {
+        if (!m->effort.empty())
+          last_effort = m->effort[0];
+        ++commands;
+      }));
+
+  // The sim holds no command in lockstep: no freshness guard. A report each minute of robot time.
+  TrainLaunch launch(home, "control",
+                     "mode:=control load:=robust.yaml freshness_timeout:=0 reset_service:=cartpole_sim/reset "
+                     "report_every:=60",
+                     "robot.launch");
+  ASSERT_TRUE(spinUntil([&] { return last.seconds >= 300.0; }, 300.0))
+      << reports << " reports, the last at " << last.seconds << " s\n"
+      << launch.output();
+  const ControlStats at_five_minutes = last;
+  EXPECT_EQ(0, launch.interrupt(30.0)) << launch.output();
+  spinUntil([&] { return false; }, 0.5);  // what was sent before the end arrives
+  const std::string output = launch.output();
+
+  // The stats add up: robot time is decisions times the step, balanced time within it, the
+  // longest stretch within that; every fall was said, and every minute reported.
+  EXPECT_NEAR(at_five_minutes.decisions * 0.02, at_five_minutes.seconds, 1e-6);
+  EXPECT_LE(at_five_minutes.balanced_seconds, at_five_minutes.seconds);
+  EXPECT_LE(at_five_minutes.longest_seconds, at_five_minutes.balanced_seconds + 1e-9);
+  EXPECT_LE(at_five_minutes.current_seconds, at_five_minutes.longest_seconds + 1e-9);
+  EXPECT_EQ(last.falls, occurrences(output, "the pole fell after")) << output;
+  EXPECT_GE(occurrences(output, "control: balanced "), 4u) << output;
+  // Control went on after each fall (the reset service put the pole back): most of the time is balanced.
+  EXPECT_GT(at_five_minutes.balanced_seconds, 0.9 * at_five_minutes.seconds);
+  // Ctrl-C: zero effort last, and the last line says how it went.
+  EXPECT_GT(commands, 0);
+  EXPECT_EQ(0.0, last_effort);
+  EXPECT_TRUE(cartpole_qlearning::test::text_match::contains(
+      output, "control ended: balanced [0-9.]+ s of [0-9.]+ s, the longest stretch [0-9.]+ s, [0-9]+ falls?, 0 of "
+              "[0-9]+ commands beyond the motor's 10 N"))
+      << output;
+  std::printf("five minutes of control on all_at_once: %.1f s balanced, the longest stretch %.1f s, %llu falls\n",
+              at_five_minutes.balanced_seconds, at_five_minutes.longest_seconds,
+              static_cast<unsigned long long>(at_five_minutes.falls));
+}
