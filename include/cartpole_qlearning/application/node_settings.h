@@ -71,6 +71,9 @@ struct ControllerSettings
   RobotInterfaceParams robot;                        // joints, offsets, command type, decision period
   // ~reset_service_type: what ~reset_service is
   std::string reset_service_type = "cartpole_qlearning/Reset";
+  // The robots are cartpole_sims: ~reset_service is a cartpole_sim's (reset or reset_simulation).
+  // A robot's driver otherwise: what the silence warning asks about.
+  bool simulated = true;
 };
 
 // What only ROS knows, handed in by the node.
