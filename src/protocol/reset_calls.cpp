@@ -10,6 +10,7 @@ namespace
 {
 constexpr double kMinGiveUpS = 5.0;
 constexpr double kMaxGiveUpS = 3600.0;
+constexpr std::chrono::seconds kOtherTypeRetryAfter(5);
 
 // now + d, or the end of time where that would overflow.
 ResetCalls::Clock::time_point later(ResetCalls::Clock::time_point now, ResetCalls::Clock::duration d)
@@ -109,7 +110,10 @@ ResetCalls::Orders ResetCalls::onReturn(std::uint64_t generation, bool answered,
   said_ = key;
   failing_ = true;
   wanted_ = true;
-  retry_at_ = later(now, retry_after_);
+  // A service of another type stays so until someone changes a node: retried less often, as each
+  // call makes its server log an error of its own (roscpp's md5sum mismatch).
+  const bool other_type = found.kind == ServiceFound::Kind::Served && key != "failed";
+  retry_at_ = later(now, other_type ? std::max<Clock::duration>(retry_after_, kOtherTypeRetryAfter) : retry_after_);
   return next(std::move(orders), now);
 }
 

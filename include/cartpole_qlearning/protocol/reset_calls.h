@@ -24,7 +24,8 @@
 //     info asks: ServiceFound). A service nobody advertises is said to be missing, one that
 //     serves another type than ~reset_service_type is named with the type it serves, as errors:
 //     no retry can make such a call work, the user has to. Each is said once while the calls
-//     fail, and again when what is found changes (the sim came up, of another type).
+//     fail, and again when what is found changes (the sim came up, of another type). A service
+//     of another type is retried every 5 s only (each call makes its server log an error).
 //   - Every call back and every give-up is an outcome (Orders::reset_done) for the protocol: a
 //     failed reset leaves the robot where it fell (lockstep_protocol.h).
 //

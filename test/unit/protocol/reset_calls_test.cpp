@@ -250,25 +250,29 @@ TEST(ResetCallsTest, AServiceOfAnotherTypeIsNamedOnceAsAnErrorWithTheParameterTo
       "~reset_service_type asks: set ~reset_service_type to cartpole_qlearning/Reset";
   Orders orders = reset.onReturn(0, false, "", ms(10), served(kType, kMd5));
   EXPECT_TRUE(says(orders, Level::Error, std::string(wrong_type) + kMeanwhile));
+  EXPECT_EQ(ms(5010), orders.wake_at) << "retried every 5 s: each call makes the server log an error";
   // Every retry finds the same: nothing more is said, the calls go on.
   for (int retry = 1; retry <= 5; ++retry)
   {
-    ASSERT_TRUE(makesCall(reset.onTime(ms(210 * retry)), 0, false));
-    EXPECT_TRUE(quiet(reset.onReturn(0, false, "", ms(210 * retry + 5), served(kType, kMd5)))) << "retry " << retry;
+    EXPECT_FALSE(reset.onTime(ms(5000 * retry + 9)).call);
+    ASSERT_TRUE(makesCall(reset.onTime(ms(5000 * retry + 10)), 0, false));
+    EXPECT_TRUE(quiet(reset.onReturn(0, false, "", ms(5000 * retry + 10), served(kType, kMd5)))) << "retry " << retry;
   }
   // What is found changes: the sim went away, then came back as it was. Each change is said.
-  ASSERT_TRUE(makesCall(reset.onTime(ms(2000)), 0, false));
-  EXPECT_TRUE(says(reset.onReturn(0, false, "", ms(2005), kMissing), Level::Error,
+  ASSERT_TRUE(makesCall(reset.onTime(ms(30010)), 0, false));
+  orders = reset.onReturn(0, false, "", ms(30015), kMissing);
+  EXPECT_EQ(ms(30215), orders.wake_at) << "a missing service may come up any moment";
+  EXPECT_TRUE(says(orders, Level::Error,
                    std::string("reset service /robot_1/cartpole_sim/reset is missing: no node advertises it. Start "
                                "the node that serves it, or set ~reset_service to the robot's reset service (\"\" "
                                "for none: a person stands the pole up)") +
                        kMeanwhile));
-  ASSERT_TRUE(makesCall(reset.onTime(ms(2300)), 0, false));
-  EXPECT_TRUE(says(reset.onReturn(0, false, "", ms(2305), served(kType, kMd5)), Level::Error,
+  ASSERT_TRUE(makesCall(reset.onTime(ms(30300)), 0, false));
+  EXPECT_TRUE(says(reset.onReturn(0, false, "", ms(30305), served(kType, kMd5)), Level::Error,
                    std::string(wrong_type) + kMeanwhile));
   // A probe that found nothing out (timed out) after it: the call's failure, a warning.
-  ASSERT_TRUE(makesCall(reset.onTime(ms(2600)), 0, false));
-  EXPECT_TRUE(says(reset.onReturn(0, false, "", ms(2605), ServiceFound()), Level::Warn,
+  ASSERT_TRUE(makesCall(reset.onTime(ms(35305)), 0, false));
+  EXPECT_TRUE(says(reset.onReturn(0, false, "", ms(35310), ServiceFound()), Level::Warn,
                    std::string("reset call to /robot_1/cartpole_sim/reset failed") + kMeanwhile));
 }
 
