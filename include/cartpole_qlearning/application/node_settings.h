@@ -51,6 +51,9 @@ struct RunSettings
   // its own or save on shutdown); a solved run's only save is the default table.
   bool run_folder = true;
   bool trace = false;  // log every update and the table at each episode end
+  // train_headless's run: what is said names its options, not the node's parameters, services and
+  // launch arguments (a command-line user has none of them).
+  bool command_line = false;
   // Where a relative training/suite is looked for, in order (the package's config/; for
   // train_headless first its --config's folder). None: a relative suite is not found.
   std::vector<std::string> suite_folders;
