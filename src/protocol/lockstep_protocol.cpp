@@ -170,7 +170,7 @@ void ControllerProtocol::onResetOutcome(bool succeeded)
   reset_failing_ = !succeeded;
   if (!succeeded && phase_ == Phase::AwaitingReset)
   {
-    // The robot stays where it fell: a repeat of its state is answered with 0 from now on.
+    // The robot stays where it fell: its new states are answered with 0 from now on.
     phase_ = Phase::WaitingForPerson;
     last_effort_ = 0.0;
   }
@@ -218,7 +218,9 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
   {
     ++counts_.repeats;
     reaction.kind = Reaction::Kind::Repeat;
-    if (phase_ == Phase::InEpisode || phase_ == Phase::WaitingForPerson)
+    // Not while a failed reset is waited on: the fallen state a lockstep sim repeats was never
+    // answered, and answering it would step the sim on, flat out, for as long as no reset works.
+    if (phase_ == Phase::InEpisode || (phase_ == Phase::WaitingForPerson && !reset_failing_))
       answer(reaction, last_effort_);
     return reaction;
   }

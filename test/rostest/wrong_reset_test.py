@@ -6,8 +6,11 @@ its reset call fails at the pole's fall. Each must:
   - say once, as an error, what it found: the type the service serves against the one asked for
     and the parameter to set, or that the service is missing, naming it (the calls are retried
     every 0.2 s meanwhile: each retry finds the same, which is not said again);
-  - count no further episode while no reset succeeds (the pole, let go, swings round and round and
-    never comes back into ~start_region), and command nothing but 0 after the fall."""
+  - count no further episode while no reset succeeds, and push no effort after the fall: each new
+    state would be answered with 0 and start an episode only inside ~start_region; a lockstep sim
+    sends none (it repeats its fallen state, which is left unanswered: the sim waits).
+What new states do after a failed reset (a pole spinning through upright) is lockstep_protocol_test's
+and robot_dispatch_test's."""
 import subprocess
 import threading
 import time
@@ -95,17 +98,14 @@ class WrongResetTest(unittest.TestCase):
         self.assertIn("~start_region", text)  # and what happens meanwhile
         with robot.lock:
             episodes = [n for _, n in robot.episodes]
-            fell_at = robot.episodes[0][0] if robot.episodes else None
         self.assertEqual([1], episodes, "%s: the first episode, and only it, before the error" % ns)
         time.sleep(WATCH)
         self.assertEqual(1, len(robot.said(words)), "%s: said more than once" % ns)
         self.assertEqual([], robot.said("failed; retrying"), "%s: the call's failure said as well" % ns)
         with robot.lock:
             self.assertEqual([1], [n for _, n in robot.episodes], "%s: episodes counted without a reset" % ns)
-            pushes = [effort for t, effort in robot.commands if t > fell_at + 0.5 and effort != 0.0]
-            answered = [t for t, _ in robot.commands if t > said_at]
+            pushes = [effort for t, effort in robot.commands if t > said_at and effort != 0.0]
         self.assertEqual([], pushes, "%s: efforts after the fall" % ns)
-        self.assertTrue(answered, "%s: the fallen robot was not commanded 0" % ns)
 
     def test_a_service_of_another_type_is_named_with_the_type_it_serves(self):
         self.check("wrong_type", WRONG_TYPE)

@@ -49,8 +49,10 @@
 //     pole up), learning nothing from the gap.
 //   - A reset that failed (onResetOutcome: the call failed, or hung and was given up) left the
 //     robot where it fell, and the reset caller retries it. Until a reset succeeds the robot is
-//     served as one without a reset service: commanded 0, and the next episode starts only on a
-//     state inside the start region, so that a spinning pole passing upright is no episode. A
+//     served as one without a reset service: each new state answered with 0, and the next
+//     episode started only on a state inside the start region, so that a spinning pole passing
+//     upright is no episode. A repeat is not answered then (a lockstep sim waits on its fallen
+//     state instead of stepping it on, flat out, for as long as no reset works). A
 //     success puts the rule above back; the reset's first state may come before its answer or
 //     after it: before it, it starts the episode when inside the start region, else it is
 //     answered with 0 and the episode starts on the next state after the answer. With resets

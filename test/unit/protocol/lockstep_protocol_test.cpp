@@ -702,7 +702,9 @@ TEST_F(ControllerProtocolTest, AfterAFailedResetSpinningStatesStartNoEpisodeUnti
   ControllerProtocol controller(session_, params_);
   controller.onState(tick(1), kUpright);
   ASSERT_TRUE(controller.onState(tick(2), kFallen).request_reset);
+  EXPECT_FALSE(controller.onState(tick(2), kFallen).answer) << "the lockstep sim's repeat of its fallen state";
   controller.onResetOutcome(false);
+  EXPECT_FALSE(controller.onState(tick(2), kFallen).answer) << "nor after the failure: the sim waits on it";
   const std::uint64_t learnt = learntSteps();
   for (std::uint64_t n = 3; n < 60; ++n)
   {
@@ -715,11 +717,11 @@ TEST_F(ControllerProtocolTest, AfterAFailedResetSpinningStatesStartNoEpisodeUnti
     EXPECT_TRUE(r.answer) << "commanded 0, as a robot without a reset service";
     EXPECT_EQ(0.0, r.effort);
   }
-  // A repeat is answered with 0 too (its first answer may have been lost).
+  // A repeat is not answered: a lockstep sim's fallen state, repeated, would be stepped on flat
+  // out for as long as no reset works.
   const Reaction repeat = controller.onState(tick(59), spinning(59));
   EXPECT_EQ(Reaction::Kind::Repeat, repeat.kind);
-  EXPECT_TRUE(repeat.answer);
-  EXPECT_EQ(0.0, repeat.effort);
+  EXPECT_FALSE(repeat.answer);
   EXPECT_EQ(1u, session_.episodesEnded());
   EXPECT_EQ(learnt, learntSteps());
   EXPECT_EQ(ControllerProtocol::Phase::WaitingForPerson, controller.phase());
@@ -805,6 +807,7 @@ TEST_F(ControllerProtocolTest, WorkingResetsAndOutcomesWithoutAResetServiceChang
   EXPECT_TRUE(robot.onState(tick(1), kUpright).episode_began);
   robot.onState(tick(2), kFallen);
   EXPECT_TRUE(robot.onState(tick(3), kFallen).answer);
+  EXPECT_TRUE(robot.onState(tick(3), kFallen).answer) << "a repeat, as a robot without a reset service has it";
   robot.onResetOutcome(true);
   EXPECT_EQ(ControllerProtocol::Phase::WaitingForPerson, robot.phase());
 }
