@@ -53,8 +53,8 @@ def table():
         ("`include/cartpole_qlearning/ros/`, `src/ros/`",
          "the ROS layer: the node classes and their mains (`*_node.cpp`), the nodelets (one class template), "
          "message conversions; installed headers only for the node classes and the conversions, the node's "
-         "helpers (command publisher, parameter server reader, reset caller, start-up and loggers, launch "
-         "control) private in `src/ros/`: "
+         "helpers (command publisher, parameter server reader, reset caller and its service probe, "
+         "start-up and loggers, launch control) private in `src/ros/`: "
          + quoted(stems("include/cartpole_qlearning/ros", "src/ros"))),
         ("`src/cli/`", "the command line: `train_headless` (the main only), its options and their rules, one file "
          "per mode and the run they share: " + quoted(stems("src/cli"))),

@@ -25,8 +25,9 @@ bool ContinuedTraining::solved() const
   return record && record->finished == "solved";
 }
 
-ContinuedTraining resumedTraining(const std::string& table_dir, const std::string& folder)
+ContinuedTraining resumedTraining(const std::string& table_dir, const std::string& given_folder)
 {
+  const std::string folder = withoutTrailingSlashes(given_folder);
   // The largest record a run writes is a few kilobytes (its solved window).
   constexpr std::size_t kMaxRecordBytes = 1 << 20;
   ContinuedTraining resumed;

@@ -114,6 +114,7 @@ RunSettingError::RunSettingError(const std::string& name_, const std::string& va
 
 LearningCurve::LearningCurve(const RunSettings& settings, RunFolder& folder, std::function<double()> unix_seconds)
   : stats_csv_(settings.stats_csv),
+    silenced_by_(settings.command_line ? "--stats-csv" : "~stats_csv"),
     table_dir_(settings.q_table_dir),
     learning_(settings.learning),
     run_folder_(settings.run_folder),
@@ -167,7 +168,7 @@ void LearningCurve::open(std::uint64_t episodes, LogLines& log)
     {
       waiting_for_folder_ = false;
       log.push_back({LogLine::Level::Error,
-                     std::string("no learning curve for this run (~stats_csv none silences this): ") + e.what()});
+                     "no learning curve for this run (" + silenced_by_ + " none silences this): " + e.what()});
       return;
     }
   }
@@ -184,7 +185,7 @@ void LearningCurve::open(std::uint64_t episodes, LogLines& log)
     if (!stats_csv_.empty())
       throw RunSettingError("stats_csv", "'" + stats_csv_ + "'", e.what());
     log.push_back({LogLine::Level::Error,
-                   std::string("no learning curve for this run (~stats_csv none silences this): ") + e.what()});
+                   "no learning curve for this run (" + silenced_by_ + " none silences this): " + e.what()});
     return;
   }
   opened_.reset();

@@ -5,6 +5,7 @@
 #include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/application/table_store.h"
 #include "cartpole_qlearning/learning/table_config.h"
+#include "cartpole_qlearning/protocol/reset_calls.h"
 
 #include <algorithm>
 #include <array>
@@ -18,6 +19,11 @@ namespace cartpole_qlearning
 namespace
 {
 constexpr std::int64_t kMaxRobots = 1000;
+
+bool endsWith(const std::string& text, const std::string& end)
+{
+  return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
+}
 
 // A value of any form as messages show it (for a key whose forms are all wrong).
 std::string anyValueText(const ParameterSource& source, const std::string& key)
@@ -350,6 +356,8 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
 
   ControllerProtocolParams& protocol = settings.protocol;
   protocol.reset_service = !settings.reset_service.empty();
+  settings.simulated = endsWith(settings.reset_service, "cartpole_sim/reset") ||
+                       endsWith(settings.reset_service, "cartpole_sim/reset_simulation");
   std::array<double, kStateDimensions> region{};
   region.fill(settings.training.start_state_bound);
   priv.readDimensions("start_region", region, false);
@@ -365,8 +373,7 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   // machine's hiccup is not a robot gone). 0 turns it off: a lockstep sim holds no command.
   settings.freshness_timeout = std::max(0.1, 5.0 * settings.robot.decision_period);
   priv.readSeconds("freshness_timeout", settings.freshness_timeout, 0.0, 10.0, false);
-  priv.readChoice("reset_service_type", settings.reset_service_type,
-                  {"cartpole_qlearning/Reset", "std_srvs/Empty", "std_srvs/Trigger"});
+  priv.readChoice("reset_service_type", settings.reset_service_type, resetServiceTypes());
   protocol.reset_starts_in_region = settings.reset_service_type != "cartpole_qlearning/Reset";
   readRobots(source, priv, context, settings.robots);
   priv.read("sync", settings.sync);

@@ -114,8 +114,11 @@ void RunApplication::Parts::loadOnStart(LogLines& log)
   }
   catch (const FileError& e)
   {
-    throw ConfigError("cannot start from the table '" + settings.load_on_start +
-                      "' (~load_on_start, which the launch files' q_table or load argument sets): " + e.what());
+    // train_headless names its option (--load or --evaluate) before the message.
+    throw ConfigError(
+        "cannot start from the table '" + settings.load_on_start + "'" +
+        (settings.command_line ? "" : " (~load_on_start, which the launch files' q_table or load argument sets)") +
+        ": " + e.what());
   }
   if (!settings.config_warning.empty())
     say(log, LogLine::Level::Warn, settings.config_warning);
@@ -156,7 +159,8 @@ std::string RunApplication::Parts::saveFinal(bool done_well, const char* finishe
   else if (!settings.q_table_path.empty())
     saved += "; the default table " + tables.resolveForService("") + " is left as it was (this run did not " +
              (config.limits.until == TrainUntil::SuitePasses ? "pass the suite" : "solve") +
-             ": ~save_q_table saves it there if you want it)";
+             (settings.command_line ? ": copy the run's table there if you want it)"
+                                    : ": ~save_q_table saves it there if you want it)");
   return saved;
 }
 
@@ -168,9 +172,11 @@ void RunApplication::Parts::endTraining(const EpisodeSummary& s, bool passed, co
   {
     // Keep the trained table alive: the user can still save it elsewhere with ~save_q_table.
     say(end.log, LogLine::Level::Error,
-        formatText("training ended (%s, episode %llu) but the table could not be saved: %s. The node keeps running: "
-                   "call ~save_q_table with another path",
-                   finished_as, count(s.episode), saved.c_str()));
+        formatText("training ended (%s, episode %llu) but the table could not be saved: %s. %s", finished_as,
+                   count(s.episode), saved.c_str(),
+                   settings.command_line ? "The same --seed trains the same table again: give --save, or the table "
+                                           "folder (ROS_HOME, --ns), a place that can be written"
+                                         : "The node keeps running: call ~save_q_table with another path"));
     return;
   }
   const bool until_suite = config.limits.until == TrainUntil::SuitePasses;

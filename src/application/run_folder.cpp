@@ -170,7 +170,7 @@ void RunFolder::selectForResume(const std::string& folder)
 {
   try
   {
-    name_ = relativePathUnder(settings_.q_table_dir, folder);
+    name_ = relativePathUnder(settings_.q_table_dir, withoutTrailingSlashes(folder));
   }
   catch (const FileError& e)
   {
@@ -203,9 +203,9 @@ RunOpening RunFolder::startNew(LogLines& log)
   catch (const FileError& e)
   {
     log.push_back({LogLine::Level::Error,
-                   formatText("cannot make this run's folder (%s): checkpoints will fail; ~save_q_table can still save "
-                              "the table elsewhere",
-                              e.what())});
+                   formatText("cannot make this run's folder (%s): checkpoints will fail; %s", e.what(),
+                              settings_.command_line ? "a solved table still goes to --save's path"
+                                                     : "~save_q_table can still save the table elsewhere")});
   }
   log.push_back({LogLine::Level::Info, formatText("run %s: checkpoints go to %s", name_.c_str(),
                                                   tables_.resolveForService(file(kRunTableFile)).c_str())});

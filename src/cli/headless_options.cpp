@@ -256,6 +256,7 @@ RunSettings headlessRunSettings(const HeadlessOptions& options, std::uint64_t se
   settings.run_folder = !options.no_run_folder;
   settings.trace = options.trace;
   settings.own_absolute_paths = true;
+  settings.command_line = true;
   // A relative training/suite: beside the config first, then the package's config/.
   const std::string config_folder = config_path.substr(0, config_path.find_last_of('/') + 1);
   settings.suite_folders = {config_folder.empty() ? "." : config_folder.substr(0, config_folder.size() - 1)};

@@ -10,7 +10,8 @@ namespace cartpole_qlearning
 {
 // Training: from scratch, from a table (--load) or on from a run folder's checkpoint (--resume),
 // ending with "solved=true|false episodes=N steps=M wall_s=T" (the session's counts: a loaded or
-// resumed table's episodes included, as the node counts them). Exit 2 when it cannot start (a bad
+// resumed table's episodes included, as the node counts them; after a stop, M is the saved table's
+// steps, the unfinished episode's included). Exit 2 when it cannot start (a bad
 // table or folder, nothing left to train), 1 when a table could not be saved.
 int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup)
 {
@@ -53,10 +54,13 @@ int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup)
     std::fprintf(stderr, "train_headless: the table was not saved to %s\n", run.application().resolve("").c_str());
     run.addError();
   }
+  // Stopped (Ctrl-C), the table saved on the way out has learnt from the unfinished episode's steps
+  // too, and the line before this one says so: steps= counts what that table counts, so that the
+  // two agree (episodes= counts finished episodes, as the table does).
+  const std::uint64_t steps = run.stopped() ? run.session().table().steps : last.total_steps;
   // Microseconds: a run to solved takes a few milliseconds.
   std::printf("solved=%s episodes=%llu steps=%llu wall_s=%.6f\n", result.solved ? "true" : "false",
-              static_cast<unsigned long long>(last.episode), static_cast<unsigned long long>(last.total_steps),
-              result.wall_s);
+              static_cast<unsigned long long>(last.episode), static_cast<unsigned long long>(steps), result.wall_s);
   return run.exitStatus();
 }
 

@@ -297,9 +297,17 @@ std::string relativePathUnder(const std::string& directory, const std::string& p
     if (relative.empty() || *relative.begin() == "..")
       refuse(path + " is outside " + base.string() + outside);
   }
-  if (relative.empty() || relative == "." || relative.filename().empty() || relative.filename() == ".")
+  if (relative.empty() || relative == ".")
     refuse(path + " names the directory " + base.string() + " itself, not a file in it");
+  if (relative.filename().empty() || relative.filename() == ".")
+    refuse(path + " ends in '/': it names a folder, not a file");
   return relative.string();
+}
+
+std::string withoutTrailingSlashes(const std::string& folder)
+{
+  const std::size_t end = folder.find_last_not_of('/');
+  return end == std::string::npos ? folder.substr(0, 1) : folder.substr(0, end + 1);
 }
 
 std::string resolvePathUnder(const std::string& directory, const std::string& path)

@@ -150,6 +150,34 @@ void ControllerProtocol::begin(Reaction& reaction, const CartPoleState& state)
   answer(reaction, session_.beginEpisode(state, params_.robot));
 }
 
+void ControllerProtocol::waitForStartRegion(Reaction& reaction, const CartPoleState& state, bool terminal)
+{
+  if (!terminal && inStartRegion(state))
+  {
+    begin(reaction, state);
+    return;
+  }
+  // Said for a robot without a reset service; a failing reset is said by the reset caller.
+  reaction.waiting_for_start = !params_.reset_service && phase_ != Phase::WaitingForPerson;
+  phase_ = Phase::WaitingForPerson;
+  answer(reaction, 0.0);
+}
+
+void ControllerProtocol::onResetOutcome(bool succeeded)
+{
+  if (!params_.reset_service)
+    return;
+  reset_failing_ = !succeeded;
+  if (!succeeded && phase_ == Phase::AwaitingReset)
+  {
+    // The robot stays where it fell: its new states are answered with 0 from now on.
+    phase_ = Phase::WaitingForPerson;
+    last_effort_ = 0.0;
+  }
+  else if (succeeded && phase_ == Phase::WaitingForPerson)
+    phase_ = Phase::AwaitingReset;  // the next state that is not fallen is the reset's start
+}
+
 bool ControllerProtocol::takesAsNew(Stamp stamp) const
 {
   if (phase_ == Phase::Finished)
@@ -190,7 +218,9 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
   {
     ++counts_.repeats;
     reaction.kind = Reaction::Kind::Repeat;
-    if (phase_ == Phase::InEpisode || phase_ == Phase::WaitingForPerson)
+    // Not while a failed reset is waited on: the fallen state a lockstep sim repeats was never
+    // answered, and answering it would step the sim on, flat out, for as long as no reset works.
+    if (phase_ == Phase::InEpisode || (phase_ == Phase::WaitingForPerson && !reset_failing_))
       answer(reaction, last_effort_);
     return reaction;
   }
@@ -234,6 +264,11 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
     case Phase::Finished:
       break;
     case Phase::AwaitingReset:
+      if (reset_failing_)
+      {
+        waitForStartRegion(reaction, state, terminal);
+        break;
+      }
       // States that come before the reset is served (realtime) are past the fall. A start drawn
       // past the fall (a start region wider than the fall's 12 degrees: config/robust.yaml's) is
       // an episode of one step, as train_headless has it; without this the lockstep sim would
@@ -246,16 +281,9 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
       break;
     case Phase::WaitingForStart:
     case Phase::WaitingForPerson:
-      if (!params_.reset_service)
+      if (!params_.reset_service || reset_failing_)
       {
-        if (!terminal && inStartRegion(state))
-        {
-          begin(reaction, state);
-          break;
-        }
-        reaction.waiting_for_start = phase_ != Phase::WaitingForPerson;
-        phase_ = Phase::WaitingForPerson;
-        answer(reaction, 0.0);
+        waitForStartRegion(reaction, state, terminal);
         break;
       }
       if (terminal && !inStartRegion(state))

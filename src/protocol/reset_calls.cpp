@@ -10,6 +10,7 @@ namespace
 {
 constexpr double kMinGiveUpS = 5.0;
 constexpr double kMaxGiveUpS = 3600.0;
+constexpr std::chrono::seconds kOtherTypeRetryAfter(5);
 
 // now + d, or the end of time where that would overflow.
 ResetCalls::Clock::time_point later(ResetCalls::Clock::time_point now, ResetCalls::Clock::duration d)
@@ -26,9 +27,54 @@ std::chrono::steady_clock::duration resetGiveUpAfter(double sim_timeout_s)
   return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
 }
 
-ResetCalls::ResetCalls(std::string service, Clock::duration give_up_after, Clock::duration retry_after)
-  : service_(std::move(service)), give_up_after_(give_up_after), retry_after_(retry_after)
+const std::vector<std::string>& resetServiceTypes()
 {
+  static const std::vector<std::string> types{"cartpole_qlearning/Reset", "std_srvs/Empty", "std_srvs/Trigger"};
+  return types;
+}
+
+ResetCalls::ResetCalls(std::string service, std::string type, std::string md5sum, Clock::duration give_up_after,
+                       Clock::duration retry_after)
+  : service_(std::move(service)),
+    type_(std::move(type)),
+    md5sum_(std::move(md5sum)),
+    give_up_after_(give_up_after),
+    retry_after_(retry_after)
+{
+}
+
+LogLine ResetCalls::failure(const std::string& message, const ServiceFound& found, std::string& key) const
+{
+  using Level = LogLine::Level;
+  // What goes on while the calls fail: said with every failure, as it is the same for each.
+  const std::string meanwhile =
+      "; retrying until it answers, and until then an episode starts only when the state is inside ~start_region";
+  if (found.kind == ServiceFound::Kind::Missing)
+  {
+    key = "missing";
+    return {Level::Error, "reset service " + service_ + " is missing: no node advertises it. Start the node that " +
+                              "serves it, or set ~reset_service to the robot's reset service (\"\" for none: a " +
+                              "person stands the pole up)" + meanwhile};
+  }
+  // "*" is what a server that takes any type answers (a relay): no type of its own to compare.
+  const bool other_md5 = !found.md5sum.empty() && found.md5sum != "*" && found.md5sum != md5sum_;
+  if (found.kind == ServiceFound::Kind::Served && (found.type != type_ || other_md5))
+  {
+    key = "serves " + found.type + " " + found.md5sum;
+    std::string text = "reset service " + service_ + " serves " + found.type;
+    if (found.type == type_)
+      text += " of another definition than this controller's (md5sum " + found.md5sum + ", not " + md5sum_ +
+              "): build both against the same " + type_;
+    else if (std::find(resetServiceTypes().begin(), resetServiceTypes().end(), found.type) != resetServiceTypes().end())
+      text += ", not " + type_ + " as ~reset_service_type asks: set ~reset_service_type to " + found.type;
+    else
+      text += ", not " + type_ + " as ~reset_service_type asks, and ~reset_service_type can only be " +
+              "cartpole_qlearning/Reset, std_srvs/Empty or std_srvs/Trigger: set ~reset_service to a service of " +
+              "one of these (\"\" for none: a person stands the pole up)";
+    return {Level::Error, text + meanwhile};
+  }
+  key = "failed";
+  return {Level::Warn, "reset call to " + service_ + " failed" + (message.empty() ? "" : ": " + message) + meanwhile};
 }
 
 ResetCalls::Orders ResetCalls::request(Clock::time_point now)
@@ -40,27 +86,34 @@ ResetCalls::Orders ResetCalls::request(Clock::time_point now)
 }
 
 ResetCalls::Orders ResetCalls::onReturn(std::uint64_t generation, bool answered, const std::string& message,
-                                        Clock::time_point now)
+                                        Clock::time_point now, const ServiceFound& found)
 {
   if (blocked_.erase(generation) > 0 || phase_ != Phase::Calling || generation != generation_)
     return next({}, now);  // a given-up call back at last: only its slot is freed
   phase_ = Phase::Idle;
   give_up_at_.reset();
   Orders orders;
+  orders.reset_done = answered;
   if (answered)
   {
     if (failing_)
       orders.log.push_back({LogLine::Level::Info, service_ + " answers again; going on"});
     failing_ = false;
+    said_.clear();
     return next(std::move(orders), now);
   }
-  if (!failing_)
-    orders.log.push_back({LogLine::Level::Warn, "reset call to " + service_ + " failed" +
-                                                    (message.empty() ? "" : ": " + message) +
-                                                    "; retrying until it answers"});
+  // Said once while the calls fail, and again when what the service turned out to be changes.
+  std::string key;
+  LogLine line = failure(message, found, key);
+  if (key != said_)
+    orders.log.push_back(std::move(line));
+  said_ = key;
   failing_ = true;
   wanted_ = true;
-  retry_at_ = later(now, retry_after_);
+  // A service of another type stays so until someone changes a node: retried less often, as each
+  // call makes its server log an error of its own (roscpp's md5sum mismatch).
+  const bool other_type = found.kind == ServiceFound::Kind::Served && key != "failed";
+  retry_at_ = later(now, other_type ? std::max<Clock::duration>(retry_after_, kOtherTypeRetryAfter) : retry_after_);
   return next(std::move(orders), now);
 }
 
@@ -82,6 +135,7 @@ ResetCalls::Orders ResetCalls::onTime(Clock::time_point now)
   }
   Orders orders;
   orders.give_up = generation_;
+  orders.reset_done = false;
   blocked_.insert(generation_++);
   phase_ = Phase::Idle;
   give_up_at_.reset();

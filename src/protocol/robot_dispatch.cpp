@@ -124,15 +124,24 @@ RobotDispatch::Orders RobotDispatch::onTick(WallClock::time_point now)
     robot.silent_reported = true;
     if (orders.stop.empty() || orders.stop.back() != r)
       orders.stop.push_back(r);
-    orders.log.push_back({LogLine::Level::Warn,
-                          formatText("no joint_states on %s for %.1f s: is the robot's driver (or its cartpole_sim) "
-                                     "running? Waiting for it",
-                                     robot.name.c_str(), params_.silent_after_s)});
+    orders.log.push_back(
+        {LogLine::Level::Warn,
+         params_.simulated
+             ? formatText("no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting for it",
+                          robot.name.c_str(), params_.silent_after_s)
+             : formatText("no joint_states on %s for %.1f s: no driver publishes them. Is the robot's driver running, "
+                          "and ~state_topic (robot.launch joint_states:=) the topic it publishes? Waiting for it",
+                          robot.name.c_str(), params_.silent_after_s)});
   }
   for (const std::size_t r : rounds_.dropOuts(now))
     orders.log.push_back(
         {LogLine::Level::Warn, robots_[r].name + " is silent; the rounds go on without it until it is back"});
   return orders;
+}
+
+void RobotDispatch::onResetOutcome(std::size_t robot, bool succeeded)
+{
+  robots_.at(robot).protocol.onResetOutcome(succeeded);
 }
 
 std::optional<RobotDispatch::Turn> RobotDispatch::next(WallClock::time_point now)

@@ -26,14 +26,8 @@ struct QLearningControllerNode::Robot
   std::unique_ptr<ResetCaller> resetter;  // none without a reset service
 };
 
-namespace
-{
-// The prefix of the node's lines: written here only.
-std::string prefixed(const LogLine& log)
-{
-  return log.prefixed ? "qlearning_controller: " + log.text : log.text;
-}
-}  // namespace
+// The prefix of the node's lines (withPrefix): written here only.
+static const char* const kPrefix = "qlearning_controller: ";
 
 QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
                                                  std::function<void()> shutdown, bool shutdown_by_default,
@@ -105,7 +99,8 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
     names.push_back(describe(robot));
   }
   const RobotDispatchParams dispatch{
-      names, settings_.sync, settings_.sim_timeout, settings_.freshness_timeout, settings_.robot, settings_.protocol};
+      names,           settings_.sync,     settings_.sim_timeout, settings_.freshness_timeout,
+      settings_.robot, settings_.protocol, settings_.simulated};
   dispatch_ = std::make_unique<RobotDispatch>(*session_, dispatch, WallClock::now());
 }
 
@@ -129,9 +124,9 @@ QLearningControllerNode::~QLearningControllerNode()
   const std::lock_guard<std::mutex> lock(mutex_);
   // ROS may be shut down already: said on the console.
   for (const LogLine& log : app_ ? app_->shutdown() : LogLines())
-    std::printf("%s\n", prefixed(log).c_str());
+    std::printf("%s\n", withPrefix(kPrefix, log).c_str());
   for (const LogLine& log : control_ ? control_->summaries() : LogLines())
-    std::printf("%s\n", prefixed(log).c_str());
+    std::printf("%s\n", withPrefix(kPrefix, log).c_str());
   // Out now: under roslaunch stdout is a pipe, and a process killed after its slow exit (a
   // loaded machine) would lose what is still buffered (seen in a new Debian 12 root: the line
   // cut after the path).
@@ -160,6 +155,9 @@ void QLearningControllerNode::onJointState(std::size_t r, const StateEvent& even
   const std::lock_guard<std::mutex> lock(mutex_);
   if (app_->finished())
     return;
+  // A reset's outcome before the state after it: it decides whether that state may start an episode.
+  for (const bool succeeded : robots_[r].resetter ? robots_[r].resetter->outcomes() : std::vector<bool>())
+    dispatch_->onResetOutcome(r, succeeded);
   const Reading<JointReadings> reading =
       readingsFromJointState(*msg, settings_.robot.cart_joint, settings_.robot.pole_joint);
   if (!reading)
@@ -343,7 +341,7 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
 void QLearningControllerNode::say(const LogLines& log) const
 {
   for (const LogLine& line : log)
-    logLine(name_, line.level, prefixed(line));
+    logLine(name_, line.level, withPrefix(kPrefix, line));
 }
 
 }  // namespace cartpole_qlearning

@@ -1,6 +1,7 @@
 #include "reset_caller.h"
 
 #include "cartpole_qlearning/Reset.h"
+#include "service_probe.h"
 
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
@@ -31,12 +32,18 @@ bool succeeded(const std_srvs::Empty::Response&, std::string&)
   return true;  // Gazebo's reset_simulation and many drivers' reset: an answer is a reset
 }
 
+// How long a failed call's probe of the service may wait for each of its steps (rosservice's own
+// is 1 s too): it holds up this robot's next retry, never the control loop.
+constexpr std::chrono::milliseconds kProbeTimeout(1000);
+
 // One call of a reset service of type Srv (ours with an empty state: a random start). Persistent:
 // on persistent_client, connected when first needed (the sim may come up after this node; a new
 // connection per episode would cost a master lookup and a TCP set-up); else on a connection of
 // its own (see ResetCalls), and the persistent link is made again once the sim answers.
+// went_through: the call itself was made (false: no server, or one that refused our type).
 template <typename Srv>
-bool callReset(ros::ServiceClient& persistent_client, const std::string& service, bool persistent, std::string& message)
+bool callReset(ros::ServiceClient& persistent_client, const std::string& service, bool persistent, std::string& message,
+               bool& went_through)
 {
   Srv srv;
   ros::ServiceClient once;
@@ -45,7 +52,15 @@ bool callReset(ros::ServiceClient& persistent_client, const std::string& service
   ros::ServiceClient& client = persistent ? persistent_client : once;
   if (!client.isValid())
     client = ros::ServiceClient(service, persistent, ros::M_string(), ros::service_traits::md5sum<Srv>());
-  return client.call(srv) && succeeded(srv.response, message);
+  went_through = client.call(srv);
+  return went_through && succeeded(srv.response, message);
+}
+
+std::string md5sumOf(const std::string& type)
+{
+  return type == "std_srvs/Empty"     ? ros::service_traits::md5sum<std_srvs::Empty>()
+         : type == "std_srvs/Trigger" ? ros::service_traits::md5sum<std_srvs::Trigger>()
+                                      : ros::service_traits::md5sum<Reset>();
 }
 }  // namespace
 
@@ -60,6 +75,7 @@ struct ResetCaller::Shared
     bool called = true;  // false: the thread was given up before it took its call
     bool answered = false;
     std::string message;
+    ServiceFound found;  // a call that did not go through: what the service turned out to be
   };
 
   std::mutex mutex;
@@ -71,6 +87,7 @@ struct ResetCaller::Shared
   std::uint64_t generation = 0;
   // A call handed to the current thread: on the persistent connection or a fresh one.
   std::optional<bool> handed;
+  std::vector<bool> outcomes;  // ResetCalls' reset_done, until outcomes() takes them
 };
 
 ResetCaller::ResetCaller(std::string service, std::string type, std::chrono::steady_clock::duration give_up_after,
@@ -78,7 +95,7 @@ ResetCaller::ResetCaller(std::string service, std::string type, std::chrono::ste
   : service_(std::move(service)),
     type_(std::move(type)),
     log_(std::move(log)),
-    calls_(service_, give_up_after),
+    calls_(service_, type_, md5sumOf(type_), give_up_after),
     shared_(std::make_shared<Shared>())
 {
   thread_ = std::thread(&ResetCaller::run, this);
@@ -103,6 +120,12 @@ void ResetCaller::request()
   shared_->changed.notify_all();
 }
 
+std::vector<bool> ResetCaller::outcomes()
+{
+  const std::lock_guard<std::mutex> lock(shared_->mutex);
+  return std::exchange(shared_->outcomes, {});
+}
+
 void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t generation, const std::string& service,
                            const std::string& type)
 {
@@ -119,7 +142,7 @@ void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t 
       if (shared->generation != generation)
       {
         // Given up before it even took its call (a starved thread): it frees its slot all the same.
-        shared->returned.push_back({generation, false, false, ""});
+        shared->returned.push_back({generation, false, false, "", {}});
         shared->changed.notify_all();
         return;
       }
@@ -129,13 +152,21 @@ void ResetCaller::callLoop(const std::shared_ptr<Shared>& shared, std::uint64_t 
       shared->handed.reset();
     }
     std::string message;
+    bool went_through = false;
     const bool answered =
-        type == "std_srvs/Empty"     ? callReset<std_srvs::Empty>(persistent_client, service, persistent, message)
-        : type == "std_srvs/Trigger" ? callReset<std_srvs::Trigger>(persistent_client, service, persistent, message)
-                                     : callReset<Reset>(persistent_client, service, persistent, message);
+        type == "std_srvs/Empty"
+            ? callReset<std_srvs::Empty>(persistent_client, service, persistent, message, went_through)
+        : type == "std_srvs/Trigger"
+            ? callReset<std_srvs::Trigger>(persistent_client, service, persistent, message, went_through)
+            : callReset<Reset>(persistent_client, service, persistent, message, went_through);
+    // A call that did not go through: is the service missing, or of another type? Asked here, on
+    // this robot's calling thread, with a timeout of its own.
+    ServiceFound found;
+    if (!went_through && ros::ok())
+      found = probeService(service, ros::this_node::getName(), kProbeTimeout);
     {
       std::lock_guard<std::mutex> lock(shared->mutex);
-      shared->returned.push_back({generation, true, answered, message});
+      shared->returned.push_back({generation, true, answered, message, found});
       shared->changed.notify_all();
       if (shared->generation != generation || shared->stopping)
         return;
@@ -155,7 +186,7 @@ void ResetCaller::run()
       shared_->changed.wait_until(lock, wake_at_, woken);
     const auto now = ResetCalls::Clock::now();
     for (const Shared::Returned& back : std::exchange(shared_->returned, {}))
-      carryOut(back.called ? calls_.onReturn(back.generation, back.answered, back.message, now)
+      carryOut(back.called ? calls_.onReturn(back.generation, back.answered, back.message, now, back.found)
                            : calls_.onThreadEnded(back.generation, now));
     if (shared_->stopping)
       break;
@@ -186,6 +217,8 @@ void ResetCaller::carryOut(const ResetCalls::Orders& orders)
   if (orders.give_up || orders.call)
     shared_->changed.notify_all();
   wake_at_ = orders.wake_at;
+  if (orders.reset_done)
+    shared_->outcomes.push_back(*orders.reset_done);
 }
 
 }  // namespace cartpole_qlearning

@@ -10,6 +10,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace cartpole_qlearning
 {
@@ -37,6 +38,9 @@ public:
 
   // A request made while a call is under way is served by the next call, not lost.
   void request();
+  // The requests' outcomes since the last look, in order: true, the robot was reset; false, a call
+  // failed or was given up (for RobotDispatch::onResetOutcome).
+  std::vector<bool> outcomes();
 
 private:
   struct Shared;

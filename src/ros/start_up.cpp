@@ -43,6 +43,11 @@ void logLine(const std::string& logger, ros::console::Level level, const std::st
     ros::console::print(nullptr, place->logger_, place->level_, __FILE__, __LINE__, __func__, "%s", text.c_str());
 }
 
+std::string withPrefix(const std::string& prefix, const LogLine& line)
+{
+  return line.prefixed ? prefix + line.text : line.text;
+}
+
 void logLine(const std::string& logger, LogLine::Level level, const std::string& text)
 {
   static const ros::console::Level kLevels[] = {ros::console::levels::Info, ros::console::levels::Warn,

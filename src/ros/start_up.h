@@ -22,6 +22,8 @@ std::string nodeLogger(const std::string& type, const std::string& node_name);
 // sim in the same manager would log on the first one's), every logger name gets its own place.
 void logLine(const std::string& logger, ros::console::Level level, const std::string& text);
 void logLine(const std::string& logger, LogLine::Level level, const std::string& text);
+// A line's text as the node says it: after the node's prefix unless the line asks for none.
+std::string withPrefix(const std::string& prefix, const LogLine& line);
 
 // Runs start() (which constructs the node class) and returns true. When it throws (a bad
 // parameter, an unusable table file), logs the reason as FATAL, "type: reason", on the logger

@@ -612,6 +612,39 @@ TEST_F(TrainHeadlessTest, BadArgumentsAreRefusedNamingThem)
     EXPECT_NE(std::string::npos, help.output.find(option)) << help.output;
 }
 
+// A command-line user has no node parameters, services or launch files: what train_headless says
+// names its own options.
+TEST_F(TrainHeadlessTest, ItsMessagesNameItsOptionsNotTheNodesParametersOrLaunchArguments)
+{
+  const CommandRun load = trainHeadless(config() + " --load missing.yaml");
+  EXPECT_EQ(2, load.status) << load.output;
+  EXPECT_NE(std::string::npos,
+            load.output.find("train_headless: --load missing.yaml: cannot start from the table 'missing.yaml': "))
+      << load.output;
+
+  const std::string mine = file("mine.yaml", "the user's own table\n");
+  const CommandRun unsolved = trainHeadless(config() + " --seed 0 --max-episodes 5 --save " + mine);
+  EXPECT_NE(std::string::npos, unsolved.output.find(" is left as it was (this run did not solve: copy the run's "
+                                                    "table there if you want it)"))
+      << unsolved.output;
+
+  // A file where the run folders go: no folder, no curve, and the run's table cannot be saved.
+  fs::remove_all(tables() / "runs");
+  std::ofstream(tables() / "runs") << "not a folder\n";
+  const CommandRun no_folder = trainHeadless(config() + " --seed 0 --max-episodes 5");
+  EXPECT_EQ(1, no_folder.status) << no_folder.output;
+  for (const std::string said : {"checkpoints will fail; a solved table still goes to --save's path",
+                                 "(--stats-csv none silences this)", "but the table could not be saved: ",
+                                 ". The same --seed trains the same table again: give --save, or the "
+                                 "table folder (ROS_HOME, --ns), a place that can be written"})
+    EXPECT_NE(std::string::npos, no_folder.output.find(said)) << said << "\n" << no_folder.output;
+
+  for (const CommandRun* run : {&load, &unsolved, &no_folder})
+    for (const std::string node_word :
+         {"~load_on_start", "~save_q_table", "~stats_csv", "launch", "argument", "The node keeps running"})
+      EXPECT_EQ(std::string::npos, run->output.find(node_word)) << node_word << "\n" << run->output;
+}
+
 // A run stopped by a signal, then resumed: SIGINT saves into the run's folder on the way out (as
 // the controller's shutdown does); SIGKILL leaves the last checkpoint. --resume goes on from
 // what is there: the episode numbers, the steps and the curve carry on, no episode twice.
@@ -663,17 +696,23 @@ TEST_P(TrainHeadlessStopTest, AStoppedRunGoesOnWithResume)
     ASSERT_TRUE(WIFEXITED(status)) << output;
     EXPECT_EQ(record.episodes, checkpoint.episodes);
     EXPECT_EQ(128 + signal, WEXITSTATUS(status)) << output;
-    EXPECT_NE(std::string::npos, output.find("on shutdown: saved " + std::to_string(record.episodes) + " episodes"))
+    // The last two lines agree: the saved table's episodes and steps (an unfinished episode's
+    // steps, learnt from, included).
+    const std::string counts =
+        "episodes=" + std::to_string(checkpoint.episodes) + " steps=" + std::to_string(checkpoint.steps) + " ";
+    EXPECT_NE(std::string::npos, output.find("on shutdown: saved " + std::to_string(checkpoint.episodes) +
+                                             " episodes, " + std::to_string(checkpoint.steps) + " steps"))
         << output;
     // Saved where it stopped: every episode in the curve is in the table.
     EXPECT_EQ(record.episodes, curveEpisodes(curve).back());
     const CommandRun as_run{0, output};
-    EXPECT_EQ(0u, as_run.lastLine().find("solved=")) << output;
+    EXPECT_TRUE(text_match::matchesWhole(as_run.lastLine(), "solved=(true|false) " + counts + "wall_s=.*")) << output;
   }
 
+  // Resumed as tab completion gives the folder, a slash at its end.
   const std::uint64_t until = checkpoint.episodes + 30;
   const CommandRun resumed =
-      trainHeadless(endlessConfig() + " --resume " + folder + " --max-episodes " + std::to_string(until));
+      trainHeadless(endlessConfig() + " --resume " + folder + "/ --max-episodes " + std::to_string(until));
   ASSERT_EQ(0, resumed.status) << resumed.output;
   EXPECT_NE(std::string::npos, resumed.output.find("run " + folder + " goes on from its checkpoint: episode " +
                                                    std::to_string(checkpoint.episodes) + ", " +

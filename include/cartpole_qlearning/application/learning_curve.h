@@ -97,6 +97,7 @@ private:
   void open(std::uint64_t episodes, LogLines& log);
 
   std::string stats_csv_;
+  std::string silenced_by_;  // the setting whose "none" asks for no curve, as the user names it
   std::string table_dir_;
   bool learning_;
   bool run_folder_;

@@ -66,6 +66,9 @@ struct RunSettings
   // its own or save on shutdown); a solved run's only save is the default table.
   bool run_folder = true;
   bool trace = false;  // log every update and the table at each episode end
+  // train_headless's run: what is said names its options, not the node's parameters, services and
+  // launch arguments (a command-line user has none of them).
+  bool command_line = false;
   // Where a relative training/suite is looked for, in order (the package's config/; for
   // train_headless first its --config's folder). None: a relative suite is not found.
   std::vector<std::string> suite_folders;
@@ -86,6 +89,9 @@ struct ControllerSettings
   RobotInterfaceParams robot;                        // joints, offsets, command type, decision period
   // ~reset_service_type: what ~reset_service is
   std::string reset_service_type = "cartpole_qlearning/Reset";
+  // The robots are cartpole_sims: ~reset_service is a cartpole_sim's (reset or reset_simulation).
+  // A robot's driver otherwise: what the silence warning asks about.
+  bool simulated = true;
 };
 
 // What only ROS knows, handed in by the node.

@@ -40,6 +40,10 @@ std::string expandHome(const std::string& path, const std::string& home);
 // it are fine). Throws FileError. Touches no file.
 std::string relativePathUnder(const std::string& directory, const std::string& path);
 
+// A folder's path without the trailing slashes tab completion adds ("runs/x/" -> "runs/x"; "/"
+// stays): the same folder, for the paths joined to it and for relativePathUnder.
+std::string withoutTrailingSlashes(const std::string& folder);
+
 // relativePathUnder, joined to the directory's absolute form: what messages show.
 std::string resolvePathUnder(const std::string& directory, const std::string& path);
 

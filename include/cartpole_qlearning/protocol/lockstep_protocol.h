@@ -47,6 +47,16 @@
 //     stepping until the reset is served). Without one (a real robot), it commands zero and
 //     starts the next episode on the first state inside the start region (a person stood the
 //     pole up), learning nothing from the gap.
+//   - A reset that failed (onResetOutcome: the call failed, or hung and was given up) left the
+//     robot where it fell, and the reset caller retries it. Until a reset succeeds the robot is
+//     served as one without a reset service: each new state answered with 0, and the next
+//     episode started only on a state inside the start region, so that a spinning pole passing
+//     upright is no episode. A repeat is not answered then (a lockstep sim waits on its fallen
+//     state instead of stepping it on, flat out, for as long as no reset works). A
+//     success puts the rule above back; the reset's first state may come before its answer or
+//     after it: before it, it starts the episode when inside the start region, else it is
+//     answered with 0 and the episode starts on the next state after the answer. With resets
+//     that work, nothing of this happens: the normal path is as it was.
 //   - A first state that is terminal (joining a sim that waits on a fallen pole) asks for a
 //     reset without learning.
 //   - Training ends after the episode that reaches the limits (solved or max_episodes); every
@@ -207,7 +217,8 @@ public:
     WaitingForStart,   // no episode runs: the next usable new state starts one
     InEpisode,         // answering states, learning from each new one
     AwaitingReset,     // the episode ended and a reset was asked for
-    WaitingForPerson,  // no reset service: commanding 0 until the state is in the start region
+    WaitingForPerson,  // no reset service, or a failed reset: commanding 0 until the state is in
+                       // the start region
     Finished           // training reached its limits
   };
 
@@ -225,6 +236,9 @@ public:
   ControllerProtocol(TrainingSession& session, const ControllerProtocolParams& params);
 
   Reaction onState(Stamp stamp, const CartPoleState& state);
+  // A reset asked for (request_reset) came back: succeeded, or failed (not served, or given up);
+  // the reset caller retries a failed one until it succeeds.
+  void onResetOutcome(bool succeeded);
   // Whether onState would take a state with this stamp as new (and so may learn and draw from
   // the exploration stream). A learner serving several robots in rounds holds such a state
   // back until every robot has one; any other it passes on at once (a repeat is answered, a
@@ -244,6 +258,8 @@ private:
   Reaction onNewState(Reaction reaction, const CartPoleState& state);
   void begin(Reaction& reaction, const CartPoleState& state);
   void answer(Reaction& reaction, double effort);
+  // No reset to count on: begins on a state inside the start region, else commands 0.
+  void waitForStartRegion(Reaction& reaction, const CartPoleState& state, bool terminal);
   bool inStartRegion(const CartPoleState& state) const;
 
   TrainingSession& session_;
@@ -256,6 +272,7 @@ private:
   static constexpr int kTimeSetBack = 3;
   int older_run_ = 0;  // older states in a row, each newer than the one before
   double last_effort_ = 0.0;
+  bool reset_failing_ = false;  // the last reset failed, none has succeeded since
   Counts counts_;
 };
 

@@ -38,6 +38,9 @@ struct RobotDispatchParams
   double freshness_timeout_s = 0.0;   // ~freshness_timeout [s]: efforts only this long after a fresh state (0: off)
   RobotInterfaceParams robot;         // the readings' mapping and ~decision_period (every robot alike)
   ControllerProtocolParams protocol;  // every robot's (the index is set per robot)
+  // The robots are cartpole_sims (their reset service is a cartpole_sim's): what the silence
+  // warning asks about; else a robot's driver.
+  bool simulated = true;
 };
 
 class RobotDispatch
@@ -80,6 +83,9 @@ public:
   Orders onInvalid(std::size_t robot, Stamp stamp, WallClock::time_point now, const std::string& publisher = "");
   // The watchdog's tick: silent robots (reported once each until heard again) and drop-outs.
   Orders onTick(WallClock::time_point now);
+  // A reset of `robot` asked for by a Turn's request_reset came back: succeeded or failed (its
+  // ResetCalls' reset_done). Fed before the states that arrive after it.
+  void onResetOutcome(std::size_t robot, bool succeeded);
   // The next state to serve, or none: a state taken at once, else every state of a complete
   // round, in robot order. Call until none (or until the run is over) after every event.
   std::optional<Turn> next(WallClock::time_point now);

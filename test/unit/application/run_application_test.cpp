@@ -233,6 +233,26 @@ TEST_F(RunApplicationTest, AFolderThatCannotBeMadeIsSaidAtTheStart)
   EXPECT_NE(std::string::npos, error.text.find("checkpoints will fail; ~save_q_table can still save the table"));
 }
 
+TEST_F(RunApplicationTest, TrainHeadlessRunsNameItsOptionsNotTheNodesParameters)
+{
+  settings_.command_line = true;
+  std::ofstream(dir_ / "runs") << "not a folder";
+  Run run = startRun();
+  EXPECT_NE(std::string::npos, log(run.started, "cannot make this run's folder")
+                                   .text.find("checkpoints will fail; a solved table still goes to --save's path"));
+  settings_.load_on_start = "missing.yaml";
+  try
+  {
+    startRun();
+    ADD_FAILURE() << "a missing table loaded";
+  }
+  catch (const ConfigError& e)
+  {
+    // train_headless names the option (--load missing.yaml: ...) before it.
+    EXPECT_EQ(0u, std::string(e.what()).rfind("cannot start from the table 'missing.yaml': ", 0)) << e.what();
+  }
+}
+
 TEST_F(RunApplicationTest, NothingIsWrittenWithoutCheckpointsAndShutdownSaveUntilTheFirstEpisode)
 {
   settings_.checkpoint_every = 0;

@@ -75,6 +75,26 @@ TEST_F(FileAccessTest, RelativePathsResolveUnderTheDirectory)
   EXPECT_EQ("runs/q.yaml", relativePathUnder(tables_, base + "/runs/q.yaml"));
 }
 
+TEST_F(FileAccessTest, AFileWithATrailingSlashIsSaidToNameAFolderAndAFoldersSlashesGo)
+{
+  try
+  {
+    relativePathUnder(tables_, "runs/x/");
+    ADD_FAILURE() << "a trailing slash taken for a file";
+  }
+  catch (const FileError& e)
+  {
+    EXPECT_EQ("runs/x/ ends in '/': it names a folder, not a file", std::string(e.what()));
+  }
+  // Tab completion's slashes, on a folder: the same folder.
+  EXPECT_EQ("runs/x", withoutTrailingSlashes("runs/x/"));
+  EXPECT_EQ("runs/x", withoutTrailingSlashes("runs/x//"));
+  EXPECT_EQ("runs/x", withoutTrailingSlashes("runs/x"));
+  EXPECT_EQ("/", withoutTrailingSlashes("/"));
+  EXPECT_EQ("/", withoutTrailingSlashes("//"));
+  EXPECT_EQ("", withoutTrailingSlashes(""));
+}
+
 // roslaunch passes q_table_dir:=~/tables on as it is: the nodes expand "~" as a shell would.
 TEST(ExpandHome, ATildeAloneOrFollowedByASlashIsTheHome)
 {

@@ -690,6 +690,128 @@ TEST_F(ControllerProtocolTest, AfterAResetThatSaysNothingTheEpisodeStartsInsideT
   EXPECT_EQ(ControllerProtocol::Phase::InEpisode, controller.phase());
 }
 
+// A pole spinning round after a fall: it passes upright (not fallen by the task's thresholds)
+// fast, so never inside the start region.
+CartPoleState spinning(std::uint64_t n)
+{
+  return CartPoleState(0.02, 0.01, n % 3 == 0 ? 0.0 : (n % 3 == 1 ? 0.15 : 2.5), 9.0);
+}
+
+TEST_F(ControllerProtocolTest, AfterAFailedResetSpinningStatesStartNoEpisodeUntilTheStateIsInTheStartRegion)
+{
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(1), kUpright);
+  ASSERT_TRUE(controller.onState(tick(2), kFallen).request_reset);
+  EXPECT_FALSE(controller.onState(tick(2), kFallen).answer) << "the lockstep sim's repeat of its fallen state";
+  controller.onResetOutcome(false);
+  EXPECT_FALSE(controller.onState(tick(2), kFallen).answer) << "nor after the failure: the sim waits on it";
+  const std::uint64_t learnt = learntSteps();
+  for (std::uint64_t n = 3; n < 60; ++n)
+  {
+    const Reaction r = controller.onState(tick(n), spinning(n));
+    EXPECT_EQ(Reaction::Kind::New, r.kind);
+    EXPECT_FALSE(r.episode_began) << n;
+    EXPECT_FALSE(r.learned);
+    EXPECT_FALSE(r.request_reset) << "the reset caller retries the one asked for";
+    EXPECT_FALSE(r.waiting_for_start) << "said by the reset caller, not as a robot without a reset service";
+    EXPECT_TRUE(r.answer) << "commanded 0, as a robot without a reset service";
+    EXPECT_EQ(0.0, r.effort);
+  }
+  // A repeat is not answered: a lockstep sim's fallen state, repeated, would be stepped on flat
+  // out for as long as no reset works.
+  const Reaction repeat = controller.onState(tick(59), spinning(59));
+  EXPECT_EQ(Reaction::Kind::Repeat, repeat.kind);
+  EXPECT_FALSE(repeat.answer);
+  EXPECT_EQ(1u, session_.episodesEnded());
+  EXPECT_EQ(learnt, learntSteps());
+  EXPECT_EQ(ControllerProtocol::Phase::WaitingForPerson, controller.phase());
+
+  // Back inside the start region (stood up by hand): an episode as without a reset service.
+  const Reaction start = controller.onState(tick(60), kSmall);
+  EXPECT_TRUE(start.episode_began);
+  EXPECT_TRUE(start.answer);
+  // Its end asks for a reset again; while none has succeeded, the same rule holds.
+  ASSERT_TRUE(controller.onState(tick(61), kFallen).request_reset);
+  EXPECT_EQ(2u, session_.episodesEnded());
+  EXPECT_FALSE(controller.onState(tick(62), spinning(0)).episode_began);
+  EXPECT_FALSE(controller.onState(tick(63), kLeaning).episode_began) << "not fallen, but outside the region";
+  EXPECT_TRUE(controller.onState(tick(64), kUpright).episode_began);
+}
+
+TEST_F(ControllerProtocolTest, AResetThatFailsThenSucceedsStartsTheEpisodeOnTheResetsState)
+{
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(1), kUpright);
+  ASSERT_TRUE(controller.onState(tick(2), kFallen).request_reset);
+  controller.onResetOutcome(false);
+  EXPECT_FALSE(controller.onState(tick(3), spinning(3)).episode_began);
+  EXPECT_FALSE(controller.onState(tick(4), kLeaning).episode_began);
+  // The retry succeeds, and its answer comes first: the rule of a working reset is back, a state
+  // that is not fallen starts the episode (a start outside a narrow start region included).
+  controller.onResetOutcome(true);
+  EXPECT_EQ(ControllerProtocol::Phase::AwaitingReset, controller.phase());
+  const Reaction fallen = controller.onState(tick(5), kFallen);
+  EXPECT_FALSE(fallen.episode_began) << "a fallen state still in flight";
+  EXPECT_FALSE(fallen.answer);
+  const Reaction start = controller.onState(tick(6), kLeaning);
+  EXPECT_TRUE(start.episode_began);
+  EXPECT_TRUE(start.answer);
+  EXPECT_EQ(1u, session_.episodesEnded());
+}
+
+TEST_F(ControllerProtocolTest, AResetsStateBeforeItsSuccessfulAnswerStartsTheEpisodeEitherWay)
+{
+  // The retry's reset publishes its state before its answer comes back. Inside the start region:
+  // the episode starts on it, and the answer after it changes nothing.
+  {
+    TrainingSession session(config_.task, config_.agent, 0);
+    ControllerProtocol controller(session, params_);
+    controller.onState(tick(1), kUpright);
+    controller.onState(tick(2), kFallen);
+    controller.onResetOutcome(false);
+    EXPECT_TRUE(controller.onState(tick(3), kSmall).episode_began);
+    controller.onResetOutcome(true);
+    EXPECT_EQ(ControllerProtocol::Phase::InEpisode, controller.phase());
+    EXPECT_TRUE(controller.onState(tick(4), kSmall).learned);
+  }
+  // Outside it (a sim drawing starts wider than ~start_region): answered with 0, and the state
+  // after the answer starts the episode.
+  {
+    TrainingSession session(config_.task, config_.agent, 0);
+    ControllerProtocol controller(session, params_);
+    controller.onState(tick(1), kUpright);
+    controller.onState(tick(2), kFallen);
+    controller.onResetOutcome(false);
+    const Reaction early = controller.onState(tick(3), kLeaning);
+    EXPECT_FALSE(early.episode_began);
+    EXPECT_TRUE(early.answer);
+    EXPECT_EQ(0.0, early.effort);
+    controller.onResetOutcome(true);
+    EXPECT_TRUE(controller.onState(tick(4), kLeaning).episode_began);
+  }
+}
+
+TEST_F(ControllerProtocolTest, WorkingResetsAndOutcomesWithoutAResetServiceChangeNothing)
+{
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(1), kUpright);
+  ASSERT_TRUE(controller.onState(tick(2), kFallen).request_reset);
+  controller.onResetOutcome(true);
+  EXPECT_FALSE(controller.onState(tick(2), kFallen).answer) << "a repeat while awaiting the reset";
+  EXPECT_TRUE(controller.onState(tick(3), kLeaning).episode_began);
+
+  params_.reset_service = false;
+  TrainingSession session(config_.task, config_.agent, 0);
+  ControllerProtocol robot(session, params_);
+  robot.onResetOutcome(false);
+  EXPECT_TRUE(robot.onState(tick(1), kUpright).episode_began);
+  robot.onState(tick(2), kFallen);
+  EXPECT_TRUE(robot.onState(tick(3), kFallen).answer);
+  EXPECT_TRUE(robot.onState(tick(3), kFallen).answer) << "a repeat, as a robot without a reset service has it";
+  robot.onResetOutcome(true);
+  EXPECT_EQ(ControllerProtocol::Phase::WaitingForPerson, robot.phase());
+}
+
 TEST_F(ControllerProtocolTest, AFirstStateThatIsTerminalRequestsAResetWithoutLearning)
 {
   ControllerProtocol controller(session_, params_);

@@ -16,6 +16,11 @@ using Level = LogLine::Level;
 namespace
 {
 const std::string kService = "/robot_1/cartpole_sim/reset";
+// The type the calls are made with, and its md5sum (any text: only equality counts).
+const std::string kType = "cartpole_qlearning/Reset";
+const std::string kMd5 = "reset-md5";
+const char* const kMeanwhile =
+    "; retrying until it answers, and until then an episode starts only when the state is inside ~start_region";
 const ResetCalls::Clock::duration kGiveUpAfter = std::chrono::seconds(5);
 const ResetCalls::Clock::time_point kNever = ResetCalls::Clock::time_point::max();
 const char* const kGivenUp =
@@ -30,7 +35,7 @@ ResetCalls::Clock::time_point ms(std::int64_t n)
 
 ResetCalls resetCalls()
 {
-  return ResetCalls(kService, kGiveUpAfter);
+  return ResetCalls(kService, kType, kMd5, kGiveUpAfter);
 }
 
 // Nothing to do: no call, no give-up, nothing said.
@@ -101,7 +106,7 @@ TEST(ResetCallsTest, AFailingRobotIsRetriedEvery200MsOnFreshConnectionsUntilItAn
   ASSERT_TRUE(makesCall(reset.request(ms(0)), 0, true));
   Orders orders = reset.onReturn(0, false, "no state yet", ms(10));
   EXPECT_TRUE(says(orders, Level::Warn,
-                   "reset call to /robot_1/cartpole_sim/reset failed: no state yet; retrying until it answers"));
+                   std::string("reset call to /robot_1/cartpole_sim/reset failed: no state yet") + kMeanwhile));
   EXPECT_FALSE(orders.call) << "retried in a tight loop";
   EXPECT_EQ(ms(210), orders.wake_at);
   EXPECT_TRUE(quiet(reset.onTime(ms(209))));
@@ -121,7 +126,7 @@ TEST(ResetCallsTest, AFailingRobotIsRetriedEvery200MsOnFreshConnectionsUntilItAn
 
   // Failing again later is said again, and a failure without a message says none.
   EXPECT_TRUE(says(reset.onReturn(0, false, "", ms(450)), Level::Warn,
-                   "reset call to /robot_1/cartpole_sim/reset failed; retrying until it answers"));
+                   std::string("reset call to /robot_1/cartpole_sim/reset failed") + kMeanwhile));
 }
 
 TEST(ResetCallsTest, AHungCallIsGivenUpAtTheGiveUpTimeAndRetriedOnANewThread)
@@ -228,6 +233,121 @@ TEST(ResetCallsTest, StopWithoutACallUnderWayGivesNothingUp)
   EXPECT_TRUE(quiet(reset.onTime(ms(1000))));
 }
 
+ServiceFound served(const std::string& type, const std::string& md5sum)
+{
+  return {ServiceFound::Kind::Served, type, md5sum};
+}
+
+const ServiceFound kMissing{ServiceFound::Kind::Missing, "", ""};
+
+TEST(ResetCallsTest, AServiceOfAnotherTypeIsNamedOnceAsAnErrorWithTheParameterToSet)
+{
+  // Told std_srvs/Trigger; the sim serves cartpole_qlearning/Reset.
+  ResetCalls reset(kService, "std_srvs/Trigger", "trigger-md5", kGiveUpAfter);
+  ASSERT_TRUE(makesCall(reset.request(ms(0)), 0, true));
+  const char* const wrong_type =
+      "reset service /robot_1/cartpole_sim/reset serves cartpole_qlearning/Reset, not std_srvs/Trigger as "
+      "~reset_service_type asks: set ~reset_service_type to cartpole_qlearning/Reset";
+  Orders orders = reset.onReturn(0, false, "", ms(10), served(kType, kMd5));
+  EXPECT_TRUE(says(orders, Level::Error, std::string(wrong_type) + kMeanwhile));
+  EXPECT_EQ(ms(5010), orders.wake_at) << "retried every 5 s: each call makes the server log an error";
+  // Every retry finds the same: nothing more is said, the calls go on.
+  for (int retry = 1; retry <= 5; ++retry)
+  {
+    EXPECT_FALSE(reset.onTime(ms(5000 * retry + 9)).call);
+    ASSERT_TRUE(makesCall(reset.onTime(ms(5000 * retry + 10)), 0, false));
+    EXPECT_TRUE(quiet(reset.onReturn(0, false, "", ms(5000 * retry + 10), served(kType, kMd5)))) << "retry " << retry;
+  }
+  // What is found changes: the sim went away, then came back as it was. Each change is said.
+  ASSERT_TRUE(makesCall(reset.onTime(ms(30010)), 0, false));
+  orders = reset.onReturn(0, false, "", ms(30015), kMissing);
+  EXPECT_EQ(ms(30215), orders.wake_at) << "a missing service may come up any moment";
+  EXPECT_TRUE(says(orders, Level::Error,
+                   std::string("reset service /robot_1/cartpole_sim/reset is missing: no node advertises it. Start "
+                               "the node that serves it, or set ~reset_service to the robot's reset service (\"\" "
+                               "for none: a person stands the pole up)") +
+                       kMeanwhile));
+  ASSERT_TRUE(makesCall(reset.onTime(ms(30300)), 0, false));
+  EXPECT_TRUE(says(reset.onReturn(0, false, "", ms(30305), served(kType, kMd5)), Level::Error,
+                   std::string(wrong_type) + kMeanwhile));
+  // A probe that found nothing out (timed out) after it: the call's failure, a warning.
+  ASSERT_TRUE(makesCall(reset.onTime(ms(35305)), 0, false));
+  EXPECT_TRUE(says(reset.onReturn(0, false, "", ms(35310), ServiceFound()), Level::Warn,
+                   std::string("reset call to /robot_1/cartpole_sim/reset failed") + kMeanwhile));
+}
+
+TEST(ResetCallsTest, AServiceNobodyServesIsSaidToBeMissingOnceUntilItAnswers)
+{
+  ResetCalls reset = resetCalls();
+  ASSERT_TRUE(makesCall(reset.request(ms(0)), 0, true));
+  Orders orders = reset.onReturn(0, false, "", ms(10), kMissing);
+  ASSERT_EQ(1u, orders.log.size());
+  EXPECT_EQ(Level::Error, orders.log[0].level);
+  EXPECT_NE(std::string::npos, orders.log[0].text.find("/robot_1/cartpole_sim/reset is missing")) << orders.log[0].text;
+  ASSERT_TRUE(makesCall(reset.onTime(ms(210)), 0, false));
+  EXPECT_TRUE(quiet(reset.onReturn(0, false, "", ms(215), kMissing)));
+  // The sim comes up: the answer is said, and a later failure of the same kind is said again.
+  ASSERT_TRUE(makesCall(reset.onTime(ms(420)), 0, false));
+  EXPECT_TRUE(says(reset.onReturn(0, true, "", ms(425)), Level::Info, kAnswersAgain));
+  ASSERT_TRUE(makesCall(reset.request(ms(500)), 0, true));
+  EXPECT_EQ(1u, reset.onReturn(0, false, "", ms(505), kMissing).log.size());
+}
+
+TEST(ResetCallsTest, AServiceOfATypeNoResetCanBeIsNamedWithTheTypesThatCan)
+{
+  ResetCalls reset = resetCalls();
+  ASSERT_TRUE(makesCall(reset.request(ms(0)), 0, true));
+  EXPECT_TRUE(says(reset.onReturn(0, false, "", ms(10), served("std_srvs/SetBool", "setbool-md5")), Level::Error,
+                   std::string("reset service /robot_1/cartpole_sim/reset serves std_srvs/SetBool, not "
+                               "cartpole_qlearning/Reset as ~reset_service_type asks, and ~reset_service_type can "
+                               "only be cartpole_qlearning/Reset, std_srvs/Empty or std_srvs/Trigger: set "
+                               "~reset_service to a service of one of these (\"\" for none: a person stands the pole "
+                               "up)") +
+                       kMeanwhile));
+}
+
+TEST(ResetCallsTest, AServiceOfTheSameTypeButAnotherDefinitionIsNamedByItsMd5sum)
+{
+  ResetCalls reset = resetCalls();
+  ASSERT_TRUE(makesCall(reset.request(ms(0)), 0, true));
+  EXPECT_TRUE(says(reset.onReturn(0, false, "", ms(10), served(kType, "older-md5")), Level::Error,
+                   std::string("reset service /robot_1/cartpole_sim/reset serves cartpole_qlearning/Reset of another "
+                               "definition than this controller's (md5sum older-md5, not reset-md5): build both "
+                               "against the same cartpole_qlearning/Reset") +
+                       kMeanwhile));
+  // A service of the type asked for, whose call still fails (success false): the call's failure.
+  ResetCalls other = resetCalls();
+  ASSERT_TRUE(makesCall(other.request(ms(0)), 0, true));
+  EXPECT_TRUE(says(other.onReturn(0, false, "busy", ms(10), served(kType, kMd5)), Level::Warn,
+                   std::string("reset call to /robot_1/cartpole_sim/reset failed: busy") + kMeanwhile));
+}
+
+TEST(ResetCallsTest, EveryCallBackAndGiveUpIsAnOutcomeForTheProtocol)
+{
+  ResetCalls reset = resetCalls();
+  Orders orders = reset.request(ms(0));
+  EXPECT_FALSE(orders.reset_done) << "a call made is no outcome";
+  orders = reset.onReturn(0, true, "", ms(10));
+  ASSERT_TRUE(orders.reset_done);
+  EXPECT_TRUE(*orders.reset_done);
+  reset.request(ms(20));
+  orders = reset.onReturn(0, false, "", ms(30), kMissing);
+  ASSERT_TRUE(orders.reset_done);
+  EXPECT_FALSE(*orders.reset_done);
+  EXPECT_FALSE(reset.onTime(ms(100)).reset_done) << "waiting for the retry";
+  ASSERT_TRUE(makesCall(reset.onTime(ms(230)), 0, false));
+  orders = reset.onTime(ms(5230));  // hung: given up
+  ASSERT_TRUE(orders.give_up);
+  ASSERT_TRUE(orders.reset_done);
+  EXPECT_FALSE(*orders.reset_done);
+  EXPECT_FALSE(reset.onReturn(0, true, "", ms(5240)).reset_done) << "a given-up call back late";
+  orders = reset.onReturn(1, true, "", ms(5250));
+  ASSERT_TRUE(orders.reset_done);
+  EXPECT_TRUE(*orders.reset_done);
+  reset.request(ms(6000));
+  EXPECT_FALSE(reset.stop().reset_done) << "a stop is no failed reset";
+}
+
 TEST(ResetCallsTest, TheGiveUpTimeIsTwiceSimTimeoutAtLeast5SAndAtMostAnHour)
 {
   using std::chrono::seconds;
@@ -240,7 +360,7 @@ TEST(ResetCallsTest, TheGiveUpTimeIsTwiceSimTimeoutAtLeast5SAndAtMostAnHour)
 
   // Used as it comes, a week into the clock: no overflow, said in seconds.
   const auto week = ms(7LL * 24 * 3600 * 1000);
-  ResetCalls reset(kService, resetGiveUpAfter(1e300));
+  ResetCalls reset(kService, kType, kMd5, resetGiveUpAfter(1e300));
   const Orders orders = reset.request(week);
   ASSERT_TRUE(orders.call);
   EXPECT_EQ(week + seconds(3600), orders.wake_at);
@@ -252,7 +372,7 @@ TEST(ResetCallsTest, TheGiveUpTimeIsTwiceSimTimeoutAtLeast5SAndAtMostAnHour)
 
 TEST(ResetCallsTest, AGiveUpTimeBeyondTheClockNeverOverflows)
 {
-  ResetCalls reset(kService, ResetCalls::Clock::duration::max());
+  ResetCalls reset(kService, kType, kMd5, ResetCalls::Clock::duration::max());
   const Orders orders = reset.request(ms(1000));
   ASSERT_TRUE(orders.call);
   EXPECT_EQ(kNever, orders.wake_at) << "wrapped round to the past: given up at once";

@@ -197,8 +197,7 @@ TEST_F(RobotDispatchTest, ASilentRobotIsStoppedAndSaidOnceAndDropsOutOfTheRounds
   RobotDispatch::Orders orders = dispatch.onTick(kT0 + milliseconds(1000));
   EXPECT_EQ(std::vector<std::size_t>{1}, orders.stop) << "robot 1 silent since the start; robot 0 heard 0.5 s ago";
   EXPECT_EQ(
-      "no joint_states on /robot_1/joint_states for 1.0 s: is the robot's driver (or its cartpole_sim) running? "
-      "Waiting for it\n"
+      "no joint_states on /robot_1/joint_states for 1.0 s: is its cartpole_sim running? Waiting for it\n"
       "/robot_1/joint_states is silent; the rounds go on without it until it is back\n",
       text(orders.log));
   // The round of robot 0 alone goes on.
@@ -217,6 +216,43 @@ TEST_F(RobotDispatchTest, ASilentRobotIsStoppedAndSaidOnceAndDropsOutOfTheRounds
   EXPECT_EQ("joint_states are back on /robot_0/joint_states; going on\n",
             text(dispatch.onState(0, tick(2), readings(kUpright), kT0 + milliseconds(1700)).log));
   EXPECT_EQ((std::vector<std::size_t>{0, 1}), servedRobots());
+}
+
+TEST_F(RobotDispatchTest, ARobotsSilenceNamesItsStateTopicAndItsDriverNotASim)
+{
+  params_.simulated = false;  // robot.launch: no cartpole_sim's reset service
+  RobotDispatch& dispatch = make(1);
+  const RobotDispatch::Orders orders = dispatch.onTick(kT0 + milliseconds(1000));
+  EXPECT_EQ(std::vector<std::size_t>{0}, orders.stop);
+  EXPECT_EQ(
+      "no joint_states on /robot_0/joint_states for 1.0 s: no driver publishes them. Is the robot's driver running, "
+      "and ~state_topic (robot.launch joint_states:=) the topic it publishes? Waiting for it\n",
+      text(orders.log));
+  EXPECT_EQ(std::string::npos, text(orders.log).find("cartpole_sim"));
+}
+
+TEST_F(RobotDispatchTest, AFailedResetKeepsASpinningPoleFromStartingEpisodesUntilItIsInTheStartRegion)
+{
+  RobotDispatch& dispatch = make(1);
+  const auto serveOne = [&](Stamp stamp, const CartPoleState& state) {
+    dispatch.onState(0, stamp, readings(state), kT0);
+    const std::optional<RobotDispatch::Turn> turn = dispatch.next(kT0);
+    EXPECT_TRUE(turn);
+    return turn ? turn->reaction : Reaction();
+  };
+  ASSERT_TRUE(serveOne(tick(1), kUpright).episode_began);
+  ASSERT_TRUE(serveOne(tick(2), kFallen).request_reset);
+  dispatch.onResetOutcome(0, false);
+  // The pole spins: it passes upright (not fallen) fast, outside the start region.
+  for (std::uint64_t n = 3; n < 40; ++n)
+  {
+    const Reaction r = serveOne(tick(n), CartPoleState(0.0, 0.0, n % 2 ? 0.05 : 2.0, 8.0));
+    EXPECT_FALSE(r.episode_began) << n;
+    EXPECT_TRUE(r.answer);
+    EXPECT_EQ(0.0, r.effort);
+  }
+  EXPECT_EQ(1u, session_->episodesEnded());
+  EXPECT_TRUE(serveOne(tick(40), kUpright).episode_began) << "stood up by hand";
 }
 
 TEST_F(RobotDispatchTest, ADroppedStateIsSaidAtMostOnceASecondOfWallTime)

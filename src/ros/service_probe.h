@@ -1,0 +1,19 @@
+// What a service is, found out the way `rosservice info` and `rosservice type` do.
+#pragma once
+
+#include "cartpole_qlearning/protocol/reset_calls.h"
+
+#include <chrono>
+#include <string>
+
+namespace cartpole_qlearning
+{
+// Asks the master which node serves `service` (lookupService): Missing when it knows none. Else
+// connects to that server and sends a probe's connection header (probe=1, md5sum=*, so that the
+// server accepts whatever the type), and reads the type and md5sum its header answers with:
+// Served. Unknown when the master or the server cannot be asked, or does not answer within
+// `timeout` (each of the connect, the write and the read). Blocks for as long: call it off the
+// control path (ResetCaller's calling thread).
+ServiceFound probeService(const std::string& service, const std::string& caller_id, std::chrono::milliseconds timeout);
+
+}  // namespace cartpole_qlearning
