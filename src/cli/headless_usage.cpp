@@ -37,7 +37,7 @@ void printHeadlessUsage(std::ostream& out)
          "  --ns NS              the namespace whose table folder the paths are under (default cartpole)\n"
          "  --max-episodes N     override training/max_episodes (a loaded or resumed table's episodes count)\n"
          "  --save PATH          the default table (the controller's ~q_table_path; default q_table.yaml, which\n"
-         "                       evaluate.launch loads), replaced only by a solved run\n"
+         "                       evaluate.launch loads; none with --no-run-folder), replaced only by a solved run\n"
          "  --checkpoint-every N a checkpoint into the run's folder every N episodes (default 100; 0: none)\n"
          "  --no-run-folder      write no run folder (no checkpoints, record or curve, nothing on Ctrl-C) and no\n"
          "                       table but --save's (when solved): for scripts that run it many times\n"

@@ -52,12 +52,13 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
   int reports = 0;
   double last_effort = -1.0;
   int commands = 0;
-  const ros::Subscriber stats = nh.subscribe<ControlStats>(
-      "/cartpole/control_stats", 1000, boost::function<void(const cartpole_qlearning::ControlStatsConstPtr&)>(
-                                           [&](const cartpole_qlearning::ControlStatsConstPtr& m) {
-                                             last = *m;
-                                             ++reports;
-                                           }));
+  const ros::Subscriber stats =
+      nh.subscribe<ControlStats>("/cartpole/control_stats", 1000,
+                                 boost::function<void(const cartpole_qlearning::ControlStatsConstPtr&)>(
+                                     [&](const cartpole_qlearning::ControlStatsConstPtr& m) {
+                                       last = *m;
+                                       ++reports;
+                                     }));
   const ros::Subscriber command = nh.subscribe<sensor_msgs::JointState>(
       "/cartpole/joint_command", 1000,
       boost::function<void(const sensor_msgs::JointStateConstPtr&)>([&](const sensor_msgs::JointStateConstPtr& m) {
@@ -93,8 +94,9 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
   EXPECT_GT(commands, 0);
   EXPECT_EQ(0.0, last_effort);
   EXPECT_TRUE(cartpole_qlearning::test::text_match::contains(
-      output, "control ended: balanced [0-9.]+ s of [0-9.]+ s, the longest stretch [0-9.]+ s, [0-9]+ falls?, 0 of "
-              "[0-9]+ commands beyond the motor's 10 N"))
+      output,
+      "control ended: balanced [0-9.]+ s of [0-9.]+ s, the longest stretch [0-9.]+ s, [0-9]+ falls?, 0 of "
+      "[0-9]+ commands beyond the motor's 10 N"))
       << output;
   std::printf("five minutes of control on all_at_once: %.1f s balanced, the longest stretch %.1f s, %llu falls\n",
               at_five_minutes.balanced_seconds, at_five_minutes.longest_seconds,

@@ -59,7 +59,7 @@ TEST(ControlMeter, CountsTimeBalancedTheLongestStretchAndFalls)
   EXPECT_NEAR(2.0, s.current_seconds, 1e-9);
   EXPECT_EQ(0u, s.clamped);
   EXPECT_NE(std::string::npos, meter.summary().text.find("control ended: balanced 5.0 s of 6.0 s, the longest stretch "
-                                                          "3.0 s, 1 fall, 0 of 301 commands beyond the motor's 10 N"))
+                                                         "3.0 s, 1 fall, 0 of 301 commands beyond the motor's 10 N"))
       << meter.summary().text;
 }
 

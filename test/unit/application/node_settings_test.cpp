@@ -186,8 +186,7 @@ TEST(ControllerSettings, ControlDrivesWithATableAndNoStepLimitNorVerdict)
               "mode = control is not allowed (needs ~load_on_start: a trained table to drive the robot with)");
   EXPECT_SAYS(controllerError("{mode: control, load_on_start: t.yaml, max_steps: 500}", shared),
               "max_steps = 500 is not allowed (not with mode control, which has no step limit");
-  EXPECT_SAYS(controllerError("{mode: control, load_on_start: t.yaml, report_every: 0}", shared),
-              "report_every = 0");
+  EXPECT_SAYS(controllerError("{mode: control, load_on_start: t.yaml, report_every: 0}", shared), "report_every = 0");
   EXPECT_SAYS(controllerError("{mode: evaluate, report_every: 5}", shared),
               "report_every = 5 is not allowed (only with mode control)");
 }
