@@ -95,7 +95,8 @@ std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSessio
   // table that can is evaluated whole and compared on whole verdicts, as every table was: the
   // table kept is the one whole evaluations of every table would keep. (The suite runs greedily
   // on the table, learning nothing.)
-  if (best_)
+  const bool passing_decides = config_.limits.until == TrainUntil::SuitePasses && best_ && best_->result.passed();
+  if (best_ && !passing_decides)
   {
     SuiteResult quick = evaluateSuite(session.table(), config_, *suite_, againstTheBest(best_->result, order_));
     failedCaseFirst(order_, quick, *suite_);

@@ -24,11 +24,8 @@ std::string newtons(double value)
 }
 }  // namespace
 
-ControlMeter::ControlMeter(std::string robot, double tau, double force_mag, double report_every)
-  : robot_(std::move(robot)),
-    tau_(tau),
-    force_mag_(force_mag),
-    report_every_(std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(report_every / tau))))
+ControlMeter::ControlMeter(std::string robot, double tau, double max_gap, double force_mag, double report_every)
+  : robot_(std::move(robot)), tau_(tau), max_gap_(max_gap), force_mag_(force_mag), report_every_(report_every)
 {
 }
 
@@ -37,6 +34,14 @@ LogLines ControlMeter::onReaction(const Reaction& reaction, bool fell)
   LogLines log;
   if (reaction.kind != Reaction::Kind::New)
     return log;  // a repeat, a stale or stray state: no new decision, no time
+  if (reaction.sim_restarted)
+  {
+    // Time went back (a sim restarted): the stretch is abandoned, not a fall, and the clock
+    // starts again from this stamp.
+    in_episode_ = false;
+    stats_.current_seconds = 0.0;
+    last_stamp_ = 0;
+  }
   if (reaction.episode_began)
     in_episode_ = true;
   if (reaction.episode_ended)
@@ -53,19 +58,27 @@ LogLines ControlMeter::onReaction(const Reaction& reaction, bool fell)
   }
   if (!reaction.answer)
     return log;
+  // The time since the last decision, by the stamps; a decision without stamps counts tau.
+  double dt = tau_;
+  if (reaction.stamp > 0 && last_stamp_ > 0 && reaction.stamp > last_stamp_)
+    dt = std::min(static_cast<double>(reaction.stamp - last_stamp_) * 1e-9, max_gap_);
+  else if (reaction.stamp > 0 && last_stamp_ == 0)
+    dt = 0.0;  // the first stamp: the clock starts here
+  last_stamp_ = reaction.stamp;
   ++stats_.decisions;
-  stats_.seconds += tau_;
+  stats_.seconds += dt;
   if (in_episode_)
   {
-    stats_.balanced_seconds += tau_;
-    stats_.current_seconds += tau_;
+    stats_.balanced_seconds += dt;
+    stats_.current_seconds += dt;
     stats_.longest_seconds = std::max(stats_.longest_seconds, stats_.current_seconds);
   }
   if (std::abs(reaction.effort) > force_mag_)
     ++stats_.clamped;
-  if (++since_report_ >= report_every_)
+  since_report_ += dt;
+  if (since_report_ >= report_every_ - 1e-9)
   {
-    since_report_ = 0;
+    since_report_ = 0.0;
     if (log.empty())
       log.push_back({LogLine::Level::Info,
                      "control" + (robot_.empty() ? std::string() : " (" + robot_ + ")") + ": " + reportText()});

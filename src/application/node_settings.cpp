@@ -373,6 +373,10 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   // machine's hiccup is not a robot gone). 0 turns it off: a lockstep sim holds no command.
   settings.freshness_timeout = std::max(0.1, 5.0 * settings.robot.decision_period);
   priv.readSeconds("freshness_timeout", settings.freshness_timeout, 0.0, 10.0, false);
+  // Control's clock: a gap between two decisions counts at most this (beyond it the guard has
+  // commanded 0, or, with the guard off, the robot was not being driven).
+  run.control_max_gap =
+      std::max({settings.freshness_timeout, 5.0 * settings.robot.decision_period, 5.0 * settings.training.physics.tau});
   priv.readChoice("reset_service_type", settings.reset_service_type, resetServiceTypes());
   protocol.reset_starts_in_region = settings.reset_service_type != "cartpole_qlearning/Reset";
   readRobots(source, priv, context, settings.robots);

@@ -268,8 +268,9 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
 
   if (!p.settings.learning)
   {
-    // Evaluation: every episode said, and after evaluation_episodes a one-line verdict.
-    if (p.meters.addEvaluationEpisode(s, end.log))
+    // Evaluation: every episode said, and after evaluation_episodes a one-line verdict. (Control:
+    // an episode ends with a fall, which its ControlMeter says.)
+    if (!p.settings.control && p.meters.addEvaluationEpisode(s, end.log))
       p.finished = end.finished = true;
     return end;
   }

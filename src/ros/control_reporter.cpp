@@ -8,21 +8,22 @@
 namespace cartpole_qlearning
 {
 ControlReporter::ControlReporter(ros::NodeHandle& nh, const std::vector<std::string>& robots, double tau,
-                                 double force_mag, double report_every, std::function<void(const LogLines&)> say)
+                                 double max_gap, double force_mag, double report_every,
+                                 std::function<void(const LogLines&)> say)
   : robots_(robots), publisher_(nh.advertise<ControlStats>("control_stats", 100)), say_(std::move(say))
 {
   for (const std::string& robot : robots_)
-    meters_.emplace_back(robot, tau, force_mag, report_every);
+    meters_.emplace_back(robot, tau, max_gap, force_mag, report_every);
 }
 
-void ControlReporter::onReaction(std::size_t robot, const Reaction& reaction, bool fell, std::uint64_t stamp)
+void ControlReporter::onReaction(std::size_t robot, const Reaction& reaction, bool fell)
 {
   ControlMeter& meter = meters_.at(robot);
   const LogLines said = meter.onReaction(reaction, fell);
   if (said.empty())
     return;
   say_(said);
-  publisher_.publish(controlStats(meter.stats(), robots_[robot], ros::Time().fromNSec(stamp)));
+  publisher_.publish(controlStats(meter.stats(), robots_[robot], ros::Time().fromNSec(reaction.stamp)));
 }
 
 LogLines ControlReporter::summaries() const

@@ -53,8 +53,8 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
   if (settings_.run.control)
     control_ = std::make_unique<ControlReporter>(nh_, settings_.robots, settings_.training.physics.tau,
-                                                 settings_.training.physics.force_mag, settings_.run.report_every,
-                                                 [this](const LogLines& log) { say(log); });
+                                                 settings_.run.control_max_gap, settings_.training.physics.force_mag,
+                                                 settings_.run.report_every, [this](const LogLines& log) { say(log); });
   ros::NodeHandle services_nh(pnh_);
   services_nh.setCallbackQueue(&services_queue_);
   save_srv_ = services_nh.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
@@ -109,6 +109,8 @@ QLearningControllerNode::~QLearningControllerNode()
   // First, with mutex_ free: a reconfigure call or a save under way ends (they take mutex_), no
   // other starts.
   reconfigure_.reset();
+  save_srv_.shutdown();  // a call from now on is refused rather than left waiting for the process to end
+  load_srv_.shutdown();
   services_spinner_.reset();
   // Resets end here; a call under way is given up, not waited for (it may hang for minutes), so
   // the save below still happens. Under mutex_: a state callback or the watchdog may be asking
@@ -198,8 +200,7 @@ void QLearningControllerNode::serve(const RobotDispatch::Turn& turn)
   if (reaction.episode_ended && !reaction.answer)
     robot.command.stop();
   if (control_)
-    control_->onReaction(turn.robot, reaction, reaction.episode_ended && session_->lastEpisode().terminated,
-                         turn.stamp);
+    control_->onReaction(turn.robot, reaction, reaction.episode_ended && session_->lastEpisode().terminated);
   if (reaction.episode_ended)
     endEpisode(robot, stamp, reaction.training_finished);
   // Reset calls run on threads of their own (ResetCaller): a blocking call from this callback would

@@ -39,8 +39,10 @@ public:
   // The suite's verdict on the session's table when it is due at the session's last episode (at
   // suite_every's cadence, and when training ends), said; the table is kept when it is the best
   // so far. Nothing when not due. Once there is a best, the verdict of a table that cannot beat it
-  // is cut short (SuiteResult::complete() false: passed() is then false, and the whole verdict
-  // would have failed too unless the best passes).
+  // is cut short (SuiteResult::complete() false); against a failing best such a table fails, and
+  // its passed() is false as its whole verdict's would be. (Against a passing best, a cut-short
+  // verdict says nothing of passing: under training/until suite_passes the keeper then judges
+  // every table whole, since passing ends training.)
   std::optional<SuiteResult> evaluateWhenDue(const TrainingSession& session, bool training_ends, LogLines& log);
   // Training ends (needs the suite): the table it saves is the best seen when that beats the last
   // (the session then holds it), said. Returns the verdict of that table (`last`, the best's, or

@@ -1,7 +1,9 @@
 // What a robot owner wants to know of a table that drives a robot (~mode control): how long it
 // has kept the pole up, its longest stretch, how often the pole fell, how many commands were
-// beyond the motor. Time is counted in decisions on new states times the decision step (tau):
-// the robot's own clock, whatever the wall clock does (a lockstep sim runs faster than real time).
+// beyond the motor. Time is the robot's own clock, whatever the wall clock does (a lockstep sim
+// runs faster than real time): the stamps of the states decided on, each decision counting the
+// time since the one before (at most max_gap: a robot silent for longer was not being controlled),
+// or tau for a robot that sends no stamps.
 #pragma once
 
 #include "cartpole_qlearning/common/log_line.h"
@@ -26,13 +28,15 @@ struct ControlStatsValues
 class ControlMeter
 {
 public:
-  // robot: as the log names it ("" the learner's own); tau: the decision step [s]; force_mag:
-  // the motor's limit [N]; report_every: a report line every this much robot time [s].
-  ControlMeter(std::string robot, double tau, double force_mag, double report_every);
+  // robot: as the log names it ("" the learner's own); tau: the step the table learnt [s] (the
+  // time of a decision without stamps); max_gap: the most time one decision counts [s];
+  // force_mag: the motor's limit [N]; report_every: a report line every this much robot time [s].
+  ControlMeter(std::string robot, double tau, double max_gap, double force_mag, double report_every);
 
-  // One of the robot's states as the protocol reacted to it; fell: the episode it ended ended
-  // on the task's thresholds (TrainingSession::lastEpisode().terminated). Returns what to say:
-  // the fall, or the periodic report when due; empty otherwise (publish the stats when not).
+  // One of the robot's states as the protocol reacted to it (reaction.stamp its stamp, 0: none);
+  // fell: the episode it ended ended on the task's thresholds (TrainingSession::lastEpisode()
+  // .terminated). Returns what to say: the fall, or the periodic report when due; empty
+  // otherwise (publish the stats when not empty).
   LogLines onReaction(const Reaction& reaction, bool fell);
   // The line said at the end (the controller stopping).
   LogLine summary() const;
@@ -47,10 +51,12 @@ private:
 
   std::string robot_;
   double tau_;
+  double max_gap_;
   double force_mag_;
-  std::uint64_t report_every_;  // in decisions
+  double report_every_;
   bool in_episode_ = false;
-  std::uint64_t since_report_ = 0;
+  Stamp last_stamp_ = 0;  // of the last decision (0: none yet, or no stamps)
+  double since_report_ = 0.0;
   ControlStatsValues stats_;
 };
 

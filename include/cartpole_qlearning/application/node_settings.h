@@ -35,6 +35,9 @@ struct RunSettings
   // learning; a fall commands 0 until a start, and ControlMeter says how it goes.
   bool control = false;
   double report_every = 10.0;  // [s] control: a report this often (robot time)
+  // [s] control: the most robot time one decision counts (ControlMeter's max_gap): the freshness
+  // bound, five decision periods or five steps, the longest.
+  double control_max_gap = 0.1;
   std::uint64_t seed = 0;
   std::string name_space = "/cartpole";  // the learner's namespace: its table folder by default, its run folders' names
   // Tables are read and written under this folder (a relative path there; one that escapes it is

@@ -8,22 +8,28 @@ using namespace cartpole_qlearning;
 
 namespace
 {
-Reaction decided(double effort, bool began = false)
-{
-  Reaction r;
-  r.answer = true;
-  r.effort = effort;
-  r.episode_began = began;
-  return r;
-}
+constexpr Stamp kStep = 20000000;  // 20 ms: a robot at 50 Hz
 
-Reaction fallen()
+// A robot's states, stamped 20 ms apart (or `gap` when given), as the protocol reacts to them.
+struct States
 {
-  Reaction r;
-  r.episode_ended = true;
-  r.answer = true;  // the zero after the fall
-  return r;
-}
+  Stamp stamp = 1000 * kStep;
+  Reaction decided(double effort, bool began = false, Stamp gap = kStep)
+  {
+    Reaction r;
+    r.answer = true;
+    r.effort = effort;
+    r.episode_began = began;
+    r.stamp = stamp += gap;
+    return r;
+  }
+  Reaction fallen()
+  {
+    Reaction r = decided(0.0);  // the zero after the fall
+    r.episode_ended = true;
+    return r;
+  }
+};
 
 std::string text(const LogLines& log)
 {
@@ -36,25 +42,27 @@ std::string text(const LogLines& log)
 
 TEST(ControlMeter, CountsTimeBalancedTheLongestStretchAndFalls)
 {
-  ControlMeter meter("", 0.02, 10.0, 1000.0);
-  EXPECT_TRUE(meter.onReaction(decided(10.0, true), false).empty());
+  ControlMeter meter("", 0.02, 0.1, 10.0, 1000.0);
+  States states;
+  EXPECT_TRUE(meter.onReaction(states.decided(0.0), false).empty());  // waiting: the clock starts
+  EXPECT_TRUE(meter.onReaction(states.decided(10.0, true), false).empty());
   for (int i = 1; i < 150; ++i)  // 3 s up
-    EXPECT_TRUE(meter.onReaction(decided(i % 2 ? -10.0 : 10.0), false).empty());
-  const LogLines fell = meter.onReaction(fallen(), true);
+    EXPECT_TRUE(meter.onReaction(states.decided(i % 2 ? -10.0 : 10.0), false).empty());
+  const LogLines fell = meter.onReaction(states.fallen(), true);
   ASSERT_EQ(1u, fell.size());
   EXPECT_EQ(LogLine::Level::Warn, fell[0].level);
   EXPECT_NE(std::string::npos, text(fell).find("control: the pole fell after 3.0 s balanced; balanced 3.0 s of"))
       << text(fell);
-  for (int i = 0; i < 50; ++i)  // 1 s waiting for a start: zeros
-    meter.onReaction(decided(0.0), false);
-  meter.onReaction(decided(10.0, true), false);
+  for (int i = 1; i < 50; ++i)  // 1 s waiting for a start (with the fall's zero): zeros
+    meter.onReaction(states.decided(0.0), false);
+  meter.onReaction(states.decided(10.0, true), false);
   for (int i = 1; i < 100; ++i)  // 2 s up, going on
-    meter.onReaction(decided(10.0), false);
+    meter.onReaction(states.decided(10.0), false);
   const ControlStatsValues& s = meter.stats();
   EXPECT_EQ(1u, s.falls);
-  EXPECT_EQ(150u + 1u + 50u + 100u, s.decisions);
+  EXPECT_EQ(1u + 150u + 50u + 100u, s.decisions);
   EXPECT_NEAR(5.0, s.balanced_seconds, 1e-9);
-  EXPECT_NEAR(6.02, s.seconds, 1e-9);
+  EXPECT_NEAR(6.0, s.seconds, 1e-9);
   EXPECT_NEAR(3.0, s.longest_seconds, 1e-9);
   EXPECT_NEAR(2.0, s.current_seconds, 1e-9);
   EXPECT_EQ(0u, s.clamped);
@@ -63,35 +71,73 @@ TEST(ControlMeter, CountsTimeBalancedTheLongestStretchAndFalls)
       << meter.summary().text;
 }
 
+TEST(ControlMeter, TimeIsTheRobotsStampsWhateverTheDecisionRate)
+{
+  // A 30 Hz driver, a 100 Hz one: the same 2 s of robot time. A silence counts at most max_gap;
+  // a robot without stamps counts tau a decision.
+  for (const Stamp gap : {Stamp(33333333), Stamp(10000000)})
+  {
+    ControlMeter meter("", 0.02, 0.1, 10.0, 1000.0);
+    States states;
+    meter.onReaction(states.decided(10.0, true, gap), false);
+    const int decisions = static_cast<int>(2e9 / static_cast<double>(gap));
+    for (int i = 0; i < decisions; ++i)
+      meter.onReaction(states.decided(10.0, false, gap), false);
+    EXPECT_NEAR(2.0, meter.stats().balanced_seconds, static_cast<double>(gap) * 1e-9) << gap;
+    meter.onReaction(states.decided(10.0, false, 500 * kStep), false);  // 10 s of silence
+    EXPECT_NEAR(2.1, meter.stats().balanced_seconds, static_cast<double>(gap) * 1e-9) << gap;
+  }
+  ControlMeter unstamped("", 0.02, 0.1, 10.0, 1000.0);
+  Reaction r;
+  r.answer = true;
+  r.episode_began = true;
+  unstamped.onReaction(r, false);
+  r.episode_began = false;
+  for (int i = 0; i < 99; ++i)
+    unstamped.onReaction(r, false);
+  EXPECT_NEAR(2.0, unstamped.stats().seconds, 1e-9);
+}
+
 TEST(ControlMeter, RepeatsAndDroppedStatesCountNothingAndAnEndThatIsNoFallIsNoFall)
 {
-  ControlMeter meter("robot_1", 0.02, 10.0, 1000.0);
-  meter.onReaction(decided(10.0, true), false);
+  ControlMeter meter("robot_1", 0.02, 0.1, 10.0, 1000.0);
+  States states;
+  meter.onReaction(states.decided(10.0, true), false);
+  meter.onReaction(states.decided(10.0), false);
   for (Reaction::Kind kind : {Reaction::Kind::Repeat, Reaction::Kind::Stale, Reaction::Kind::Stray})
   {
-    Reaction r = decided(10.0);
+    Reaction r = states.decided(10.0);
     r.kind = kind;
     EXPECT_TRUE(meter.onReaction(r, false).empty());
   }
-  EXPECT_EQ(1u, meter.stats().decisions);
-  // Time set back (a sim restarted): the episode is abandoned, not a fall.
-  Reaction restarted = decided(0.0);
-  restarted.episode_ended = true;
+  EXPECT_EQ(2u, meter.stats().decisions);
+  // Time set back (a sim restarted): the stretch is abandoned, not a fall, and the clock starts again.
+  Reaction restarted = states.decided(0.0);
+  restarted.stamp = kStep;
+  restarted.sim_restarted = true;
+  restarted.episode_began = true;
   EXPECT_TRUE(meter.onReaction(restarted, false).empty());
   EXPECT_EQ(0u, meter.stats().falls);
-  EXPECT_EQ(0.0, meter.stats().current_seconds);
+  EXPECT_NEAR(0.0, meter.stats().current_seconds, 1e-12);
+  EXPECT_NEAR(0.02, meter.stats().seconds, 1e-12);
+  // An episode that ends otherwise than by a fall is no fall.
+  Reaction ended = states.decided(0.0);
+  ended.episode_ended = true;
+  EXPECT_TRUE(meter.onReaction(ended, false).empty());
+  EXPECT_EQ(0u, meter.stats().falls);
   // A robot of several is named.
-  meter.onReaction(decided(10.0, true), false);
-  EXPECT_NE(std::string::npos, text(meter.onReaction(fallen(), true)).find("control (robot_1): the pole fell"));
+  meter.onReaction(states.decided(10.0, true), false);
+  EXPECT_NE(std::string::npos, text(meter.onReaction(states.fallen(), true)).find("control (robot_1): the pole fell"));
 }
 
 TEST(ControlMeter, ReportsEveryPeriodOfRobotTimeAndCountsCommandsBeyondTheMotor)
 {
-  ControlMeter meter("", 0.02, 10.0, 1.0);  // every 50 decisions
+  ControlMeter meter("", 0.02, 0.1, 10.0, 1.0);  // every second: 50 decisions at 50 Hz
+  States states;
   int reports = 0;
-  for (int i = 0; i < 500; ++i)
+  for (int i = 0; i <= 500; ++i)
   {
-    const LogLines said = meter.onReaction(decided(i % 10 == 0 ? 15.0 : 10.0, i == 0), false);
+    const LogLines said = meter.onReaction(states.decided(i % 10 == 0 ? 15.0 : 10.0, i == 0), false);
     reports += said.empty() ? 0 : 1;
     if (!said.empty())
     {
@@ -100,6 +146,6 @@ TEST(ControlMeter, ReportsEveryPeriodOfRobotTimeAndCountsCommandsBeyondTheMotor)
     }
   }
   EXPECT_EQ(10, reports);
-  EXPECT_EQ(50u, meter.stats().clamped);
-  EXPECT_NE(std::string::npos, meter.summary().text.find("50 of 500 commands beyond the motor's 10 N"));
+  EXPECT_EQ(51u, meter.stats().clamped);
+  EXPECT_NE(std::string::npos, meter.summary().text.find("51 of 501 commands beyond the motor's 10 N"));
 }

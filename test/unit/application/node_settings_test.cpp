@@ -179,6 +179,11 @@ TEST(ControllerSettings, ControlDrivesWithATableAndNoStepLimitNorVerdict)
   EXPECT_EQ(std::numeric_limits<unsigned>::max(), control.training.task.max_episode_steps);
   EXPECT_EQ(0u, control.run.evaluation_episodes);
   EXPECT_EQ(10.0, control.run.report_every);
+  // A gap between two decisions counts at most the freshness bound (0.1 s: five 20 ms periods).
+  EXPECT_DOUBLE_EQ(0.1, control.run.control_max_gap);
+  EXPECT_DOUBLE_EQ(
+      2.0,
+      readController("{mode: control, load_on_start: t.yaml, freshness_timeout: 2.0}", shared).run.control_max_gap);
   EXPECT_EQ(2.5, readController("{mode: control, load_on_start: t.yaml, report_every: 2.5}", shared).run.report_every);
   EXPECT_FALSE(readController("mode: evaluate", shared).run.control);
   // What control cannot take, each refused naming it.
