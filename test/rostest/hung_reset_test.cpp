@@ -250,7 +250,9 @@ TEST(HungReset, ResetCallerGivesAHungCallUpOnANewThreadAndDoesNotWaitForItAtTheE
   ASSERT_TRUE(
       spinUntil([&] { return service.calls() == 2 && log.count(answers_again, rosgraph_msgs::Log::INFO); }, 15.0))
       << service.calls() << " calls";
-  EXPECT_GE((ros::WallTime::now() - hung_at).toSec(), 2.9) << "given up before its time";
+  // hung_at is when this test saw the hang, some time after the call began (0.18 s later under ASan
+  // beside CI's fuzzers): a give-up before its time would come at once, not seconds later.
+  EXPECT_GE((ros::WallTime::now() - hung_at).toSec(), 2.0) << "given up before its time";
   EXPECT_EQ(1, log.count(given_up, rosgraph_msgs::Log::WARN));
   // Taken back on a persistent connection.
   caller->request();
