@@ -1,6 +1,5 @@
 #include "cartpole_qlearning/learning/table_config.h"
 
-#include <charconv>
 #include <utility>
 #include <vector>
 
@@ -8,19 +7,12 @@ namespace cartpole_qlearning
 {
 namespace
 {
-std::string numberText(double value)
-{
-  char text[32];
-  const auto result = std::to_chars(text, text + sizeof text, value);
-  return std::string(text, result.ptr);
-}
-
 template <typename Container>
 std::string listText(const Container& values)
 {
   std::string text;
   for (const auto value : values)
-    text += (text.empty() ? "" : ", ") + numberText(static_cast<double>(value));
+    text += (text.empty() ? "" : ", ") + exactText(static_cast<double>(value));
   return "[" + text + "]";
 }
 
@@ -100,7 +92,7 @@ std::string tableContradiction(const TrainingConfig& config, const std::string& 
   differ("learning/previous_action", flagText(wanted.previous_action), flagText(has.previous_action));
   differ("learning/actions", listText(config.agent.actions), listText(table.actions()));
   if (table.tau > 0.0)
-    differ("physics/tau", numberText(config.physics.tau), numberText(table.tau));
+    differ("physics/tau", exactText(config.physics.tau), exactText(table.tau));
   std::string text;
   for (const auto& [key, values] : found)
     text += (text.empty() ? "" : "; ") + key + " is " + values.first + " in " + config_origin + " but " +

@@ -475,15 +475,15 @@ bool holdsTrainingConfig(const ParameterSource& source)
   return false;
 }
 
-namespace
-{
-// The shortest text that reads back as the same double, whatever the locale.
 std::string exactText(double value)
 {
   char text[32];
   const auto result = std::to_chars(text, text + sizeof text, value);
   return std::string(text, result.ptr);
 }
+
+namespace
+{
 
 template <typename Container>
 void emitNumbers(YAML::Emitter& out, const Container& values)

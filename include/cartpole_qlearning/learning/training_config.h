@@ -295,4 +295,8 @@ bool holdsTrainingConfig(const ParameterSource& source);
 // configuration gives the same text however it was read (a file, the parameter server).
 std::string trainingConfigText(const TrainingConfig& config);
 
+// The shortest text that reads back as the same double, whatever the locale (the config text a
+// table carries, and messages that must show two values apart however close they are).
+std::string exactText(double value);
+
 }  // namespace cartpole_qlearning
