@@ -246,6 +246,10 @@ cp "$WORK/solved.yaml" "$TABLES/q_table.yaml"
 run "evaluate.launch" 200 0 "roslaunch cartpole_qlearning evaluate.launch q_table:=q_table.yaml" \
   "evaluation episode 1: [0-9]+ steps" \
   "EVALUATED 5 episodes: [0-5] balanced to the step limit \(500 steps\), mean return [0-9.]+"
+# Posing as a case of the suite, in lockstep: the verdict is train_headless's, figure for figure.
+run "evaluate.launch suite_case:=one_step_late" 200 0 \
+  "roslaunch cartpole_qlearning evaluate.launch suite_case:=one_step_late mode:=lockstep" "EVALUATED 100 episodes"
+output docs/tutorial.md tutorial_suite_case
 
 # The simulator alone.
 if start "sim.launch" "roslaunch cartpole_qlearning sim.launch"; then
