@@ -32,6 +32,11 @@ std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options)
       const std::string path = tablePath(setup.table_dir, options.evaluate_path);
       const TableConfig own = tableConfig(loadTable(setup.table_dir, options.evaluate_path), path);
       setup.config = own.config;
+      // Wide starts and perturbations were training's devices (robust.yaml starts in +-0.25, past
+      // the 12 degrees that end an episode): the evaluation's starts are CartPole-v1's and its
+      // physics unperturbed, as evaluate.launch's sim without a config. --config sets others.
+      setup.config.start_state_bound = TrainingConfig().start_state_bound;
+      setup.config.perturbations = PerturbationParams();
       setup.config_origin = "the table's own configuration (" + path + ")";
       setup.config_warning = own.defaults_used;
     }

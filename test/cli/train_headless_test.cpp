@@ -397,6 +397,25 @@ TEST_F(TrainHeadlessTest, ATableAloneIsEvaluatedWithItsOwnConfigurationInEpisode
   EXPECT_EQ(0u, suite.lastLine().find("suite=")) << suite.output;
 }
 
+// Training's wide starts (robust.yaml's +-0.25, past the 12 degrees that end an episode) are not
+// the evaluation's: a table alone is evaluated from CartPole-v1's starts, so no episode is over
+// at its first step; with the training config given, its starts are used, and some are.
+TEST_F(TrainHeadlessTest, ATableAloneIsEvaluatedFromTheEvaluationsStartsNotTrainingsWideOnes)
+{
+  // "Solved" at its first episode, so that --save writes the table.
+  const std::string wide =
+      file("wide.yaml", "physics:\n  start_state_bound: 0.3\ntask:\n  solved_window: 1\n  solved_mean_return: 0\n");
+  const CommandRun trained = trainHeadless("--config " + wide + " --seed 0 --quiet --no-run-folder --save w.yaml");
+  ASSERT_EQ(0, trained.status) << trained.output;
+  const CommandRun alone = trainHeadless("--evaluate w.yaml --episodes 30 --max-steps 50");
+  ASSERT_EQ(0, alone.status) << alone.output;
+  EXPECT_NE(std::string::npos, alone.output.find("evaluation episode 30: ")) << alone.output;
+  EXPECT_FALSE(text_match::contains(alone.output, "evaluation episode [0-9]+: 1 steps")) << alone.output;
+  const CommandRun as_trained = trainHeadless("--config " + wide + " --evaluate w.yaml --episodes 30 --max-steps 50");
+  ASSERT_EQ(0, as_trained.status) << as_trained.output;
+  EXPECT_TRUE(text_match::contains(as_trained.output, "evaluation episode [0-9]+: 1 steps")) << as_trained.output;
+}
+
 TEST_F(TrainHeadlessTest, EvaluateOnASuitePrintsEachCaseAndEndsWithTheSuitesVerdict)
 {
   namespace cq = cartpole_qlearning;
