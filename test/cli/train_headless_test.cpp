@@ -149,6 +149,31 @@ TEST_F(TrainHeadlessTest, SolvesAndEndsWithTheResultLine)
   EXPECT_NE(std::string::npos, run.output.find("mean_return_100")) << run.output;
 }
 
+// The package (its config/ folder) is found on ROS_PACKAGE_PATH as rospack finds it, whether an
+// entry is the package's folder, the folder holding it, or neither (then rospack's crawl).
+TEST_F(TrainHeadlessTest, ThePackageIsFoundWhereverThePackagePathHasIt)
+{
+  const fs::path package = fs::canonical(fs::path(CARTPOLE_CONFIG_DIR).parent_path());
+  const fs::path parent = dir_ / "workspace_src";
+  fs::create_directories(parent);
+  fs::create_directory_symlink(package, parent / "cartpole_qlearning");
+  const fs::path elsewhere = dir_ / "other_src";
+  fs::create_directories(elsewhere / "nested");
+  fs::create_directory_symlink(package, elsewhere / "nested" / "cartpole_qlearning");
+  const std::vector<std::pair<std::string, fs::path>> cases{
+      {"/nonexistent:" + package.string(), package},
+      {parent.string(), parent / "cartpole_qlearning"},
+      {elsewhere.string(), elsewhere / "nested" / "cartpole_qlearning"}};
+  for (const auto& [path, found] : cases)
+  {
+    const CommandRun run = runCommand("ROS_PACKAGE_PATH=" + path + " ROS_HOME=" + dir_.string() + " " + TRAIN_HEADLESS +
+                                      " --seed 0 --no-run-folder --max-episodes 3");
+    EXPECT_EQ(0, run.status) << path << ": " << run.output;
+    EXPECT_NE(std::string::npos, run.output.find("(" + (found / "config" / "robust_suite.yaml").string() + ", greedy"))
+        << path << ": " << run.output;
+  }
+}
+
 TEST_F(TrainHeadlessTest, EveryRunSaysWhatItsTableIsWorthOnTheRobustnessSuite)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --no-run-folder");
