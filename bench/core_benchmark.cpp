@@ -6,6 +6,7 @@
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/learning/discretiser.h"
 #include "cartpole_qlearning/application/headless_trainer.h"
+#include "cartpole_qlearning/application/robustness_suite.h"
 #include "lockstep_loopback.h"
 #include "cartpole_qlearning/learning/q_learning_agent.h"
 #include "cartpole_qlearning/common/random.h"
@@ -221,6 +222,45 @@ void BM_LockstepLoopbackToSolved(benchmark::State& state)
   trainingToSolved<LockstepLoopback>(state);
 }
 BENCHMARK(BM_LockstepLoopbackToSolved)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The robustness suite's verdict on seed 0's solved table (the default config's, which fails the
+// suite): greedy steps, no learning. state.range(0): threads (0: one per core).
+// - whole: every case to its last episode, as the verdict a finished run prints;
+// - until decided: stopped at its first failing case, each case at its deciding episode, as
+//   training judges a table (issue 29: <= 2 ms on average for a failing table).
+void suiteVerdict(benchmark::State& state, bool whole)
+{
+  const TrainingConfig config = readTrainingConfig(*loadYamlParameters(CARTPOLE_CONFIG_FILE));
+  HeadlessTrainer trainer(config, 0);
+  if (!trainer.run().solved)
+  {
+    state.SkipWithError("the config did not solve with seed 0");
+    return;
+  }
+  const RobustnessSuite suite = loadRobustnessSuite(CARTPOLE_SUITE_FILE, config);
+  SuiteRun how = whole ? SuiteRun::complete() : SuiteRun::untilDecided({});
+  how.threads = static_cast<unsigned>(state.range(0));
+  std::uint64_t steps = 0;
+  for (auto _ : state)
+  {
+    const SuiteResult result = evaluateSuite(trainer.session().table(), config, suite, how);
+    for (const CaseResult& c : result.cases)
+      steps += c.steps;
+    benchmark::DoNotOptimize(result);
+  }
+  state.counters["greedy_steps_per_s"] = benchmark::Counter(static_cast<double>(steps), benchmark::Counter::kIsRate);
+  state.counters["steps"] = static_cast<double>(state.iterations() > 0 ? steps / state.iterations() : 0);
+}
+void BM_SuiteVerdictWhole(benchmark::State& state)
+{
+  suiteVerdict(state, true);
+}
+BENCHMARK(BM_SuiteVerdictWhole)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+void BM_SuiteVerdictUntilDecided(benchmark::State& state)
+{
+  suiteVerdict(state, false);
+}
+BENCHMARK(BM_SuiteVerdictUntilDecided)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

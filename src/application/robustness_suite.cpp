@@ -169,6 +169,7 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
       effort = decision.effort;
     }
     const EpisodeSummary& s = session.lastEpisode();
+    result.steps += s.steps;
     result.balanced += s.truncated && !s.terminated;
     returns += s.episode_return;
     result.run = e + 1;

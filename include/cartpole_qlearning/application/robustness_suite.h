@@ -58,6 +58,7 @@ struct CaseResult
   // The balanced episodes the run was decided against when SuiteRun::target said other than pass
   // (0: pass).
   std::uint64_t target = 0;
+  std::uint64_t steps = 0;  // steps run over the episodes run (greedy steps: the verdict's cost)
   bool passed() const
   {
     return balanced >= pass;
