@@ -29,7 +29,16 @@
 #        one step late, noise, other masses, pushes, against the anchor's time to mere "solved";
 #        its steps are checked against train_headless --config robust.yaml --seed 0 (the same
 #        table). Median of BENCH_ROBUST_RUNS launches.
-# (a), (b1), (b2) and (c) are measured in rounds, some before (d) and (e) and one after them;
+#   (j)  the MuJoCo sim (issue 28): roslaunch cartpole_qlearning train.launch nodelet:=true
+#        config:=.../config/mujoco_cartpole.yaml seed:=0 (mjcf/cartpole.xml, two mj_steps a tau), to
+#        solved: steps/s as in (e), median of BENCH_NODELET_RUNS launches
+#   (k)  train_headless --config config/mujoco_cartpole.yaml --seed 0 to solved: steps / its
+#        wall_s, median of 3 runs
+#   (l)  mujoco_bare_loop: mj_step twice a step on the same model, a bang-bang ctrl and a reset
+#        when the pole falls, nothing of this package: steps/s, measured in each round as (a)-(c);
+#        (j) and (k) are compared with it. (j), (k), (l) need a build with MuJoCo; the rows then
+#        say they were skipped.
+# (a), (b1), (b2), (c) and (l) are measured in rounds, some before (d) and (e) and one after them;
 # each figure is the median over the rounds, its spread is printed beside it.
 # Every measured process runs on one CPU (taskset): a round trip costs about twice as much when
 # the two processes sit on different CPUs (a cross-CPU wake-up), and where the scheduler puts
@@ -95,6 +104,13 @@ LOCKSTEP_ANSWER=$(find_exe lockstep_answer)
 CARTPOLE_SIM=$(find_exe cartpole_sim)
 CORE_BENCHMARK=$(find_exe core_benchmark)
 TRAIN_HEADLESS=$(find_exe train_headless)
+# Built only with MuJoCo (and Google Benchmark, as bench/'s other programs).
+MUJOCO_BARE_LOOP=$(catkin_find --first-only --libexec "$PKG" mujoco_bare_loop 2>/dev/null | head -n 1) || true
+MUJOCO_SKIPPED=""
+[[ -n "$MUJOCO_BARE_LOOP" && -x "$MUJOCO_BARE_LOOP" ]] ||
+  MUJOCO_SKIPPED="mujoco_bare_loop is not built: the build found no MuJoCo (Debian 12: libmujoco-dev)"
+# mjcf/cartpole.xml steps 0.01 s; config/mujoco_cartpole.yaml's tau is 0.02 s: two mj_steps a step.
+MUJOCO_FRAME_SKIP=2
 
 # The anchor sits beside the repository (<repo>/../shared), not in it: the repository is where
 # this script is, wherever the workspace links it from.
@@ -156,7 +172,9 @@ start_master
 
 ANCHOR_COUNT=$(wc -w <<<"$ANCHOR_SEEDS")
 [[ -n "$ANCHOR_SKIPPED" ]] && ANCHOR_COUNT=0
-echo "Measuring (about $((ROUNDS * 9 + 13 + NODELET_RUNS * 4 + ROBUST_RUNS * 15 + 15 + ANCHOR_COUNT * 2 + 3)) s): master $ROS_MASTER_URI, logs in $WORK" >&2
+MUJOCO_COUNT=1
+[[ -n "$MUJOCO_SKIPPED" ]] && MUJOCO_COUNT=0
+echo "Measuring (about $((ROUNDS * 9 + 13 + NODELET_RUNS * 4 + ROBUST_RUNS * 15 + 15 + ANCHOR_COUNT * 2 + 3 + MUJOCO_COUNT * (ROUNDS * 2 + NODELET_RUNS * 5 + 6))) s): master $ROS_MASTER_URI, logs in $WORK" >&2
 
 # --- Setup of (a) and (c): the answering side stays up for the whole run --------------------
 # The sim as train.launch starts it (the shared parameters in the namespace, sim.yaml in the
@@ -183,6 +201,11 @@ measure_round()
   done
   run "answer_$r.log" 30 "${PIN[@]}" "$LOCKSTEP_ANSWER" __ns:=bench_sim "_duration:=$DURATION" "_warmup:=$WARMUP"
   [[ -n "$(field "answer_$r.log" rate)" ]] || die "no result from lockstep_answer (log: $WORK/answer_$r.log)"
+  if [[ -z "$MUJOCO_SKIPPED" ]]; then
+    run "mujoco_bare_$r.log" 30 "${PIN[@]}" "$MUJOCO_BARE_LOOP" "$PKG_DIR/mjcf/cartpole.xml" cart_joint pole_joint \
+      cart_motor "$MUJOCO_FRAME_SKIP" "$DURATION"
+    [[ -n "$(field "mujoco_bare_$r.log" rate)" ]] || die "no result from mujoco_bare_loop (log: $WORK/mujoco_bare_$r.log)"
+  fi
 }
 
 for ((r = 1; r < ROUNDS; r++)); do
@@ -255,6 +278,34 @@ read -r TO_PASSED TO_PASSED_MIN TO_PASSED_MAX <<<"$(printf '%s\n' "${ROBUST_TO_P
 run robust_headless.log 300 "${PIN[@]}" "$TRAIN_HEADLESS" --config "$PKG_DIR/config/robust.yaml" --seed 0 --no-run-folder --quiet
 ROBUST_HEADLESS_STEPS=$(field robust_headless.log steps)
 
+# --- (j), (k) The MuJoCo sim on the graph and headless ---------------------------------------------
+if [[ -z "$MUJOCO_SKIPPED" ]]; then
+  echo "(j) roslaunch $PKG train.launch nodelet:=true config:=$PKG_DIR/config/mujoco_cartpole.yaml seed:=0, to solved, $NODELET_RUNS launches" >&2
+  # The launches before left their configs' keys in /cartpole (rosparam load merges), and a
+  # model's physics refuses the equations' keys: the namespace starts empty, as on a fresh master.
+  rosparam delete /cartpole
+  MUJOCO_RATES=() MUJOCO_SECONDS=()
+  for ((i = 1; i <= NODELET_RUNS; i++)); do
+    run "mujoco_nodelet_$i.log" "$TRAIN_TIMEOUT" "${PIN[@]}" roslaunch "$PKG" train.launch nodelet:=true \
+      "config:=$PKG_DIR/config/mujoco_cartpole.yaml" seed:=0
+    figures=$(solved "mujoco_nodelet_$i.log" "train.launch nodelet:=true config:=mujoco_cartpole.yaml") || exit 1
+    read -r MUJOCO_EPISODES MUJOCO_STEPS mujoco_s <<<"$figures"
+    MUJOCO_SECONDS+=("$mujoco_s")
+    MUJOCO_RATES+=("$(calc 'printf "%.1f", (t > 0 ? m / t : 0)' "m=$MUJOCO_STEPS" "t=$mujoco_s")")
+  done
+  read -r MUJOCO_RATE _ _ <<<"$(printf '%s\n' "${MUJOCO_RATES[@]}" | stats)"
+  read -r MUJOCO_S _ _ <<<"$(printf '%s\n' "${MUJOCO_SECONDS[@]}" | stats)"
+  echo "(k) train_headless --config $PKG_DIR/config/mujoco_cartpole.yaml --seed 0, to solved, 3 runs" >&2
+  MUJOCO_HEADLESS_RATES=()
+  for i in 1 2 3; do
+    run "mujoco_headless_$i.log" 120 "${PIN[@]}" "$TRAIN_HEADLESS" --config "$PKG_DIR/config/mujoco_cartpole.yaml" \
+      --seed 0 --no-run-folder --quiet
+    MUJOCO_HEADLESS_STEPS=$(field "mujoco_headless_$i.log" steps)
+    MUJOCO_HEADLESS_RATES+=("$(calc 'printf "%.1f", m / t' "m=$MUJOCO_HEADLESS_STEPS" "t=$(field "mujoco_headless_$i.log" wall_s)")")
+  done
+  read -r MUJOCO_HEADLESS_RATE MUJOCO_HEADLESS_MIN MUJOCO_HEADLESS_MAX <<<"$(printf '%s\n' "${MUJOCO_HEADLESS_RATES[@]}" | stats)"
+fi
+
 measure_round "$ROUNDS"
 
 # --- (f), (g) The core alone ------------------------------------------------------------------
@@ -304,6 +355,11 @@ read -r BARE_RATE BARE_MIN BARE_MAX <<<"$(spread rate "${PING_LOGS[@]}")"
 read -r INTRA1_RATE INTRA1_MIN INTRA1_MAX <<<"$(spread rate "${INTRA1_LOGS[@]}")"
 read -r INTRA2_RATE INTRA2_MIN INTRA2_MAX <<<"$(spread rate "${INTRA2_LOGS[@]}")"
 read -r SIM_RATE SIM_MIN SIM_MAX <<<"$(spread rate "${ANSWER_LOGS[@]}")"
+if [[ -z "$MUJOCO_SKIPPED" ]]; then
+  MUJOCO_BARE_LOGS=()
+  for ((r = 1; r <= ROUNDS; r++)); do MUJOCO_BARE_LOGS+=("mujoco_bare_$r.log"); done
+  read -r MUJOCO_BARE_RATE MUJOCO_BARE_MIN MUJOCO_BARE_MAX <<<"$(spread rate "${MUJOCO_BARE_LOGS[@]}")"
+fi
 SIM_REPEATS=0
 for log in "${ANSWER_LOGS[@]}"; do
   SIM_REPEATS=$((SIM_REPEATS + $(field "$log" repeats)))
@@ -373,6 +429,16 @@ fi
 text_row "(i) nodelet loop, robust.yaml seed:=0, to a passing table" \
   "$(calc 'printf "roslaunch to SUITE PASSED %.2f s (%.2f to %.2f): median of %d; %d steps, %d episodes, %.1f s of training", a, b, c, n, m, e, t' \
     "a=$TO_PASSED" "b=$TO_PASSED_MIN" "c=$TO_PASSED_MAX" "n=$ROBUST_RUNS" "m=$ROBUST_STEPS" "e=$ROBUST_EPISODES" "t=$ROBUST_S")"
+if [[ -z "$MUJOCO_SKIPPED" ]]; then
+  row "(j) MuJoCo nodelet loop, mujoco_cartpole.yaml: steps" "$MUJOCO_RATE" \
+    "$MUJOCO_STEPS steps, $MUJOCO_EPISODES episodes, $(calc 'printf "%.1f", t' "t=$MUJOCO_S") s to SOLVED (median of $NODELET_RUNS; rounded to 0.1 s)"
+  row "(k) train_headless, mujoco_cartpole.yaml seed 0: steps" "$MUJOCO_HEADLESS_RATE" \
+    "$MUJOCO_HEADLESS_STEPS steps to solved; $(range "$MUJOCO_HEADLESS_MIN" "$MUJOCO_HEADLESS_MAX" runs)"
+  row "(l) bare loop of mj_step, frame skip $MUJOCO_FRAME_SKIP: steps" "$MUJOCO_BARE_RATE" \
+    "mujoco_bare_loop, mjcf/cartpole.xml; $(range "$MUJOCO_BARE_MIN" "$MUJOCO_BARE_MAX")"
+else
+  text_row "(j), (k), (l) the MuJoCo sim, headless and a bare mj_step loop" "skipped: $MUJOCO_SKIPPED"
+fi
 
 # --- Targets ----------------------------------------------------------------------------------
 echo
@@ -404,11 +470,25 @@ if [[ -z "$ANCHOR_SKIPPED" ]]; then
 else
   printf "  %-47s not measured, the anchor was skipped: %s\n" "robust roslaunch-to-PASSED (i) vs anchor (h)" "$ANCHOR_SKIPPED"
 fi
+# Issue 28: the MuJoCo sim in lockstep as a nodelet >= 0.8x a bare mj_step loop's rate; headless
+# training's cost a step <= 1.2x the bare loop's (the bare loop's rate / headless's).
+if [[ -z "$MUJOCO_SKIPPED" ]]; then
+  at_least "MuJoCo nodelet loop (j) / bare mj_step loop (l)" "$MUJOCO_RATE" "$MUJOCO_BARE_RATE" 0.8
+  calc 'v = b / h; if (v <= t) printf "  %-47s %8.2f  (target <= %g): MET, %.0f %% below\n", name, v, t, 100 * (1 - v / t);
+    else printf "  %-47s %8.2f  (target <= %g): MISSED by %.2f (%.0f %% over)\n", name, v, t, v - t, 100 * (v / t - 1)' \
+    "name=headless MuJoCo cost a step (k) / bare loop (l)" "b=$MUJOCO_BARE_RATE" "h=$MUJOCO_HEADLESS_RATE" "t=1.2"
+else
+  printf "  %-47s not measured: %s\n" "MuJoCo (j), (k) vs bare loop (l)" "$MUJOCO_SKIPPED"
+fi
 
 # The same seed trains the same table in every loop: the step counts must agree.
 if [[ "$TRAIN_STEPS $NODELET_STEPS $LOOPBACK_STEPS" != "$HEADLESS_STEPS $HEADLESS_STEPS $HEADLESS_STEPS" ]]; then
   echo
   echo "warning: seed 0 trained differently: (d) $TRAIN_STEPS, (e) $NODELET_STEPS, (f) $LOOPBACK_STEPS, (g) $HEADLESS_STEPS steps"
+fi
+if [[ -z "$MUJOCO_SKIPPED" && "$MUJOCO_STEPS" != "$MUJOCO_HEADLESS_STEPS" ]]; then
+  echo
+  echo "warning: mujoco_cartpole.yaml seed 0 trained differently: (j) $MUJOCO_STEPS steps, (k) $MUJOCO_HEADLESS_STEPS"
 fi
 if [[ "$ROBUST_STEPS" != "$ROBUST_HEADLESS_STEPS" ]]; then
   echo

@@ -162,6 +162,16 @@ void readFinite(SectionReader& priv, const std::string& name, double& value)
     priv.fail(name, SectionReader::numberText(value), "must be finite");
 }
 
+// A MuJoCo model's joints are the robot's by default (the sim publishes them; ~cart_joint and
+// ~pole_joint still win): one config names them for the sim and the controller alike.
+void useModelJoints(const EngineParams& engine, RobotInterfaceParams& robot)
+{
+  if (engine.kind == EngineKind::Equations)
+    return;
+  robot.cart_joint = engine.cart_joint;
+  robot.pole_joint = engine.pole_joint;
+}
+
 // The robot's joints, offsets and command (robot_interface.h; docs/your_own_cartpole.md).
 void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& robot)
 {
@@ -316,9 +326,11 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   priv.read("evaluation_episodes", run.evaluation_episodes, 0);
   // What the sim poses as (evaluate.launch suite_case:=NAME), for the verdict to say.
   unsigned max_steps = kEvaluationMaxSteps;
+  EngineParams robot_engine = settings.training.engine;  // whose joints the robot has by default
   if (const auto found = readSuiteCase(priv, settings.training))
   {
     const auto& [suite, suite_case] = *found;
+    robot_engine = suite_case.engine;
     max_steps = suite.max_episode_steps;
     if (run.learning)
       priv.fail("suite_case", "'" + suite_case.name + "'", "only with mode evaluate: the verdict says the case");
@@ -368,6 +380,7 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
                 "must be 4 finite values > 0: |x|, |x_dot|, |theta|, |theta_dot| bounds");
     protocol.start_region[i] = region[i];
   }
+  useModelJoints(robot_engine, settings.robot);
   readRobotInterface(priv, settings.training.physics.tau, settings.robot);
   // The freshness guard's bound: a few decision periods, and no less than 0.1 s (a real-time
   // machine's hiccup is not a robot gone). 0 turns it off: a lockstep sim holds no command.
@@ -395,7 +408,7 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
 SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource& source)
 {
   SimSettings settings;
-  readPhysics(shared, settings.physics, settings.start_state_bound);
+  readPhysics(shared, settings.physics, settings.start_state_bound, settings.engine);
 
   // The same reader and checks as the shared sections; a key it does not know (a typo such as
   // lockstep_timout) stops the node instead of being ignored.
@@ -405,21 +418,20 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
   settings.mode = mode == "lockstep" ? SimMode::Lockstep : SimMode::Realtime;
   priv.read("seed", settings.seed, 0);
   settings.perturbations = readPerturbations(shared);
+  checkPerturbationsFitEngine(shared, settings.engine, settings.perturbations);
   // A suite case's physics, start region and perturbations replace the shared ones, as
   // train_headless --evaluate TABLE --suite FILE runs it; its seed is the suite's unless ~seed is set.
   TrainingConfig base;
   base.physics = settings.physics;
   base.start_state_bound = settings.start_state_bound;
+  base.engine = settings.engine;
   if (const auto found = readSuiteCase(priv, base))
   {
     const auto& [suite, suite_case] = *found;
-    if (suite_case.engine.kind != EngineKind::Equations)
-      priv.fail("suite_case", "'" + suite_case.name + "'",
-                "its physics/engine is " + toString(suite_case.engine.kind) +
-                    "; the sim runs the equations only (train_headless --suite runs it)");
     settings.suite = suite.origin;
     settings.suite_case = suite_case.name;
     settings.physics = suite_case.physics;
+    settings.engine = suite_case.engine;
     settings.start_state_bound = suite_case.start_state_bound;
     settings.perturbations = suite_case.perturbations;
     if (source.keysUnder("seed").empty())
@@ -459,6 +471,7 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
                   instead);
   }
   RobotInterfaceParams& pose = settings.pose;
+  useModelJoints(settings.engine, pose);
   for (const auto& [name, joint] :
        {std::pair<const char*, std::string*>{"cart_joint", &pose.cart_joint}, {"pole_joint", &pose.pole_joint}})
   {
@@ -494,7 +507,7 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
                                     {"pole_frame", &settings.pole_frame}})
   {
     priv.read(name, *frame);
-    if (frame->empty())
+    if (frame->empty() && !source.keysUnder(name).empty())
       priv.fail(name, "''", "frame names must not be empty");
   }
   priv.refuseUnknown();

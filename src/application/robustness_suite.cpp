@@ -117,9 +117,7 @@ RobustnessSuite parseRobustnessSuite(const std::string& yaml, const std::string&
     }
     // The case's sections, read by the configuration's own readers: the same keys, checks and messages.
     // (A case's model is relative to the suite file's folder.)
-    const std::size_t slash = origin.find_last_of('/');
-    const auto source = parseYamlParameters(YAML::Dump(sections), origin + ": case " + c.name,
-                                            slash == std::string::npos ? "." : origin.substr(0, slash + (slash == 0)));
+    const auto source = parseYamlParameters(YAML::Dump(sections), origin + ": case " + c.name, configFolder(origin));
     readPhysics(*source, c.physics, c.start_state_bound, c.engine);
     c.perturbations = readPerturbations(*source);
     checkPerturbationsFitEngine(*source, c.engine, c.perturbations);

@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/ros/cartpole_sim.h"
 
 #include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/simulation/physics_engines.h"
 #include "cartpole_qlearning/ros/conversions.h"
 #include "parameter_source.h"
 #include "start_up.h"
@@ -36,10 +37,30 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
 {
   const std::lock_guard<std::mutex> lock(mutex_);
   readParameters();
-  // The core's simulation, perturbations included, built as train_headless builds its own: the same
-  // seed and config give the same episodes.
-  simulation_ = std::make_unique<CartPoleSimulation>(settings_.physics, settings_.start_state_bound, settings_.seed,
-                                                     settings_.perturbations);
+  // The core's simulation, perturbations included, on the engine the config asks for (the equations
+  // or a MuJoCo model), built by the factory train_headless builds its own with: the same seed and
+  // config give the same episodes.
+  try
+  {
+    simulation_ = std::make_unique<CartPoleSimulation>(makeSimulation(
+        settings_.physics, settings_.engine, settings_.start_state_bound, settings_.seed, settings_.perturbations));
+  }
+  catch (const EngineError& e)
+  {
+    // A relative model without config_file was taken relative to the node's working folder (~/.ros).
+    const bool unanchored = !settings_.engine.model.empty() && settings_.engine.model.front() != '/' &&
+                            RosParameterSource(nh_).folder().empty();
+    throw ConfigError(std::string(e.what()) +
+                      (unanchored ? " (a relative physics/model is relative to the folder of the parameter " +
+                                        nh_.resolveName("config_file") +
+                                        ", which is not set: the launch files set it to their config)"
+                                  : ""));
+  }
+  // TF shows the engine's bodies unless told other frames.
+  if (settings_.cart_frame.empty())
+    settings_.cart_frame = simulation_->engine().cartBody().empty() ? "cart" : simulation_->engine().cartBody();
+  if (settings_.pole_frame.empty())
+    settings_.pole_frame = simulation_->engine().poleBody().empty() ? "pole" : simulation_->engine().poleBody();
 
   if (settings_.mode == SimMode::Lockstep)
     joint_state_pub_ = nh_.advertise<sensor_msgs::JointState>(
@@ -92,12 +113,13 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
           });
     publishState(ros::Time::now());
   }
-  say(ros::console::levels::Info,
-      "cartpole_sim: %s mode, tau %g s, integrator %s, seed %llu, start state [%g, %g, %g, %g]%s%s",
-      settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau,
-      toString(settings_.physics.integrator).c_str(), static_cast<unsigned long long>(settings_.seed),
-      simulation_->state()[0], simulation_->state()[1], simulation_->state()[2], simulation_->state()[3],
-      settings_.publish_clock ? ", publishing /clock" : "",
+  const std::string engine = settings_.engine.kind == EngineKind::Equations
+                                 ? "integrator " + toString(settings_.physics.integrator)
+                                 : "MuJoCo model " + settings_.engine.model;
+  say(ros::console::levels::Info, "cartpole_sim: %s mode, tau %g s, %s, seed %llu, start state [%g, %g, %g, %g]%s%s",
+      settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau, engine.c_str(),
+      static_cast<unsigned long long>(settings_.seed), simulation_->state()[0], simulation_->state()[1],
+      simulation_->state()[2], simulation_->state()[3], settings_.publish_clock ? ", publishing /clock" : "",
       own_rate ? (", joint_states every " + SectionReader::numberText(settings_.publish_period) + " s").c_str() : "");
   if (!settings_.suite_case.empty())
     say(ros::console::levels::Info, "cartpole_sim: posing as case %s of %s", settings_.suite_case.c_str(),

@@ -53,6 +53,14 @@ std::string RosParameterSource::describe(const std::string& key) const
   return "parameter " + nh_.resolveName(key);
 }
 
+std::string RosParameterSource::folder() const
+{
+  std::string path;
+  if (!nh_.getParam("config_file", path) || path.empty())
+    return "";
+  return configFolder(path);
+}
+
 bool RosParameterSource::get(const std::string& key, double& value) const
 {
   XmlRpcValue v;

@@ -24,6 +24,10 @@ public:
   std::vector<std::string> keysUnder(const std::string& section) const override;
   std::string origin() const override;
   std::string describe(const std::string& key) const override;
+  // The folder of the config file the launch loaded here, which it names in config_file beside
+  // the config's sections (a relative physics/model is relative to it, as train_headless
+  // --config has it); "" when none is named.
+  std::string folder() const override;
 
 private:
   ros::NodeHandle nh_;

@@ -182,6 +182,18 @@ MujocoEngine::~MujocoEngine()
   mj_deleteModel(model_);
 }
 
+std::string MujocoEngine::cartBody() const
+{
+  const char* name = mj_id2name(model_, mjOBJ_BODY, cart_body_);
+  return name != nullptr ? name : "";
+}
+
+std::string MujocoEngine::poleBody() const
+{
+  const char* name = mj_id2name(model_, mjOBJ_BODY, pole_body_);
+  return name != nullptr ? name : "";
+}
+
 double MujocoEngine::forceLimit() const
 {
   if (!model_->actuator_ctrllimited[actuator_])

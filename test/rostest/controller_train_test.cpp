@@ -1,6 +1,8 @@
 // train.launch's nodes, lockstep, seed 0: the controller solves CartPole-v1 over ROS topics,
 // writes the same table as train_headless, and a fresh greedy controller balances with it.
-// With ~config (controller_train_tiles.test: tiles.yaml) the same over that config.
+// With ~config (controller_train_tiles.test: tiles.yaml) the same over that config; with
+// controller_train_mujoco.test, train.launch itself on the project's MuJoCo model, whose joint
+// names joint_states then carry.
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
@@ -11,6 +13,7 @@
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
 
 #include <array>
 #include <cstdio>
@@ -38,12 +41,13 @@ std::string qTableDir()
   return kTableDir.path();
 }
 
-// The config file loaded over cartpole.yaml in the controller's namespace.
+// The config file loaded (over cartpole.yaml, unless ~config is an absolute path, which the .test
+// gave train.launch as is) in the controller's namespace.
 std::string configFile()
 {
   std::string file = "cartpole.yaml";
   ros::param::get("~config", file);
-  return file;
+  return file.front() == '/' ? file : CARTPOLE_CONFIG_DIR "/" + file;
 }
 }  // namespace
 
@@ -52,10 +56,18 @@ class ControllerTrainTest : public ::testing::Test
 protected:
   static std::vector<EpisodeStats> stats_;
   static ros::Subscriber sub_;
+  static ros::Subscriber joints_sub_;
+  static std::vector<std::string> joint_names_;  // of the first joint_states seen
 
   static void SetUpTestSuite()
   {
     ros::NodeHandle nh;
+    joints_sub_ = nh.subscribe<sensor_msgs::JointState>(
+        "/cartpole/joint_states", 1,
+        boost::function<void(const sensor_msgs::JointStateConstPtr&)>([](const sensor_msgs::JointStateConstPtr& m) {
+          if (joint_names_.empty())
+            joint_names_ = m->name;
+        }));
     sub_ = nh.subscribe<EpisodeStats>(
         "/cartpole/episode_stats", 1000,
         boost::function<void(const cartpole_qlearning::EpisodeStatsConstPtr&)>(
@@ -66,10 +78,13 @@ protected:
   static void TearDownTestSuite()
   {
     sub_ = ros::Subscriber();
+    joints_sub_ = ros::Subscriber();
   }
 };
 std::vector<EpisodeStats> ControllerTrainTest::stats_;
 ros::Subscriber ControllerTrainTest::sub_;
+ros::Subscriber ControllerTrainTest::joints_sub_;
+std::vector<std::string> ControllerTrainTest::joint_names_;
 
 TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
 {
@@ -91,17 +106,23 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
   EXPECT_EQ(solved.episode, table.episodes);
   EXPECT_EQ(solved.total_steps, table.steps);
   const std::string headless = qTableDir() + "/headless.yaml";
-  const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " + CARTPOLE_CONFIG_DIR "/" +
-                              configFile() + " --no-run-folder --save " + headless;
+  const std::string command = std::string(TRAIN_HEADLESS) + " --seed 0 --quiet --config " + configFile() +
+                              " --no-run-folder --save " + headless;
   ASSERT_EQ(0, std::system(command.c_str())) << command;
   EXPECT_EQ(fileText(headless), fileText(trained)) << "train.launch (lockstep) and train_headless differ for seed 0";
   // The table is of the features the config asks for, as the test names them.
   std::string features;
   ros::param::get("~features", features);
   EXPECT_EQ(features, toString(table.features().kind));
-  const auto source = cartpole_qlearning::loadYamlParameters(CARTPOLE_CONFIG_DIR "/" + configFile());
+  const auto source = cartpole_qlearning::loadYamlParameters(configFile());
   EXPECT_EQ("", cartpole_qlearning::QTable(cartpole_qlearning::readAgent(*source).featureParams(), table.actions())
                     .shapeMismatch(table));
+  // joint_states name the joints as the engine does: a MuJoCo model's own, else the URDF's.
+  const cartpole_qlearning::EngineParams engine = cartpole_qlearning::readTrainingConfig(*source).engine;
+  const std::vector<std::string> joints = engine.kind == cartpole_qlearning::EngineKind::Mujoco
+                                              ? std::vector<std::string>{engine.cart_joint, engine.pole_joint}
+                                              : std::vector<std::string>{"cart_joint", "pole_joint"};
+  EXPECT_EQ(joints, joint_names_);
 
   // 3. The run's learning curve: episodes.csv beside its checkpoint, a header and one row per
   //    episode, each the episode_stats message of that episode.

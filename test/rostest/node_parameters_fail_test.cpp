@@ -4,6 +4,8 @@
 // and the value. Ok cases, with valid values set the same way, prove the nodes read those
 // namespaces and stay up, so the ko cases cannot pass vacuously. Only this wiring is checked
 // here: the rules themselves are gtests of the core's readers (node_settings_test.cpp).
+#include "cartpole_qlearning/simulation/physics_engines.h"
+
 #include "test_support.h"
 #include "text_match.h"
 
@@ -179,6 +181,52 @@ TEST_F(NodeParametersTest, SimNodeletRefusesAnUnknownMode)
 {
   expectRefused(kSimNodelet, "/ko_sim_nodelet_mode", {{"cartpole_sim/mode", XmlRpcValue("warp")}},
                 "[/~]mode\\b.*\\bwarp\\b");
+}
+
+// A MuJoCo model (physics/engine mujoco): relative to the folder of config_file, which the launch
+// files set beside the config they load; one that cannot serve stops the sim naming the key and the model.
+const std::string kModelConfig = CARTPOLE_CONFIG_DIR "/mujoco_cartpole.yaml";
+
+Parameters modelPhysics(const std::string& model)
+{
+  return {{"physics/engine", XmlRpcValue("mujoco")},
+          {"physics/model", XmlRpcValue(model)},
+          {"physics/cart_joint", XmlRpcValue("cart_joint")},
+          {"physics/pole_joint", XmlRpcValue("pole_joint")},
+          {"physics/actuator", XmlRpcValue("cart_motor")}};
+}
+
+TEST_F(NodeParametersTest, SimStepsAMujocoModelRelativeToTheConfigFile)
+{
+  if (!cartpole_qlearning::mujocoAvailable())
+  {
+    // Without MuJoCo the sim says how to get it.
+    expectRefused(kSim, "/ko_sim_no_mujoco", modelPhysics("../mjcf/cartpole.xml"),
+                  "physics/engine = 'mujoco' is not available: cartpole_qlearning was built without MuJoCo");
+    return;
+  }
+  Parameters parameters = modelPhysics("../mjcf/cartpole.xml");
+  parameters.push_back({"config_file", XmlRpcValue(kModelConfig)});
+  parameters.push_back({"cartpole_sim/mode", XmlRpcValue("lockstep")});
+  expectRunning(kSim, "/ok_sim_mujoco", parameters,
+                {"lockstep mode, tau 0.02 s, MuJoCo model " CARTPOLE_CONFIG_DIR "/../mjcf/cartpole.xml"});
+}
+
+TEST_F(NodeParametersTest, SimRefusesAMujocoModelThatCannotServe)
+{
+  if (!cartpole_qlearning::mujocoAvailable())
+    GTEST_SKIP() << "built without MuJoCo (SimStepsAMujocoModelRelativeToTheConfigFile checks the message)";
+  expectRefused(kSim, "/ko_sim_model", modelPhysics("/nonexistent/cartpole.xml"),
+                "physics/model = '/nonexistent/cartpole.xml' cannot be loaded");
+  // A relative model with no config_file to be relative to.
+  expectRefused(kSim, "/ko_sim_model_relative", modelPhysics("../mjcf/cartpole.xml"),
+                "physics/model = '../mjcf/cartpole.xml' cannot be loaded[\\s\\S]*the parameter "
+                "/ko_sim_model_relative/config_file, which "
+                "is not set");
+  Parameters rail = modelPhysics("../mjcf/cartpole.xml");
+  rail.push_back({"config_file", XmlRpcValue(kModelConfig)});
+  rail.at(2).second = XmlRpcValue("rail");
+  expectRefused(kSim, "/ko_sim_joint", rail, "physics/cart_joint = 'rail' in the model .*cartpole.xml: no such joint");
 }
 
 // qlearning_controller

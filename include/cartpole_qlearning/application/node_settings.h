@@ -128,6 +128,7 @@ enum class SimMode
 struct SimSettings
 {
   CartPoleParams physics;           // the shared physics section
+  EngineParams engine;              // physics/engine and, for a MuJoCo model, its model, joints and actuator
   double start_state_bound = 0.05;  // physics/start_state_bound
   SimMode mode = SimMode::Realtime;
   std::uint64_t seed = 0;
@@ -139,8 +140,9 @@ struct SimSettings
   double tf_rate = 30.0;  // [Hz] lockstep: TF at most this often (wall clock)
   double track_y = 0.0;   // [m] where the track lies along world y (several robots side by side)
   std::string world_frame = "world";
-  std::string cart_frame = "cart";
-  std::string pole_frame = "pole";
+  // "": the engine's bodies (cartBody(), poleBody(): the equations' cart and pole, a model's own).
+  std::string cart_frame;
+  std::string pole_frame;
   // What a real cart-pole does (the shared perturbations section, as train_headless reads it from
   // its config), or the suite case's when ~suite_case names one.
   PerturbationParams perturbations;
@@ -148,7 +150,8 @@ struct SimSettings
   // region and perturbations over the shared ones; its seed unless ~seed is given). "": none.
   std::string suite;
   std::string suite_case;
-  // Posing as another cart-pole (docs/your_own_cartpole.md): its joint names, offsets and signs
+  // Posing as another cart-pole (docs/your_own_cartpole.md): its joint names (by default a MuJoCo
+  // model's cart_joint and pole_joint, else cart_joint and pole_joint), offsets and signs
   // (~cart_joint, ~pole_joint, ~cart_zero, ~cart_sign, ~pole_upright, ~pole_angle_sign), whole turns
   // added to the pole's reading (~pole_turns) and whether velocities are published.
   // (~effort_sign too: -1, a robot whose + effort pushes the cart toward -x.)

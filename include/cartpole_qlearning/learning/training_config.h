@@ -219,6 +219,9 @@ private:
 
 // A YAML document as a parameter source. Throws ConfigError when the file cannot be read or parsed.
 std::unique_ptr<ParameterSource> loadYamlParameters(const std::string& path);
+// The folder a config file's relative paths are relative to: the file's own ("config/x.yaml" ->
+// "config", "x.yaml" -> ".", "/x.yaml" -> "/"). The nodes use it on the launch's config_file.
+std::string configFolder(const std::string& path);
 // (folder: what folder() answers; loadYamlParameters gives the file's.)
 std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin,
                                                      const std::string& folder = "");
@@ -267,8 +270,7 @@ struct TrainingConfig
 
 // Each reader starts from the defaults, overrides what the source sets, validates, and throws
 // ConfigError naming the key on a bad value or an unknown key in its section.
-void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound);
-// The same with the engine's keys: engine (equations or mujoco), and for mujoco model (an MJCF
+// The physics section with the engine's keys: engine (equations or mujoco), and for mujoco model (an MJCF
 // file: absolute, or relative to source.folder(); ${NAME} is the environment variable NAME),
 // cart_joint, pole_joint and actuator. The equations' own keys (gravity, masses, half_length,
 // integrator, friction) are refused beside engine mujoco, the model's keys beside the equations.

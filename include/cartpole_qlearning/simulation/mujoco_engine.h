@@ -53,6 +53,9 @@ public:
     return clamps_;
   }
 
+  // The bodies cart_joint and pole_joint move.
+  std::string cartBody() const override;
+  std::string poleBody() const override;
   // mj_steps per tau (tau / the model's timestep).
   int frameSkip() const
   {

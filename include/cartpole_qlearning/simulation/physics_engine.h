@@ -75,6 +75,16 @@ public:
   virtual const CartPoleState& state() const = 0;
   // Steps whose command the drive clamped, since the engine was made.
   virtual std::uint64_t clamps() const = 0;
+  // The names of the cart's and the pole's bodies (a model's own; the URDF's links, cart and pole,
+  // for the equations): the sim's TF frames unless it is told others.
+  virtual std::string cartBody() const
+  {
+    return "cart";
+  }
+  virtual std::string poleBody() const
+  {
+    return "pole";
+  }
 };
 
 // CartPole-v1's equations (cartpole_dynamics.h) as an engine.

@@ -367,8 +367,12 @@ TEST(SimSettings, DefaultsAreTheDocumentedOnes)
   EXPECT_TRUE(s.publish_tf);
   EXPECT_EQ(0.0, s.track_y);
   EXPECT_EQ("world", s.world_frame);
-  EXPECT_EQ("cart", s.cart_frame);
-  EXPECT_EQ("pole", s.pole_frame);
+  // "": the engine's bodies, the equations' cart and pole (PhysicsEngine::cartBody, poleBody).
+  EXPECT_EQ("", s.cart_frame);
+  EXPECT_EQ("", s.pole_frame);
+  EXPECT_EQ(EngineKind::Equations, s.engine.kind);
+  EXPECT_EQ("cart_joint", s.pose.cart_joint);
+  EXPECT_EQ("pole_joint", s.pose.pole_joint);
   EXPECT_FALSE(s.perturbations.any());
   EXPECT_EQ("", s.suite_case);
   EXPECT_EQ(0.05, s.start_state_bound);
@@ -494,6 +498,53 @@ TEST(SimSettings, PosesAsACaseOfTheSuite)
               "suite_case = 'late' is not allowed (the cases of " + suite + ": nominal, one_step_late, sensor_noise");
   EXPECT_SAYS(simError("suite_case: nominal"), "suite_case = 'nominal' is not allowed (needs ~suite");
   EXPECT_SAYS(simError("{suite: /nonexistent.yaml, suite_case: nominal}"), "/nonexistent.yaml: cannot be read");
+}
+
+// A MuJoCo model's physics (config/mujoco_cartpole.yaml's, as the launch files load it): the sim
+// steps it, and the sim and the controller name the joints as the model does.
+const char* const kModelPhysics =
+    "physics: {engine: mujoco, model: ../mjcf/model.xml, cart_joint: rail, pole_joint: swing, actuator: motor}";
+
+TEST(SimSettings, ReadsAMujocoModelRelativeToTheConfigsFolderAndPublishesItsJointNames)
+{
+  const SimSettings s = readSimSettings(*parseYamlParameters(kModelPhysics, "/cartpole", "/home/me/config"),
+                                        *parseYamlParameters("", kSim));
+  EXPECT_EQ(EngineKind::Mujoco, s.engine.kind);
+  EXPECT_EQ("/home/me/config/../mjcf/model.xml", s.engine.model);
+  EXPECT_EQ("motor", s.engine.actuator);
+  EXPECT_EQ("rail", s.pose.cart_joint);
+  EXPECT_EQ("swing", s.pose.pole_joint);
+  // ~cart_joint and ~pole_joint still rename them (posing as another robot).
+  const SimSettings posed = readSim("{cart_joint: slider_to_cart, pole_joint: cart_to_pole}", kModelPhysics);
+  EXPECT_EQ("slider_to_cart", posed.pose.cart_joint);
+  EXPECT_EQ("cart_to_pole", posed.pose.pole_joint);
+  // The model's keys beside the equations, and the equations' beside a model, are refused as in train_headless.
+  EXPECT_SAYS(simError("", "physics: {engine: mujoco, model: m.xml, gravity: 9.8}"),
+              "physics/gravity is not allowed with physics/engine mujoco");
+  EXPECT_SAYS(simError("", "perturbations: {half_length: [0.9, 1.1]}\n" + std::string(kModelPhysics)),
+              "perturbations/half_length is not allowed with physics/engine mujoco");
+}
+
+TEST(SimSettings, PosesAsAMujocoCaseOfTheSimToSimSuite)
+{
+  const std::string suite = std::string(CARTPOLE_CONFIG_DIR) + "/sim_to_sim_suite.yaml";
+  const SimSettings s = readSim("{suite: " + suite + ", suite_case: mujoco}");
+  EXPECT_EQ(EngineKind::Mujoco, s.engine.kind);
+  EXPECT_EQ(std::string(CARTPOLE_CONFIG_DIR) + "/../mjcf/cartpole.xml", s.engine.model);
+  EXPECT_EQ("cart_joint", s.pose.cart_joint);
+  EXPECT_EQ(1000u, s.seed);
+}
+
+TEST(ControllerSettings, FindsAMujocoModelsJointsByTheirNames)
+{
+  const ControllerSettings s = readController("", kModelPhysics);
+  EXPECT_EQ("rail", s.robot.cart_joint);
+  EXPECT_EQ("swing", s.robot.pole_joint);
+  EXPECT_EQ("rail", s.robot.command_joint);
+  // A robot's own names still win (robot.launch cart_joint:=...).
+  EXPECT_EQ("slider_to_cart", readController("cart_joint: slider_to_cart", kModelPhysics).robot.cart_joint);
+  // The equations' robot keeps the URDF's names.
+  EXPECT_EQ("cart_joint", readController("").robot.cart_joint);
 }
 
 TEST(SimSettings, RefusesAnInfiniteTrackOrAnEmptyFrame)

@@ -212,11 +212,6 @@ TEST(Config, EngineKeysThatDoNotApplyAreRefused)
       errorOf("physics: {engine: mujoco, model: m.xml}\nperturbations: {half_length: [0.9, 1.1]}");
   EXPECT_NE(std::string::npos, length.find("perturbations/half_length is not allowed with physics/engine mujoco"))
       << length;
-  // The 3-argument reader (the sim node's, for now) runs the equations only.
-  CartPoleParams physics;
-  double bound = 0.05;
-  EXPECT_THROW(readPhysics(*parseYamlParameters("physics: {engine: mujoco, model: m.xml}", "t"), physics, bound),
-               ConfigError);
 }
 
 TEST(Config, TheAliveRewardIsInvertedPendulumsV5)
