@@ -74,7 +74,8 @@ def table():
         ("`bench/`", "benchmarks (Google Benchmark for the core; the lockstep loops against raw TCPROS and "
          "intra-process round trips; the Python anchor)"),
         ("`scripts/`", "what users run: " + quoted(files("scripts"))),
-        ("`tools/`", "what developers run (CI, fuzzing, sanitizers, pictures, figures, reference trajectories): "
+        ("`tools/`", "what developers run (CI, fuzzing, sanitizers, pictures, figures, reference trajectories, the pages' output "
+         "blocks checked): "
          + quoted(files("tools"))),
         ("`.ci/`", "`run`: what CI runs (the README's test command in a workspace of its own)"),
     ]
