@@ -18,6 +18,10 @@
 #        of the launch; median of BENCH_NODELET_RUNS launches
 #   (f)  LockstepLoopback to solved (the protocol classes without ROS) and (g) HeadlessTrainer to
 #        solved (train_headless's loop): steps/s from core_benchmark, median of 3 repetitions
+#   (g2) the robustness suite's verdict on (g)'s table (greedy, no learning; seed 0's default table
+#        fails the suite): whole, every case to its last episode, on one thread and one per core
+#        (what a finished run prints), and until decided (stopped at its first failing case, as
+#        training judges a table): wall ms and greedy steps/s beside (g)'s training steps/s
 #   (h)  the Python anchor ../shared/anchors/gym_tabular_q.py (Gymnasium + numpy, the tutorial's
 #        method in one process), to solved: median wall time over BENCH_ANCHOR_SEEDS, which
 #        (e)'s roslaunch-to-SOLVED time and (i)'s roslaunch-to-SUITE-PASSED time are compared
@@ -33,7 +37,7 @@
 #        config:=.../config/mujoco_cartpole.yaml seed:=0 (mjcf/cartpole.xml, two mj_steps a tau), to
 #        solved: steps/s as in (e), median of BENCH_NODELET_RUNS launches
 #   (k)  train_headless --config config/mujoco_cartpole.yaml --seed 0 to solved: steps / its
-#        wall_s, median of 3 runs
+#        train_s (the saved table's verdict apart), median of 3 runs
 #   (l)  mujoco_bare_loop: mj_step twice a step on the same model, a bang-bang ctrl and a reset
 #        when the pole falls, nothing of this package: steps/s, measured in each round as (a)-(c);
 #        (j) and (k) are compared with it. (j), (k), (l) need a build with MuJoCo; the rows then
@@ -301,7 +305,7 @@ if [[ -z "$MUJOCO_SKIPPED" ]]; then
     run "mujoco_headless_$i.log" 120 "${PIN[@]}" "$TRAIN_HEADLESS" --config "$PKG_DIR/config/mujoco_cartpole.yaml" \
       --seed 0 --no-run-folder --quiet
     MUJOCO_HEADLESS_STEPS=$(field "mujoco_headless_$i.log" steps)
-    MUJOCO_HEADLESS_RATES+=("$(calc 'printf "%.1f", m / t' "m=$MUJOCO_HEADLESS_STEPS" "t=$(field "mujoco_headless_$i.log" wall_s)")")
+    MUJOCO_HEADLESS_RATES+=("$(calc 'printf "%.1f", m / t' "m=$MUJOCO_HEADLESS_STEPS" "t=$(field "mujoco_headless_$i.log" train_s)")")
   done
   read -r MUJOCO_HEADLESS_RATE MUJOCO_HEADLESS_MIN MUJOCO_HEADLESS_MAX <<<"$(printf '%s\n' "${MUJOCO_HEADLESS_RATES[@]}" | stats)"
 fi
@@ -310,7 +314,7 @@ measure_round "$ROUNDS"
 
 # --- (f), (g) The core alone ------------------------------------------------------------------
 echo "(f), (g) core_benchmark: LockstepLoopback and HeadlessTrainer to solved, 3 repetitions" >&2
-run core_benchmark.log 120 "${PIN[@]}" "$CORE_BENCHMARK" --benchmark_filter='(LockstepLoopback|HeadlessTraining)ToSolved' \
+run core_benchmark.log 120 "${PIN[@]}" "$CORE_BENCHMARK" --benchmark_filter='(LockstepLoopback|HeadlessTraining)ToSolved|SuiteVerdict' \
   --benchmark_repetitions=3 --benchmark_min_time=0.2 --benchmark_out="$WORK/core_benchmark.json" --benchmark_out_format=json
 # "median min max steps episodes" of steps_per_s over the repetitions of one benchmark.
 core_figures()
@@ -329,6 +333,28 @@ figures=$(core_figures BM_LockstepLoopbackToSolved) || exit 1
 read -r LOOPBACK_RATE LOOPBACK_MIN LOOPBACK_MAX LOOPBACK_STEPS LOOPBACK_EPISODES <<<"$figures"
 figures=$(core_figures BM_HeadlessTrainingToSolved) || exit 1
 read -r HEADLESS_RATE HEADLESS_MIN HEADLESS_MAX HEADLESS_STEPS HEADLESS_EPISODES <<<"$figures"
+# "median_ms min_ms max_ms greedy_steps_per_s steps" of one suite verdict benchmark (NAME/THREADS).
+verdict_figures()
+{
+  python3 - "$WORK/core_benchmark.json" "$1" <<'EOF' || die "no result for $1 from core_benchmark (log: $WORK/core_benchmark.log)"
+import json, statistics, sys
+runs = [b for b in json.load(open(sys.argv[1]))["benchmarks"]
+        if b["name"].startswith(sys.argv[2] + "/") and b.get("run_type", "iteration") == "iteration"]
+if not runs or any(b.get("error_occurred") for b in runs):
+    sys.exit(1)
+ms = [b["real_time"] for b in runs]  # the benchmarks report milliseconds
+print(statistics.median(ms), min(ms), max(ms), statistics.median(b["greedy_steps_per_s"] for b in runs),
+      int(runs[0]["steps"]))
+EOF
+}
+VERDICT_ROWS=()
+for verdict in "BM_SuiteVerdictWhole/1 whole, one thread" "BM_SuiteVerdictWhole/0 whole, one thread per core" \
+  "BM_SuiteVerdictUntilDecided/1 until decided, one thread" "BM_SuiteVerdictUntilDecided/0 until decided, one thread per core"; do
+  figures=$(verdict_figures "${verdict%% *}") || exit 1
+  read -r V_MS V_MIN V_MAX V_RATE V_STEPS <<<"$figures"
+  VERDICT_ROWS+=("$(calc 'printf "%.2f ms (%.2f to %.2f), %d greedy steps, %.2f M greedy steps/s (training: %.2f M/s)", a, b, c, s, r / 1e6, g / 1e6' \
+    "a=$V_MS" "b=$V_MIN" "c=$V_MAX" "s=$V_STEPS" "r=$V_RATE" "g=$HEADLESS_RATE")|${verdict#* }")
+done
 
 # --- (h) The Python anchor --------------------------------------------------------------------
 if [[ -z "$ANCHOR_SKIPPED" ]]; then
@@ -419,6 +445,9 @@ row "(f) LockstepLoopback to solved (no ROS): steps" "$LOOPBACK_RATE" \
 row "(g) HeadlessTrainer to solved (train_headless): steps" "$HEADLESS_RATE" \
   "$HEADLESS_STEPS steps, $HEADLESS_EPISODES episodes; $(range "$HEADLESS_MIN" "$HEADLESS_MAX" repetitions); the protocol: $(calc \
     'printf "%.1f", 1e9 / f - 1e9 / g' "f=$LOOPBACK_RATE" "g=$HEADLESS_RATE") ns a step ((f) - (g))"
+for verdict_row in "${VERDICT_ROWS[@]}"; do
+  text_row "(g2) the suite's verdict on (g)'s table, ${verdict_row#*|}" "${verdict_row%%|*}"
+done
 if [[ -z "$ANCHOR_SKIPPED" ]]; then
   row "(h) Python anchor gym_tabular_q.py: steps" "$ANCHOR_RATE" \
     "$(calc 'printf "wall %.2f s to solved (%.2f to %.2f), %d episodes: median of seeds %s; (e) roslaunch to SOLVED / this = %.2f", w, lo, hi, e, seeds, s / w' \
