@@ -35,8 +35,8 @@ struct TableRead
 // What an absolute path the user gives (not a service's caller) names.
 enum class AbsolutePaths
 {
-  MustLieInTheFolder,  // the node's parameters
-  AreTheUsersFiles     // train_headless's command line: followed as the shell would
+  MustLieInTheFolder,
+  AreTheUsersFiles  // train_headless's command line, the node's parameters: followed as the shell would
 };
 
 class TableStore
