@@ -213,8 +213,8 @@ if start "train.launch stop_when_solved:=false" "roslaunch cartpole_qlearning tr
   # Stopped after 15 s, as a user would with Ctrl-C: rostopic alone took up to 5.1 s to print its
   # first message on a heavily loaded 2-core machine.
   run "rostopic echo episode_stats" 15 124 "rostopic echo /cartpole/episode_stats" "mean_return_100"
-  run "save_q_table, default path" 30 0 "rosservice call /cartpole/qlearning_controller/save_q_table \"path: ''\"" \
-    "success: True" "cartpole_qlearning/cartpole/q_table.yaml"
+  run "save_q_table now.yaml" 30 0 "rosservice call /cartpole/qlearning_controller/save_q_table \"path: 'now.yaml'\"" \
+    "success: True" "cartpole_qlearning/cartpole/now.yaml"
   run "save_q_table runs/my_table.yaml" 30 0 \
     "rosservice call /cartpole/qlearning_controller/save_q_table \"path: 'runs/my_table.yaml'\"" "success: True"
   check "the table is in ~/.ros/cartpole_qlearning/cartpole/runs/my_table.yaml" "test -s '$TABLES/runs/my_table.yaml'"
@@ -223,7 +223,9 @@ if start "train.launch stop_when_solved:=false" "roslaunch cartpole_qlearning tr
   stop_launch "Ctrl-C saves the run's checkpoint and leaves the default table" "$training" "$training_log" \
     "on shutdown: saved .* to .*/runs/.*/q_table.yaml" "the default table is left as it was"
 fi
-cp "$WORK/solved.yaml" "$TABLES/q_table.yaml"
+# The tutorial in order: its saves while training are named, so what it evaluates next is the
+# solved default table the first command saved.
+check "the saves while training left the solved default table" "cmp '$TABLES/q_table.yaml' '$WORK/solved.yaml'"
 
 # In real time: a machine busy with other work answers late and the pole may fall (a robot's
 # lot), so the verdict is checked for its form; the table's greedy worth is train_headless
@@ -231,6 +233,13 @@ cp "$WORK/solved.yaml" "$TABLES/q_table.yaml"
 run "evaluate.launch" 200 0 "roslaunch cartpole_qlearning evaluate.launch q_table:=q_table.yaml" \
   "evaluation episode 1: [0-9]+ steps" \
   "EVALUATED 5 episodes: [0-5] balanced to the step limit \(500 steps\), mean return [0-9.]+"
+run "evaluate.launch q_table:=runs/my_table.yaml" 100 0 \
+  "roslaunch cartpole_qlearning evaluate.launch q_table:=runs/my_table.yaml episodes:=1" \
+  "cartpole_qlearning/cartpole/runs/my_table.yaml" "EVALUATED 1 episodes: [01] balanced to the step limit"
+# An absolute table, as train_headless --save wrote it: a launch argument is the user's own.
+run "evaluate.launch q_table:=/tmp/x.yaml" 100 0 \
+  "rosrun cartpole_qlearning train_headless --save /tmp/x.yaml --no-run-folder --quiet && roslaunch cartpole_qlearning evaluate.launch q_table:=/tmp/x.yaml episodes:=1" \
+  "loaded /tmp/x.yaml \(259 episodes" "EVALUATED 1 episodes: [01] balanced to the step limit"
 
 # The simulator alone.
 if start "sim.launch" "roslaunch cartpole_qlearning sim.launch"; then

@@ -115,6 +115,8 @@ TEST(TableAlone, EvaluateLaunchLoadsAnAbsoluteTableWhileItsServicesStayInTheFold
   const std::string evaluated =
       launchOutput(home, "absolute", "ns:=absolute mode:=lockstep episodes:=2 q_table:=" + table, "evaluate.launch", status);
   EXPECT_EQ(0, status) << evaluated;
+  EXPECT_NE(std::string::npos, evaluated.find("loaded " + table + " (259 episodes, 61681 steps of training)"))
+      << evaluated;
   EXPECT_NE(std::string::npos, evaluated.find("with the table's own configuration (" + table + ")")) << evaluated;
   EXPECT_EQ(500, verdictSteps(evaluated, 2)) << evaluated;
   EXPECT_EQ(std::string::npos, evaluated.find("outside")) << evaluated;
