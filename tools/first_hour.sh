@@ -301,6 +301,14 @@ run "learning curve" 120 0 \
   "wrote docs/images/learning_curve.png \(259 episodes, solved at episode 259\)"
 check "the README's learning curve is what its command draws" "cmp -s docs/images/learning_curve.png '$WORK/learning_curve_committed.png'"
 
+# A robot's profile tried without the robot (last: it replaces the default table, and says so).
+run "try_robot.launch robot:=openai_ros_cartpole" 400 0 \
+  "roslaunch cartpole_qlearning try_robot.launch robot:=openai_ros_cartpole" \
+  "SOLVED after" "replacing the one there \(" "ending the launch"
+run "try_robot.launch: evaluate the table" 200 0 \
+  "roslaunch cartpole_qlearning try_robot.launch robot:=openai_ros_cartpole mode:=evaluate load:=q_table.yaml" \
+  "EVALUATED 10 episodes: [0-9]+ balanced to the step limit \(500 steps\)"
+
 echo "[first-hour] not run: catkin_make tests and rostest (scripts/test.sh builds and runs every test with the \
 same commands in CI's workspace; a second build of every test here cost a good part of CI's time), rqt_plot (Debian 12 ships no rqt), plot_learning_curve --follow (runs until \
 Ctrl-C; plot_learning_curve.test covers it), rviz:=true (needs a display; rviz_screenshot ran RViz under Xvfb), \
