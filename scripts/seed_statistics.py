@@ -15,7 +15,7 @@ with the machine and the date: the "How fast it learns" table of docs/results.md
 Statistics over all the seeds run: a seed that did not solve within --max-episodes ranks
 after every solved one, so a percentile that falls on it reads "> N". Steps and wall time are
 the medians over the solved seeds. Wall time is the training loop's own (train_headless's
-wall_s, the anchor's likewise), not process start-up. With -j 2 two runs share the CPUs and
+train_s, the saved table's verdict apart; the anchor's wall_s), not process start-up. With -j 2 two runs share the CPUs and
 the wall times are noisier; -j 1 (the default) times one run at a time.
 
 Finds train_headless by itself: --train-headless PATH, else where rosrun would find it when a
@@ -40,7 +40,8 @@ DEFAULT_ANCHOR = os.path.join(os.path.dirname(REPO), "shared", "anchors", "gym_t
 ANCHOR_PYTHON = "/usr/bin/python3"  # Debian's, where python3-numpy is installed
 
 RETURNS = re.compile(r"^returns=([-0-9.e ]*)$", re.MULTILINE)
-RESULT = re.compile(r"^solved=(true|false) episodes=(\d+) steps=(\d+) wall_s=([0-9.]+)$")
+RESULT = re.compile(r"^until=\w+ reached=(?:true|false) solved=(true|false|n/a) episodes=(\d+) steps=(\d+) "
+                    r"train_s=([0-9.]+) verdict_s=[0-9.]+$")
 ANCHOR_RESULT = re.compile(r"^(solved|unsolved) seed=\d+ episodes=(\d+) steps=(\d+) wall_s=([0-9.]+)")
 
 # The shipped configs of the table, in its order: (file in config/, what the row is called).

@@ -119,6 +119,19 @@ check() {
   fi
 }
 
+# output PAGE BLOCK: the page's output block marked <!-- output: BLOCK --> is what the command
+# run last printed (tools/doc_output.py: `...` any text, `~` a home folder; a block marked `form`
+# is checked for its form only). docs_tests checks that every marked block is checked here.
+output() {
+  local page=$1 name=$2
+  local why
+  if why=$(/usr/bin/python3 "$SRC/tools/doc_output.py" "$SRC/$page" "$name" "$LAST_LOG" 2>&1); then
+    record "$page: the output shown ($name) is what it printed" 0
+  else
+    record "$page: the output shown ($name) is what it printed" 0 "$why"
+  fi
+}
+
 # start NAME COMMAND: a documented command that runs until stopped (a launch), in the background.
 start() {
   local name=$1 command=$2
@@ -198,8 +211,10 @@ wait_for 30 "$LOGS/roscore.log" "started core service" || echo "[first-hour] ros
 
 # --- Training on the ROS graph ----------------------------------------------------------------
 run "train.launch" 300 0 "roslaunch cartpole_qlearning train.launch" "SOLVED after" "ending the launch"
+output docs/tutorial.md tutorial_train
 cp "$TABLES/q_table.yaml" "$WORK/two_process.yaml" 2>/dev/null
 run "train.launch nodelet:=true" 300 0 "roslaunch cartpole_qlearning train.launch nodelet:=true" "SOLVED after"
+output docs/launch_files.md nodelet_train
 check "nodelets wrote the two-process table, byte for byte" "cmp '$TABLES/q_table.yaml' '$WORK/two_process.yaml'"
 timeout 120 rosrun cartpole_qlearning train_headless --seed 0 --quiet --save "$WORK/headless.yaml" >/dev/null 2>&1
 check "train_headless --seed 0 wrote the launched table, byte for byte" "cmp '$TABLES/q_table.yaml' '$WORK/headless.yaml'"
@@ -278,11 +293,12 @@ cp "$TABLES/q_table.yaml" "$WORK/four_robots.yaml"
 run "train.launch robots:=4 nodelet:=true" 300 0 "roslaunch cartpole_qlearning train.launch robots:=4 nodelet:=true" \
   "SOLVED after"
 check "four robots: nodelets wrote the two-process table, byte for byte" "cmp '$TABLES/q_table.yaml' '$WORK/four_robots.yaml'"
-run "train_headless --robots 4" 120 0 "rosrun cartpole_qlearning train_headless --robots 4" "^solved=true"
+run "train_headless --robots 4" 120 0 "rosrun cartpole_qlearning train_headless --robots 4" "^until=solved reached=true solved=true"
 
 # Training without ROS.
 run "train_headless --save headless.yaml" 120 0 "rosrun cartpole_qlearning train_headless --save headless.yaml" \
-  "the default table: saved .* to $TABLES/headless.yaml" "^solved=true"
+  "the default table: saved .* to $TABLES/headless.yaml" "^until=solved reached=true solved=true"
+output docs/train_headless.md train_headless
 # Real time again, and the headless table balances 19 of 20 lockstep episodes (train_headless
 # --evaluate headless.yaml --episodes 20): the verdict is checked for its form.
 run "evaluate.launch q_table:=headless.yaml" 120 0 \
@@ -292,6 +308,7 @@ run "evaluate.launch q_table:=headless.yaml" 120 0 \
 run "train_headless --replay tutorial_10_steps.yaml" 60 0 \
   "rosrun cartpole_qlearning train_headless --config config/tutorial_4_states.yaml --replay config/tutorial_10_steps.yaml" \
   "^  S0 upright +1\.117003125 +1\.380753125$" "^  S1 tilted left +1\.71037015625 +0$" "^  S2 tilted right +0 +0\.8155625$"
+output docs/tutorial.md tutorial_replay
 run "train.launch trace:=true, the tutorial's 4 states" 120 0 \
   "roslaunch cartpole_qlearning train.launch config:=\$(rospack find cartpole_qlearning)/config/tutorial_4_states.yaml trace:=true max_episodes:=3 ns:=tutorial" \
   "episode 1 step 1: S0 upright --A" "Q-table after episode 3:" "NOT solved, max_episodes reached"

@@ -245,6 +245,8 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
 
   SuiteResult result;
   result.cases_in_suite = suite.cases.size();
+  if (config.task.reward != RewardScheme::Gymnasium)
+    result.reward_note = toString(config.task.reward) + "'s reward, " + rewardMeaning(config.task.reward);
   const std::size_t kept = how.stop_at_first_failure ? std::min(first_failure.load() + 1, order.size()) : order.size();
   for (std::size_t p = 0; p < kept; ++p)
     result.cases.push_back(results[p]);
@@ -326,7 +328,18 @@ std::string SuiteResult::summary() const
   return text;
 }
 
+std::size_t SuiteResult::casesPassed() const
+{
+  return static_cast<std::size_t>(
+      std::count_if(cases.begin(), cases.end(), [](const CaseResult& c) { return c.passed(); }));
+}
+
 std::string SuiteResult::table() const
+{
+  return rows() + summary();
+}
+
+std::string SuiteResult::rows() const
 {
   std::size_t width = 4;
   for (const CaseResult& c : cases)
@@ -344,7 +357,8 @@ std::string SuiteResult::table() const
                   c.passed() ? "pass" : "FAIL");
     out << line;
   }
-  out << summary();
+  if (!reward_note.empty())
+    out << "(mean return: " << reward_note << ")\n";
   return out.str();
 }
 

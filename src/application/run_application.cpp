@@ -4,6 +4,8 @@
 #include "cartpole_qlearning/learning/table_config.h"
 #include "cartpole_qlearning/learning/trace.h"
 
+#include <chrono>
+#include <functional>
 #include <utility>
 
 namespace cartpole_qlearning
@@ -53,7 +55,8 @@ struct RunApplication::Parts
       folder(settings, tables, std::move(clocks.calendar)),
       curve(settings, folder, std::move(clocks.unix_seconds)),
       keeper(config, settings.learning, settings.suite_folders),
-      meters(config, settings, std::move(clocks.steady))
+      meters(config, settings, clocks.steady),
+      steady(std::move(clocks.steady))
   {
     if (settings.trace && settings.learning)
       state_names = stateNames(config.agent);
@@ -83,6 +86,7 @@ struct RunApplication::Parts
   LearningCurve curve;
   BestTableKeeper keeper;
   RunMeters meters;
+  std::function<std::chrono::steady_clock::time_point()> steady;  // times the final verdict
   std::vector<std::string> state_names;  // as the trace names the rows
   // A table to load has this run's shape (useTable refuses any other): its file is at most this
   // long. Fixed for the run, so readTable() reads it without a lock. (After session: initialised
@@ -94,6 +98,9 @@ struct RunApplication::Parts
   const std::vector<double> actions = session.table().actions();
 
   int launcher = 0;
+  // The first episode whose window was solved in this session (0: none yet). A run that goes on
+  // after solved (training/stop_when_solved false) says when it solved.
+  std::uint64_t first_solved = 0;
   bool finished = false;
   bool final_saved = false;  // training ended and its table is saved (else a shutdown saves it)
   bool shut_down = false;
@@ -167,7 +174,9 @@ std::string RunApplication::Parts::saveFinal(bool done_well, const char* finishe
   else
   {
     // The default table is the only save, if there is one.
-    saved = "no run folder";
+    saved = !settings.q_table_path.empty() ? "no run folder"
+            : settings.command_line        ? "no run folder and no --save: the table was not written"
+                                           : "no run folder and no ~q_table_path: the table was not written";
     saved_ok = !publishes || published.success;
   }
   final_saved = saved_ok || published.success;
@@ -198,13 +207,22 @@ void RunApplication::Parts::endTraining(const EpisodeSummary& s, bool passed, co
     return;
   }
   const bool until_suite = config.limits.until == TrainUntil::SuitePasses;
+  // A run that went on after solving says when it solved and what its window holds now.
+  const bool went_on = !until_suite && !config.limits.stop_when_solved && first_solved > 0;
+  const std::string outcome = until_suite ? (passed ? "SUITE PASSED" : "suite NOT passed, max_episodes reached")
+                              : went_on   ? formatText("SOLVED at episode %llu, went on: max_episodes reached",
+                                                       count(first_solved))
+                              : s.solved  ? "SOLVED"
+                                          : "NOT solved, max_episodes reached";
+  std::string window = formatText("mean return of the last %u: %.2f", config.task.solved_window,
+                                  shownReturn(s.mean_return_window, 2));
+  if (went_on)
+    window += s.solved ? ", still solved" : formatText(", below %g now", config.task.solved_mean_return);
+  if (config.task.reward != RewardScheme::Gymnasium)
+    window += "; " + toString(config.task.reward) + "'s reward: " + rewardMeaning(config.task.reward);
   say(end.log, LogLine::Level::Info,
-      formatText("%s after %llu episodes, %llu steps, %.1f s (mean return of the last %u: %.2f); %s",
-                 until_suite ? (passed ? "SUITE PASSED" : "suite NOT passed, max_episodes reached")
-                 : s.solved  ? "SOLVED"
-                             : "NOT solved, max_episodes reached",
-                 count(s.episode), count(s.total_steps), meters.secondsRunning(), config.task.solved_window,
-                 shownReturn(s.mean_return_window, 2), saved.c_str()));
+      formatText("%s after %llu episodes, %llu steps, %.1f s (%s); %s", outcome.c_str(), count(s.episode),
+                 count(s.total_steps), meters.secondsRunning(), window.c_str(), saved.c_str()));
   end.finished = true;
 }
 
@@ -257,16 +275,21 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
   end.robot_steps_per_second = rates.robot_steps_per_second;
 
   const bool until_suite = p.config.limits.until == TrainUntil::SuitePasses;
+  if (p.settings.learning && s.solved && p.first_solved == 0)
+    p.first_solved = s.episode;
   std::optional<SuiteResult> verdict = p.keeper.evaluateWhenDue(p.session, training_finished, end.log);
   training_finished = training_finished || (until_suite && verdict && verdict->passed());
   if (training_finished && p.keeper.hasSuite())
   {
+    const auto verdict_began = p.steady();
     verdict = p.keeper.settle(p.session, verdict, end.log);
+    end.verdict_seconds = std::chrono::duration<double>(p.steady() - verdict_began).count();
     end.robustness = verdict->summary();
     p.folder.setRobustness(end.robustness);
   }
   const bool passed = verdict && verdict->passed();
   const bool done_well = until_suite ? passed : s.solved;
+  end.goal_reached = training_finished && done_well;
   const char* finished_as = !done_well ? "max_episodes" : until_suite ? "suite_passed" : "solved";
 
   // When training ends here, the table is saved before the caller says so: whoever acts on the

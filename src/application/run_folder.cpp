@@ -268,17 +268,21 @@ RunOpening RunFolder::goOn(bool respawn, TrainingSession& session, LogLines& log
                       " does not fit this controller's configuration: " + mismatch);
   record_ = record;
   const EpisodeSummary& s = session.lastEpisode();
-  log.push_back(
-      {LogLine::Level::Warn,
-       formatText("%srun %s goes on from its checkpoint: episode %llu, %llu steps%s", respawn ? "restarted; " : "",
-                  name_.c_str(), count(s.episode), count(s.total_steps),
-                  record_matches ? "" : " (its record was one checkpoint behind: the solved window starts empty)")});
   if (record.finished.empty())
+  {
+    log.push_back(
+        {LogLine::Level::Warn,
+         formatText("%srun %s goes on from its checkpoint: episode %llu, %llu steps%s", respawn ? "restarted; " : "",
+                    name_.c_str(), count(s.episode), count(s.total_steps),
+                    record_matches ? "" : " (its record was one checkpoint behind: the solved window starts empty)")});
     return RunOpening::GoesOn;
-  // Ended (or killed) after its final save: nothing to train. A controller stays up rather than
-  // exit, which under respawn would only start it again.
-  log.push_back({LogLine::Level::Info, formatText("run %s has finished already (%s); nothing left to do", name_.c_str(),
-                                                  record.finished.c_str())});
+  }
+  // Ended (or killed) after its final save: nothing to train, and nothing said of going on. A
+  // controller stays up rather than exit, which under respawn would only start it again.
+  log.push_back({LogLine::Level::Info,
+                 formatText("%srun %s has finished already (%s, episode %llu, %llu steps); nothing left to do",
+                            respawn ? "restarted; " : "", name_.c_str(), record.finished.c_str(), count(s.episode),
+                            count(s.total_steps))});
   return RunOpening::FinishedAlready;
 }
 

@@ -73,14 +73,20 @@ double RunMeters::secondsRunning() const
 bool RunMeters::addEvaluationEpisode(const EpisodeSummary& s, LogLines& log)
 {
   balanced_ += s.truncated && !s.terminated;
-  log.push_back(
-      {LogLine::Level::Info, formatText("evaluation episode %llu: %u steps, return %.1f, %s", count(s.episode), s.steps,
-                                        s.episode_return, s.terminated ? "fell" : "balanced to the step limit")});
+  // A return other than CartPole-v1's (+1 a step) is said with its meaning: on the first episode
+  // and on the verdict.
+  const RewardScheme reward = config_.task.reward;
+  const std::string meaning =
+      reward == RewardScheme::Gymnasium ? "" : " (" + toString(reward) + "'s reward: " + rewardMeaning(reward) + ")";
+  log.push_back({LogLine::Level::Info,
+                 formatText("evaluation episode %llu: %u steps, return %.1f%s, %s", count(s.episode), s.steps,
+                            s.episode_return, s.episode == 1 ? meaning.c_str() : "",
+                            s.terminated ? "fell" : "balanced to the step limit")});
   if (evaluation_episodes_ == 0 || s.episode < evaluation_episodes_)
     return false;
   std::string verdict = formatText(
-      "EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f", count(s.episode),
-      count(balanced_), config_.task.max_episode_steps, shownReturn(s.mean_return_window, 1));
+      "EVALUATED %llu episodes: %llu balanced to the step limit (%u steps), mean return %.1f%s", count(s.episode),
+      count(balanced_), config_.task.max_episode_steps, shownReturn(s.mean_return_window, 1), meaning.c_str());
   if (!evaluation_case_.empty())
     verdict += formatText("; %s: %s (needs %llu)", evaluation_case_.c_str(),
                           balanced_ >= evaluation_pass_ ? "PASSED" : "FAILED", count(evaluation_pass_));

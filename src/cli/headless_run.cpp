@@ -98,7 +98,11 @@ TrainingResult HeadlessRun::run()
         error_ = printLog(end.log, options_.quiet) || error_;
         // What the saved table is worth is a result, as the result line is: --quiet keeps it.
         if (options_.quiet && !end.robustness.empty())
-          std::printf("robustness of the saved table: %s\n", end.robustness.c_str());
+          std::printf("robustness of the saved table%s: %s\n",
+                      config.limits.until == TrainUntil::SuitePasses ? "" : " (for information: trained until solved)",
+                      end.robustness.c_str());
+        verdict_seconds_ += end.verdict_seconds;
+        goal_reached_ = goal_reached_ || end.goal_reached;
         return end.finished || training_finished;
       },
       &g_stop);
@@ -112,6 +116,16 @@ TrainingResult HeadlessRun::run()
   if (options_.print_returns)
     std::printf("returns=%s\n", returns.c_str());
   return result;
+}
+
+double HeadlessRun::verdictSeconds() const
+{
+  return verdict_seconds_;
+}
+
+bool HeadlessRun::goalReached() const
+{
+  return goal_reached_;
 }
 
 bool HeadlessRun::stopped() const

@@ -29,6 +29,10 @@ public:
   // (then the save on shutdown, as the controller's); then --returns' line.
   TrainingResult run();
 
+  // Of run()'s seconds, those the saved table's final verdict (the suite) took.
+  double verdictSeconds() const;
+  // Training ended where it trained to: solved, or under until suite_passes the suite passed.
+  bool goalReached() const;
   bool stopped() const;
   // A failure the mode found after the run (it has said it).
   void addError();
@@ -46,6 +50,8 @@ private:
   HeadlessTrainer trainer_;
   std::vector<std::string> robot_names_;
   std::unique_ptr<RunApplication> application_;
+  double verdict_seconds_ = 0.0;
+  bool goal_reached_ = false;
   bool stopped_ = false;
   bool error_ = false;
 };

@@ -1,7 +1,8 @@
 // train_headless: the controller node's application with the core alone (no ROS master): it
 // trains (from scratch, from a table, or on from a run's checkpoint) or evaluates a table
 // greedily, making the same RunApplication calls as the node, and prints what the node logs.
-// Training ends with one line "solved=true|false episodes=N steps=M wall_s=T", an evaluation
+// Training ends with one line "until=U reached=B solved=B|n/a episodes=N steps=M train_s=T verdict_s=V"
+// (train_mode.cpp), an evaluation
 // with "evaluated=N balanced=M mean_return=R", a robustness suite (--evaluate TABLE --suite FILE)
 // with "suite=PASSED|FAILED cases=N passed=K worst=M/E". With --replay it learns from the transitions of a
 // file instead (the tutorial's worked example), tracing each update. --policy TABLE prints the

@@ -8,10 +8,32 @@
 
 namespace cartpole_qlearning
 {
+namespace
+{
+// What training runs until: "solved", "max_episodes" (it goes on after solved) or "suite_passes".
+const char* trainedUntil(const TrainingLimits& limits)
+{
+  return limits.until == TrainUntil::SuitePasses ? "suite_passes" : limits.stop_when_solved ? "solved" : "max_episodes";
+}
+
+// The result line: what the run trained until and whether it got there, whether the window ever
+// reached solved (n/a where the task's returns cannot: sutton_barto's reward, episodes shorter than
+// solved_mean_return), the counts, and the seconds of training and of the saved table's verdict
+// apart (microseconds: a run to solved takes a few milliseconds).
+void printResult(const TrainingConfig& config, bool reached, bool solved, std::uint64_t episodes, std::uint64_t steps,
+                 double train_s, double verdict_s)
+{
+  std::printf("until=%s reached=%s solved=%s episodes=%llu steps=%llu train_s=%.6f verdict_s=%.6f\n",
+              trainedUntil(config.limits), reached ? "true" : "false",
+              !config.task.solvable() ? "n/a" : solved ? "true" : "false", static_cast<unsigned long long>(episodes),
+              static_cast<unsigned long long>(steps), train_s, verdict_s);
+}
+}  // namespace
+
 // Training: from scratch, from a table (--load) or on from a run folder's checkpoint (--resume),
-// ending with "solved=true|false episodes=N steps=M wall_s=T" (the session's counts: a loaded or
-// resumed table's episodes included, as the node counts them; after a stop, M is the saved table's
-// steps, the unfinished episode's included). Exit 2 when it cannot start (a bad
+// ending with "until=U reached=true|false solved=true|false|n/a episodes=N steps=M train_s=T
+// verdict_s=V" (the session's counts: a loaded or resumed table's episodes included, as the node
+// counts them; after a stop, M is the saved table's steps, the unfinished episode's included). Exit 2 when it cannot start (a bad
 // table or folder, nothing left to train), 1 when a table could not be saved.
 int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup)
 {
@@ -38,8 +60,10 @@ int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup)
   {
     // A resumed run that had finished: nothing to train; its counts, as a result line.
     const EpisodeSummary& last = run.session().lastEpisode();
-    std::printf("solved=%s episodes=%llu steps=%llu wall_s=0.000000\n", from.solved() ? "true" : "false",
-                static_cast<unsigned long long>(last.episode), static_cast<unsigned long long>(last.total_steps));
+    // Its record says how it finished ("solved", "suite_passed" or "max_episodes").
+    const bool to_max_episodes = std::string(trainedUntil(setup.config.limits)) == "max_episodes";
+    printResult(setup.config, to_max_episodes || (from.record && from.record->finished != "max_episodes"), from.solved(), last.episode,
+                last.total_steps, 0.0, 0.0);
     return 0;
   }
   const TrainingResult result = run.run();
@@ -58,9 +82,11 @@ int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup)
   // too, and the line before this one says so: steps= counts what that table counts, so that the
   // two agree (episodes= counts finished episodes, as the table does).
   const std::uint64_t steps = run.stopped() ? run.session().table().steps : last.total_steps;
-  // Microseconds: a run to solved takes a few milliseconds.
-  std::printf("solved=%s episodes=%llu steps=%llu wall_s=%.6f\n", result.solved ? "true" : "false",
-              static_cast<unsigned long long>(last.episode), static_cast<unsigned long long>(steps), result.wall_s);
+  const TrainingLimits& limits = setup.config.limits;
+  const bool ran_them_all = !run.stopped() && last.episode >= limits.max_episodes;
+  const bool reached = limits.until == TrainUntil::Solved && !limits.stop_when_solved ? ran_them_all : run.goalReached();
+  printResult(setup.config, reached, result.solved, last.episode, steps, result.wall_s - run.verdictSeconds(),
+              run.verdictSeconds());
   return run.exitStatus();
 }
 

@@ -35,6 +35,27 @@ std::string toString(RewardScheme scheme)
   return "unknown";
 }
 
+std::string rewardMeaning(RewardScheme scheme)
+{
+  switch (scheme)
+  {
+    case RewardScheme::Gymnasium:
+      return "+1 a step";
+    case RewardScheme::Seed:
+      return "+1 a step, -1 on the fall";
+    case RewardScheme::SuttonBarto:
+      return "0 a step, -1 on the fall";
+    case RewardScheme::Alive:
+      return "+1 a step, 0 on the fall";
+  }
+  return "unknown";
+}
+
+double TaskParams::largestReturn() const
+{
+  return reward == RewardScheme::SuttonBarto ? 0.0 : static_cast<double>(max_episode_steps);
+}
+
 double TaskParams::thetaThresholdRad() const
 {
   return theta_threshold_deg * 2.0 * M_PI / 360.0;

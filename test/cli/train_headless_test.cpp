@@ -136,8 +136,15 @@ TEST_F(TrainHeadlessTest, SolvesAndEndsWithTheResultLine)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0");
   EXPECT_EQ(0, run.status) << run.output;
-  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "solved=true episodes=[0-9]+ steps=[0-9]+ wall_s=[0-9.]+"))
+  text_match::Groups seconds;
+  ASSERT_TRUE(text_match::matchesWhole(
+      run.lastLine(), "until=solved reached=true solved=true episodes=[0-9]+ steps=[0-9]+ train_s=([0-9.]+) verdict_s=([0-9.]+)",
+      &seconds))
       << run.lastLine();
+  // The saved table's verdict (the default config's suite, 800 greedy episodes) is timed apart
+  // from the training: both took some time.
+  EXPECT_GT(std::stod(seconds[1]), 0.0) << run.lastLine();
+  EXPECT_GT(std::stod(seconds[2]), 0.0) << run.lastLine();
   // Progress lines come before it.
   EXPECT_NE(std::string::npos, run.output.find("mean_return_100")) << run.output;
 }
@@ -146,12 +153,55 @@ TEST_F(TrainHeadlessTest, EveryRunSaysWhatItsTableIsWorthOnTheRobustnessSuite)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --no-run-folder");
   EXPECT_EQ(0, run.status) << run.output;
-  // The default table of seed 0 does not hold a command one step late: the run says so.
-  EXPECT_NE(std::string::npos, run.output.find("robustness of the saved table (" CARTPOLE_CONFIG_DIR
+  // The default table of seed 0 does not hold a command one step late: the run says so, as
+  // information on a run that trained until solved, with where to go for a robust table, and no
+  // FAILED right before the SOLVED line.
+  EXPECT_NE(std::string::npos, run.output.find("robustness of the saved table, for information (" CARTPOLE_CONFIG_DIR
                                                "/robust_suite.yaml, greedy, 100 episodes per case):"))
       << run.output;
-  EXPECT_NE(std::string::npos, run.output.find("one_step_late ")) << run.output;
-  EXPECT_NE(std::string::npos, run.output.find(": FAILED")) << run.output;
+  EXPECT_TRUE(text_match::contains(run.output, "\none_step_late +0/100 +95 +[0-9.]+ +FAIL\n")) << run.output;
+  EXPECT_TRUE(text_match::contains(run.output, "\n[0-9] of 8 cases pass: not yet a table for a real robot. .*"
+                                               "config/robust.yaml trains until this suite passes.*\nSOLVED after "))
+      << run.output;
+  EXPECT_EQ(std::string::npos, run.output.find("FAILED")) << run.output;
+}
+
+// A run that goes on after solved says when it solved and what its window holds at the end; its
+// result line says what it trained until.
+TEST_F(TrainHeadlessTest, ARunThatGoesOnAfterSolvedSaysWhenItSolved)
+{
+  const CommandRun run = trainHeadless("--config " + file("go_on.yaml", "training:\n  stop_when_solved: false\n"
+                                                                         "  max_episodes: 400\n") +
+                                       " --seed 0 --no-run-folder");
+  EXPECT_EQ(0, run.status) << run.output;
+  // Seed 0 solves at episode 259 (as SolvesAndEndsWithTheResultLine's run, the same episodes).
+  const CommandRun solved = trainHeadless(config() + " --seed 0 --no-run-folder --quiet");
+  text_match::Groups first;
+  ASSERT_TRUE(text_match::contains(solved.lastLine(), "episodes=([0-9]+) ", &first)) << solved.output;
+  EXPECT_TRUE(text_match::contains(run.output, "\nSOLVED at episode " + first[1] +
+                                                   ", went on: max_episodes reached after 400 episodes, [0-9]+ steps, "
+                                                   "[0-9.]+ s \\(mean return of the last 100: [0-9.]+, "
+                                                   "(still solved|below 475 now)\\); "))
+      << run.output;
+  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(),
+                                       "until=max_episodes reached=true solved=true episodes=400 steps=[0-9]+ .*"))
+      << run.lastLine();
+}
+
+// Under sutton_barto's reward (0 a step, -1 on the fall) returns are said with their meaning, and
+// solved, which such returns cannot reach, is n/a.
+TEST_F(TrainHeadlessTest, ReturnsOtherThanCartPoleV1sAreSaidWithTheirMeaning)
+{
+  const CommandRun run = trainHeadless("--config " + file("sb.yaml", "task:\n  reward: sutton_barto\n") +
+                                       " --seed 0 --no-run-folder --max-episodes 20");
+  EXPECT_EQ(0, run.status) << run.output;
+  EXPECT_NE(std::string::npos,
+            run.output.find("(mean return of the last 100: -1.00; sutton_barto's reward: 0 a step, -1 on the fall)"))
+      << run.output;
+  EXPECT_NE(std::string::npos, run.output.find("\n(mean return: sutton_barto's reward, 0 a step, -1 on the fall)\n"))
+      << run.output;
+  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "until=solved reached=false solved=n/a episodes=20 .*"))
+      << run.lastLine();
 }
 
 TEST_F(TrainHeadlessTest, QuietKeepsTheRobustnessOfTheSavedTableBesideTheResultLine)
@@ -161,10 +211,11 @@ TEST_F(TrainHeadlessTest, QuietKeepsTheRobustnessOfTheSavedTableBesideTheResultL
   // What the table is worth (a table of 5 episodes falls everywhere), then the result line; no
   // progress line, no other line of the suite.
   EXPECT_TRUE(text_match::contains(run.output,
-                                   "(^|\n)robustness of the saved table: nominal [0-9]+/100, one_step_late "
-                                   "[0-9]+/100, .*all_at_once [0-9]+/100: FAILED\nsolved=false episodes=5 "))
+                                   "(^|\n)robustness of the saved table \\(for information: trained until solved\\): "
+                                   "nominal [0-9]+/100, one_step_late [0-9]+/100, .*all_at_once [0-9]+/100: "
+                                   "FAILED\nuntil=solved reached=false solved=false episodes=5 "))
       << run.output;
-  EXPECT_EQ(0u, run.lastLine().find("solved=false episodes=5 ")) << run.output;
+  EXPECT_EQ(0u, run.lastLine().find("until=solved reached=false solved=false episodes=5 ")) << run.output;
   EXPECT_EQ(std::string::npos, run.output.find("robustness at episode")) << run.output;
   EXPECT_EQ(std::string::npos, run.output.find("mean_return_100")) << run.output;
   EXPECT_EQ(std::string::npos, run.output.find("balanced  needed")) << run.output;
@@ -241,7 +292,7 @@ TEST_F(TrainHeadlessTest, RelativePathsAreUnderTheTableFolderAbsoluteOnesTheUser
     const CommandRun escape = trainHeadless(config() + " --seed 0 " + bad);
     EXPECT_EQ(2, escape.status) << bad << ": " << escape.output;
     EXPECT_NE(std::string::npos, escape.output.find(bad)) << escape.output;
-    EXPECT_EQ(std::string::npos, escape.output.find("solved=")) << escape.output;
+    EXPECT_EQ(std::string::npos, escape.output.find("until=")) << escape.output;
   }
   EXPECT_EQ(before, written());
   EXPECT_FALSE(fs::exists(dir_ / "cartpole_qlearning" / "x.yaml"));
@@ -252,7 +303,7 @@ TEST_F(TrainHeadlessTest, AnUnsolvedRunLeavesSavesFileAloneAndSaysWhereItsTableI
   const std::string mine = file("mine.yaml", "the user's own table\n");
   const CommandRun run = trainHeadless(config() + " --seed 0 --max-episodes 5 --save " + mine);
   ASSERT_EQ(0, run.status) << run.output;
-  EXPECT_EQ(0u, run.lastLine().find("solved=false episodes=5 ")) << run.lastLine();
+  EXPECT_EQ(0u, run.lastLine().find("until=solved reached=false solved=false episodes=5 ")) << run.lastLine();
   EXPECT_EQ("the user's own table\n", fileText(mine));
   const std::string folder = runFolder(run.output);
   ASSERT_NE("", folder) << run.output;
@@ -268,9 +319,12 @@ TEST_F(TrainHeadlessTest, NoRunFolderWritesNothingButSave)
 {
   const CommandRun unsaved = trainHeadless(config() + " --seed 0 --no-run-folder");
   ASSERT_EQ(0, unsaved.status) << unsaved.output;
-  EXPECT_EQ(0u, unsaved.lastLine().find("solved=true ")) << unsaved.lastLine();
+  EXPECT_EQ(0u, unsaved.lastLine().find("until=solved reached=true solved=true ")) << unsaved.lastLine();
   EXPECT_EQ(std::vector<std::string>(), written());
   EXPECT_EQ(std::string::npos, unsaved.output.find("checkpoint")) << unsaved.output;
+  // It says so, rather than leave the user looking for a file.
+  EXPECT_NE(std::string::npos, unsaved.output.find("; no run folder and no --save: the table was not written\n"))
+      << unsaved.output;
   const CommandRun saved = trainHeadless(config() + " --seed 0 --quiet --no-run-folder --save t.yaml");
   ASSERT_EQ(0, saved.status) << saved.output;
   EXPECT_EQ(std::vector<std::string>{"cartpole/t.yaml"}, written());
@@ -430,7 +484,7 @@ TEST_F(TrainHeadlessTest, LoadTrainsFurtherFromTheTablesCounters)
   // Ten more episodes, numbered on from 31; the steps add up from the table's (+1 a step).
   text_match::Groups result;
   const std::string last = loaded.lastLine();
-  ASSERT_TRUE(text_match::matchesWhole(last, "solved=false episodes=40 steps=([0-9]+) wall_s=.*", &result)) << last;
+  ASSERT_TRUE(text_match::matchesWhole(last, "until=solved reached=false solved=false episodes=40 steps=([0-9]+) train_s=.*", &result)) << last;
   text_match::Groups returns;
   ASSERT_TRUE(text_match::contains(loaded.output, "returns=([0-9 ]+)\n", &returns)) << loaded.output;
   std::istringstream values(returns[1]);
@@ -476,7 +530,7 @@ TEST_F(TrainHeadlessTest, TheStatsCsvHasOneRowPerEpisodeEndingWhereTheResultLine
   ASSERT_EQ(0, run.status) << run.output;
   text_match::Groups result;
   const std::string last = run.lastLine();
-  ASSERT_TRUE(text_match::matchesWhole(last, "solved=true episodes=([0-9]+) steps=([0-9]+) wall_s=.*", &result))
+  ASSERT_TRUE(text_match::matchesWhole(last, "until=solved reached=true solved=true episodes=([0-9]+) steps=([0-9]+) train_s=.*", &result))
       << last;
   const unsigned long episodes = std::stoul(result[1]);
   const unsigned long steps = std::stoul(result[2]);
@@ -520,21 +574,22 @@ TEST_F(TrainHeadlessTest, AStatsCsvThatCannotBeWrittenStopsBeforeTraining)
   EXPECT_EQ(2, run.status) << run.output;
   EXPECT_NE(std::string::npos, run.output.find("--stats-csv")) << run.output;
   EXPECT_NE(std::string::npos, run.output.find("a_folder")) << run.output;
-  EXPECT_EQ(std::string::npos, run.output.find("solved=")) << run.output;
+  EXPECT_EQ(std::string::npos, run.output.find("until=")) << run.output;
 }
 
 TEST_F(TrainHeadlessTest, UnsolvedRunSaysSo)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
   EXPECT_EQ(0, run.status);
-  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "solved=false episodes=5 steps=[0-9]+ wall_s=[0-9.]+"))
+  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "until=solved reached=false solved=false episodes=5 steps=[0-9]+ train_s=[0-9.]+ verdict_s=[0-9.]+"))
       << run.lastLine();
 }
 
 TEST_F(TrainHeadlessTest, WallTimeHasMicrosecondsSoAFewMillisecondsCanBeRead)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
-  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "solved=false episodes=5 steps=[0-9]+ wall_s=[0-9]+\\.[0-9]{6}"))
+  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "until=solved reached=false solved=false episodes=5 steps=[0-9]+ "
+                                                               "train_s=[0-9]+\\.[0-9]{6} verdict_s=[0-9]+\\.[0-9]{6}"))
       << run.lastLine();
 }
 
@@ -544,7 +599,7 @@ TEST_F(TrainHeadlessTest, ReturnsListsEveryEpisodesReturnBeforeTheResultLine)
   EXPECT_EQ(0, run.status) << run.output;
   text_match::Groups result;
   const std::string last = run.lastLine();
-  ASSERT_TRUE(text_match::matchesWhole(last, "solved=false episodes=7 steps=([0-9]+) wall_s=[0-9.]+", &result))
+  ASSERT_TRUE(text_match::matchesWhole(last, "until=solved reached=false solved=false episodes=7 steps=([0-9]+) train_s=[0-9.]+ verdict_s=[0-9.]+", &result))
       << run.output;
   text_match::Groups returns;
   ASSERT_TRUE(text_match::contains(run.output, "returns=([0-9 ]+)\n", &returns)) << run.output;
@@ -567,7 +622,7 @@ TEST_F(TrainHeadlessTest, BadConfigStopsWithTheKeyTheValueAndTheRange)
   EXPECT_EQ(2, bad_value.status);
   EXPECT_NE(std::string::npos, bad_value.output.find("learning/gamma = 2 is not allowed (must be in [0, 1])"))
       << bad_value.output;
-  EXPECT_EQ(std::string::npos, bad_value.output.find("solved="));
+  EXPECT_EQ(std::string::npos, bad_value.output.find("until="));
 
   const CommandRun typo = trainHeadless("--config " + file("typo.yaml", "task:\n  max_steps: 200\n"));
   EXPECT_EQ(2, typo.status);
@@ -602,7 +657,7 @@ TEST_F(TrainHeadlessTest, BadArgumentsAreRefusedNamingThem)
     const CommandRun run = trainHeadless(config() + " " + c.first);
     EXPECT_EQ(2, run.status) << c.first << ": " << run.output;
     EXPECT_NE(std::string::npos, run.output.find("train_headless: " + c.second)) << c.first << ": " << run.output;
-    EXPECT_FALSE(text_match::contains(run.output, "solved=(true|false) episodes=[0-9]")) << run.output;
+    EXPECT_FALSE(text_match::contains(run.output, "until=[a-z_]+ reached=")) << run.output;
   }
   EXPECT_EQ(std::vector<std::string>(), written());
   const CommandRun help = trainHeadless("--help");
@@ -706,7 +761,9 @@ TEST_P(TrainHeadlessStopTest, AStoppedRunGoesOnWithResume)
     // Saved where it stopped: every episode in the curve is in the table.
     EXPECT_EQ(record.episodes, curveEpisodes(curve).back());
     const CommandRun as_run{0, output};
-    EXPECT_TRUE(text_match::matchesWhole(as_run.lastLine(), "solved=(true|false) " + counts + "wall_s=.*")) << output;
+    EXPECT_TRUE(text_match::matchesWhole(as_run.lastLine(),
+                                         "until=max_episodes reached=false solved=(true|false) " + counts + "train_s=.*"))
+        << output;
   }
 
   // Resumed as tab completion gives the folder, a slash at its end.
@@ -720,7 +777,7 @@ TEST_P(TrainHeadlessStopTest, AStoppedRunGoesOnWithResume)
       << resumed.output;
   // (It may end solved: the last 100 episodes of so long a run balance.)
   EXPECT_TRUE(
-      text_match::matchesWhole(resumed.lastLine(), "solved=(true|false) episodes=" + std::to_string(until) + " .*"))
+      text_match::matchesWhole(resumed.lastLine(), "until=max_episodes reached=true solved=(true|false) episodes=" + std::to_string(until) + " .*"))
       << resumed.output;
   const cartpole_qlearning::QTable table =
       cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string());
@@ -736,10 +793,15 @@ TEST_P(TrainHeadlessStopTest, AStoppedRunGoesOnWithResume)
   // A finished run has nothing left to do.
   const CommandRun again = trainHeadless(endlessConfig() + " --resume " + folder);
   EXPECT_EQ(0, again.status) << again.output;
-  EXPECT_NE(std::string::npos, again.output.find("has finished already (" + finished + "); nothing left to do"))
+  EXPECT_NE(std::string::npos, again.output.find("has finished already (" + finished + ", episode " +
+                                                  std::to_string(until) + ", " + std::to_string(table.steps) +
+                                                  " steps); nothing left to do"))
       << again.output;
-  EXPECT_EQ("solved=" + std::string(finished == "solved" ? "true" : "false") + " episodes=" + std::to_string(until) +
-                " steps=" + std::to_string(table.steps) + " wall_s=0.000000",
+  // Nothing on either stream says it goes on (stderr is in output too).
+  EXPECT_EQ(std::string::npos, again.output.find("goes on from")) << again.output;
+  // Trained until max_episodes (endless.yaml goes on after solved): it got there.
+  EXPECT_EQ("until=max_episodes reached=true solved=" + std::string(finished == "solved" ? "true" : "false") + " episodes=" +
+                std::to_string(until) + " steps=" + std::to_string(table.steps) + " train_s=0.000000 verdict_s=0.000000",
             again.lastLine());
   EXPECT_EQ(until, cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string()).episodes);
 }
@@ -780,7 +842,7 @@ TEST_F(TrainHeadlessTest, ResumeCountsMaxEpisodesFromTheCheckpointTableNotTheRec
   // One more allowed: it trains exactly one, from the table's count.
   const CommandRun more = trainHeadless(endlessConfig() + " --resume " + folder + " --max-episodes 41 --quiet");
   EXPECT_EQ(0, more.status) << more.output;
-  EXPECT_TRUE(text_match::contains(more.lastLine(), "^solved=(true|false) episodes=41 ")) << more.output;
+  EXPECT_TRUE(text_match::contains(more.lastLine(), "^until=max_episodes reached=true solved=(true|false) episodes=41 ")) << more.output;
 }
 
 // Several robots are named as train.launch robots:=N names their namespaces, as the node logs.
@@ -887,7 +949,7 @@ TEST_F(TrainHeadlessTest, TraceAndReplayRefuseATileCodedConfig)
     const CommandRun run = trainHeadless(tiles + option);
     EXPECT_EQ(2, run.status) << run.output;
     EXPECT_NE(std::string::npos, run.output.find("it needs learning/features bins")) << run.output;
-    EXPECT_EQ(std::string::npos, run.output.find("solved=")) << run.output;
+    EXPECT_EQ(std::string::npos, run.output.find("until=")) << run.output;
   }
 }
 
@@ -897,7 +959,7 @@ TEST_F(TrainHeadlessTest, TraceWhileTrainingHoldsItsArithmeticWithATableAtEachEp
 {
   const CommandRun run = trainHeadless(tutorialConfig() + " --trace --seed 3 --max-episodes 6");
   ASSERT_EQ(0, run.status) << run.output;
-  EXPECT_EQ(0u, run.lastLine().find("solved=false episodes=6 steps=")) << run.lastLine();
+  EXPECT_EQ(0u, run.lastLine().find("until=solved reached=false solved=false episodes=6 steps=")) << run.lastLine();
   const TraceReading trace(run.output, kTutorialNames);
   EXPECT_EQ(std::vector<std::string>(), trace.check(2, 0.9, 0.5)) << run.output;
   ASSERT_EQ(6u, trace.tables.size());

@@ -114,6 +114,9 @@ struct SuiteResult
 {
   std::vector<CaseResult> cases;  // in the order run; a suite stopped at a failure lists the cases run
   std::size_t cases_in_suite = 0;
+  // What a return means when the reward is not CartPole-v1's +1 a step ("sutton_barto's reward, 0 a
+  // step, -1 on the fall"), printed under the rows; "" for gymnasium.
+  std::string reward_note;
   bool passed() const;
   // A case run can no longer pass, whatever its episodes not run would give. (A suite stopped
   // against targets other than pass may be neither passed() nor failed(): not decided.)
@@ -132,7 +135,11 @@ struct SuiteResult
   // "nominal 100/100, one_step_late 97/100, ... : PASSED" on one line; a case cut short reads
   // "one_step_late 3/9 (stopped: failed)", a suite stopped early ends "FAILED (stopped at one_step_late)".
   std::string summary() const;
-  // One line per case, aligned, then the verdict: for a console.
+  // The number of cases run that passed.
+  std::size_t casesPassed() const;
+  // A header and one line per case, aligned: for a console.
+  std::string rows() const;
+  // rows(), then the verdict (summary()).
   std::string table() const;
 };
 

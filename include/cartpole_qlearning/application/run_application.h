@@ -63,6 +63,12 @@ struct EpisodeEnd
   // Training ended here: the robustness suite's summary of the table it saved (episode_stats'
   // robustness); "" otherwise, or when there is no suite (training/suite none).
   std::string robustness;
+  // Training ended here: whether it got where it trained to (solved; under until suite_passes, the
+  // suite passed; when it goes on after solved, the last window solved).
+  bool goal_reached = false;
+  // Training ended here: the wall seconds the saved table's final verdict (the suite) took, apart
+  // from the training's.
+  double verdict_seconds = 0.0;
 };
 
 class RunApplication

@@ -19,6 +19,8 @@ enum class RewardScheme
 // Parses "gymnasium", "seed", "sutton_barto" or "alive"; throws std::invalid_argument otherwise.
 RewardScheme rewardSchemeFromString(const std::string& name);
 std::string toString(RewardScheme scheme);
+// What a return means under the scheme, for a reader of the logs: "0 a step, -1 on the fall".
+std::string rewardMeaning(RewardScheme scheme);
 
 struct TaskParams
 {
@@ -31,6 +33,15 @@ struct TaskParams
 
   // The threshold in radians, computed the way Gymnasium does (12 * 2 * pi / 360).
   double thetaThresholdRad() const;
+  // The largest return an episode can have (one that balances to max_episode_steps).
+  double largestReturn() const;
+  // Whether solved_mean_return can be reached at all: not under sutton_barto (at most 0), nor with
+  // episodes shorter than it. Training with such a task never says solved; its goal is elsewhere
+  // (training/until suite_passes).
+  bool solvable() const
+  {
+    return largestReturn() >= solved_mean_return;
+  }
   // Empty when valid, else a message naming the first bad field, its value and the allowed range.
   std::string validate() const;
 };

@@ -253,7 +253,7 @@ TEST_F(RunFolderTest, ACheckpointSavesTheBestTableBeforeTheRecordThatNamesIt)
   EXPECT_EQ(0u, record(name()).best_episode);
   EXPECT_FALSE(fs::exists(dir_ / name() / kRunBestTableFile));
 
-  BestTable best{learner.table(), SuiteResult{{CaseResult{"nominal", 4, 4, 3, 4, 0.0}}}, 2};
+  BestTable best{learner.table(), SuiteResult{{CaseResult{"nominal", 4, 4, 3, 4, 0.0}}, 1, ""}, 2};
   fall(learner);
   ASSERT_TRUE(run.checkpoint(learner, "max_episodes", &best, message)) << message;
   const RunRecord written = record(name());
@@ -337,7 +337,10 @@ TEST_F(RunFolderTest, ARunThatFinishedHasNothingLeftToDo)
   TrainingSession again = session();
   log.clear();
   EXPECT_EQ(RunOpening::FinishedAlready, resumed.resume(again, log));
-  EXPECT_EQ("run " + name() + " has finished already (solved); nothing left to do", log.back().text);
+  ASSERT_EQ(1u, log.size());  // nothing said of going on from the checkpoint: it does not
+  EXPECT_EQ("run " + name() + " has finished already (solved, episode 1, " +
+                std::to_string(again.lastEpisode().total_steps) + " steps); nothing left to do",
+            log.back().text);
 }
 
 }  // namespace
