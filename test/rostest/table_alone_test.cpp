@@ -106,14 +106,15 @@ TEST(TableAlone, EvaluateLaunchLoadsAnAbsoluteTableWhileItsServicesStayInTheFold
   std::filesystem::create_directories(home);
   std::filesystem::create_directories(elsewhere);
   const std::string table = elsewhere + "/mine.yaml";
-  const auto trained = runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --seed 0 --quiet --no-run-folder --save " + table);
+  const auto trained =
+      runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --seed 0 --quiet --no-run-folder --save " + table);
   ASSERT_EQ(0, trained.status) << trained.output;
   ASSERT_TRUE(std::filesystem::exists(table)) << trained.output;
 
   // Two episodes and a verdict: the launch ends by itself, having loaded the table where it lies.
   int status = -1;
-  const std::string evaluated =
-      launchOutput(home, "absolute", "ns:=absolute mode:=lockstep episodes:=2 q_table:=" + table, "evaluate.launch", status);
+  const std::string evaluated = launchOutput(
+      home, "absolute", "ns:=absolute mode:=lockstep episodes:=2 q_table:=" + table, "evaluate.launch", status);
   EXPECT_EQ(0, status) << evaluated;
   EXPECT_NE(std::string::npos, evaluated.find("loaded " + table + " (259 episodes, 61681 steps of training)"))
       << evaluated;

@@ -550,8 +550,8 @@ TEST_F(RunApplicationTest, ASolvedRunSaysWhatDefaultTableItReplaced)
   ASSERT_TRUE(run.session->lastEpisode().solved);
   EXPECT_EQ(2u, loadQTableFile(default_table.string()).episodes);
   const LogLine solved = log(end.log, "SOLVED");
-  EXPECT_TRUE(says(end.log, "; the default table: saved 2 episodes, 10 steps of training to " +
-                                default_table.string() + ", replacing the one there (7 episodes, 123 steps)"))
+  EXPECT_TRUE(says(end.log, "; the default table: saved 2 episodes, 10 steps of training to " + default_table.string() +
+                                ", replacing the one there (7 episodes, 123 steps)"))
       << solved.text;
 }
 
