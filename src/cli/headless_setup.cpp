@@ -10,13 +10,54 @@
 #include <ros/package.h>
 
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 
 namespace cartpole_qlearning
 {
+namespace
+{
+bool isThisPackage(const std::filesystem::path& folder)
+{
+  std::ifstream manifest(folder / "package.xml");
+  if (!manifest)
+    return false;
+  std::ostringstream text;
+  text << manifest.rdbuf();
+  return text.str().find("<name>cartpole_qlearning</name>") != std::string::npos;
+}
+
+std::string lookUpPackage()
+{
+  // rospack crawls every folder under the package path before it answers (Debian's adds
+  // /usr/share: hundreds of folders, 0.1-0.3 s, most of a run to solved). The package is nearly
+  // always at the top of an entry (a workspace's src/cartpole_qlearning, or the entry itself):
+  // looked for there first, entry by entry in rospack's order; anywhere else, rospack finds it.
+  if (const char* path = std::getenv("ROS_PACKAGE_PATH"))
+  {
+    std::istringstream entries(path);
+    std::string entry;
+    while (std::getline(entries, entry, ':'))
+    {
+      if (entry.empty())
+        continue;
+      if (isThisPackage(entry))
+        return entry;
+      if (isThisPackage(std::filesystem::path(entry) / "cartpole_qlearning"))
+        return (std::filesystem::path(entry) / "cartpole_qlearning").string();
+    }
+  }
+  return ros::package::getPath("cartpole_qlearning");
+}
+}  // namespace
+
 std::string packagePath()
 {
-  return ros::package::getPath("cartpole_qlearning");
+  static const std::string path = lookUpPackage();
+  return path;
 }
 
 std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options)
@@ -32,6 +73,11 @@ std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options)
       const std::string path = tablePath(setup.table_dir, options.evaluate_path);
       const TableConfig own = tableConfig(loadTable(setup.table_dir, options.evaluate_path), path);
       setup.config = own.config;
+      // Wide starts and perturbations were training's devices (robust.yaml starts in +-0.25, past
+      // the 12 degrees that end an episode): the evaluation's starts are CartPole-v1's and its
+      // physics unperturbed, as evaluate.launch's sim without a config. --config sets others.
+      setup.config.start_state_bound = TrainingConfig().start_state_bound;
+      setup.config.perturbations = PerturbationParams();
       setup.config_origin = "the table's own configuration (" + path + ")";
       setup.config_warning = own.defaults_used;
     }

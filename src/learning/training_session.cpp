@@ -55,6 +55,7 @@ double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size
   e.running = true;
   e.number = episodes_.size() == 1 ? last_.episode + 1 : e.ended + 1;
   e.steps = 0;
+  e.steps_before_table = 0;
   e.episode_return = 0.0;
   agent_.activeRows(start_state, e.rows[e.current]);
   e.action = chooseAction(e.state(), e.epsilon);
@@ -122,7 +123,7 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   last_.terminated = decision.outcome.terminated;
   last_.truncated = decision.outcome.truncated;
   last_.solved = returns_.full() && last_.mean_return_window >= task_.params().solved_mean_return;
-  last_.total_steps += e.steps;
+  last_.total_steps += e.steps - e.steps_before_table;
   last_.robot = robot;
   last_.robot_episode = e.ended;
   last_.robot_mean_return_window = e.returns.mean();
@@ -175,6 +176,8 @@ std::string TrainingSession::resume(QTable table, const std::vector<double>& rec
   last_ = EpisodeSummary();
   last_.episode = episodes;
   last_.total_steps = steps;
+  for (Episode& e : episodes_)
+    e.steps_before_table = e.running ? e.steps : 0;
   returns_ = ReturnWindow(task_.params().solved_window);
   for (double value : recent_returns)
     returns_.push(value);

@@ -149,6 +149,31 @@ TEST_F(TrainHeadlessTest, SolvesAndEndsWithTheResultLine)
   EXPECT_NE(std::string::npos, run.output.find("mean_return_100")) << run.output;
 }
 
+// The package (its config/ folder) is found on ROS_PACKAGE_PATH as rospack finds it, whether an
+// entry is the package's folder, the folder holding it, or neither (then rospack's crawl).
+TEST_F(TrainHeadlessTest, ThePackageIsFoundWhereverThePackagePathHasIt)
+{
+  const fs::path package = fs::canonical(fs::path(CARTPOLE_CONFIG_DIR).parent_path());
+  const fs::path parent = dir_ / "workspace_src";
+  fs::create_directories(parent);
+  fs::create_directory_symlink(package, parent / "cartpole_qlearning");
+  const fs::path elsewhere = dir_ / "other_src";
+  fs::create_directories(elsewhere / "nested");
+  fs::create_directory_symlink(package, elsewhere / "nested" / "cartpole_qlearning");
+  const std::vector<std::pair<std::string, fs::path>> cases{
+      {"/nonexistent:" + package.string(), package},
+      {parent.string(), parent / "cartpole_qlearning"},
+      {elsewhere.string(), elsewhere / "nested" / "cartpole_qlearning"}};
+  for (const auto& [path, found] : cases)
+  {
+    const CommandRun run = runCommand("ROS_PACKAGE_PATH=" + path + " ROS_HOME=" + dir_.string() + " " + TRAIN_HEADLESS +
+                                      " --seed 0 --no-run-folder --max-episodes 3");
+    EXPECT_EQ(0, run.status) << path << ": " << run.output;
+    EXPECT_NE(std::string::npos, run.output.find("(" + (found / "config" / "robust_suite.yaml").string() + ", greedy"))
+        << path << ": " << run.output;
+  }
+}
+
 TEST_F(TrainHeadlessTest, EveryRunSaysWhatItsTableIsWorthOnTheRobustnessSuite)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --no-run-folder");
@@ -395,6 +420,25 @@ TEST_F(TrainHeadlessTest, ATableAloneIsEvaluatedWithItsOwnConfigurationInEpisode
                                          "/../test/data/short_suite.yaml");
   EXPECT_EQ(0, suite.status) << suite.output;
   EXPECT_EQ(0u, suite.lastLine().find("suite=")) << suite.output;
+}
+
+// Training's wide starts (robust.yaml's +-0.25, past the 12 degrees that end an episode) are not
+// the evaluation's: a table alone is evaluated from CartPole-v1's starts, so no episode is over
+// at its first step; with the training config given, its starts are used, and some are.
+TEST_F(TrainHeadlessTest, ATableAloneIsEvaluatedFromTheEvaluationsStartsNotTrainingsWideOnes)
+{
+  // "Solved" at its first episode, so that --save writes the table.
+  const std::string wide =
+      file("wide.yaml", "physics:\n  start_state_bound: 0.3\ntask:\n  solved_window: 1\n  solved_mean_return: 0\n");
+  const CommandRun trained = trainHeadless("--config " + wide + " --seed 0 --quiet --no-run-folder --save w.yaml");
+  ASSERT_EQ(0, trained.status) << trained.output;
+  const CommandRun alone = trainHeadless("--evaluate w.yaml --episodes 30 --max-steps 50");
+  ASSERT_EQ(0, alone.status) << alone.output;
+  EXPECT_NE(std::string::npos, alone.output.find("evaluation episode 30: ")) << alone.output;
+  EXPECT_FALSE(text_match::contains(alone.output, "evaluation episode [0-9]+: 1 steps")) << alone.output;
+  const CommandRun as_trained = trainHeadless("--config " + wide + " --evaluate w.yaml --episodes 30 --max-steps 50");
+  ASSERT_EQ(0, as_trained.status) << as_trained.output;
+  EXPECT_TRUE(text_match::contains(as_trained.output, "evaluation episode [0-9]+: 1 steps")) << as_trained.output;
 }
 
 TEST_F(TrainHeadlessTest, EvaluateOnASuitePrintsEachCaseAndEndsWithTheSuitesVerdict)

@@ -72,7 +72,7 @@ class PolicyPictureTest(unittest.TestCase):
                                      "--seed", "0", "--quiet", "--no-run-folder", "--save", table],
                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
                                     env=cls.env, timeout=120)
-            assert result.returncode == 0 and "solved=true" in result.stdout, result.stdout
+            assert result.returncode == 0 and " solved=true " in result.stdout, result.stdout
             cls.tables[name] = table
 
     @classmethod

@@ -65,8 +65,7 @@ TEST(PerturbedGraph, TrainLaunchUnderEveryPerturbationWritesTheHeadlessTable)
   const CommandRun headless =
       trainHeadless(rosHome() + "/headless", "--config " + config + " --seed 3 --max-episodes 300 --quiet");
   ASSERT_EQ(0, headless.status) << headless.output;
-  EXPECT_EQ(0u, headless.lastLine().rfind("until=solved reached=false solved=false episodes=300 ", 0))
-      << headless.output;
+  EXPECT_EQ(0u, headless.lastLine().find("until=solved reached=false solved=false episodes=300 ")) << headless.output;
   const std::string table = runTable(graph);
   EXPECT_NE(std::string::npos, table.find("previous_action: true"));
   EXPECT_EQ(runTable(rosHome() + "/headless"), table) << "train.launch (lockstep) and train_headless differ";

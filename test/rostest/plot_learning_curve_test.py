@@ -369,7 +369,7 @@ class TrainHeadlessCurveTest(PictureTest):
         self.assertEqual(0, result.returncode, result.stdout)
         last = result.stdout.strip().splitlines()[-1]
         self.assertTrue(last.startswith("until=solved reached=true solved=true episodes="), last)
-        episodes = int(last.split()[3].split("=")[1])
+        episodes = int(dict(field.split("=") for field in last.split())["episodes"])
         result = self.draw([csv, "-o", self.path("curve.png")])
         self.assertIn("%d episodes, solved at episode %d" % (episodes, episodes), result.stdout)
         self.assert_rising_curve(self.path("curve.png"), solved_at=episodes, last=episodes)

@@ -67,7 +67,7 @@ TEST(RobotEvaluate, TheHeadlessTableKeepsThePoleUpOnThePosedRobotAndNotWithoutIt
   const auto trained =
       runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --seed 0 --quiet --no-run-folder --save q_table.yaml");
   ASSERT_EQ(0, trained.status) << trained.output;
-  ASSERT_EQ(0u, trained.lastLine().rfind("until=solved reached=true solved=true ", 0)) << trained.output;
+  ASSERT_EQ(0u, trained.lastLine().find("until=solved reached=true solved=true ")) << trained.output;
 
   const std::string args = privateParam("args");
   EXPECT_GE(evaluate(home, "posed", args), numberParam("min_return"));

@@ -56,7 +56,7 @@ TEST(TableAlone, RobotAndEvaluateLaunchRunATableWithItsOwnConfigurationInTheEval
   const auto trained = runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + config +
                                   " --seed 0 --quiet --no-run-folder --save q_table.yaml");
   ASSERT_EQ(0, trained.status) << trained.output;
-  ASSERT_EQ(0u, trained.lastLine().rfind("until=solved reached=true solved=true ", 0)) << trained.output;
+  ASSERT_EQ(0u, trained.lastLine().find("until=solved reached=true solved=true ")) << trained.output;
   const std::string table = home + "/cartpole_qlearning/cartpole/q_table.yaml";
 
   // robot.launch with no config: the table's own, in 500-step episodes; no episode ends balanced at 200.

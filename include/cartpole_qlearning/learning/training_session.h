@@ -166,7 +166,10 @@ public:
   std::string replaceTable(QTable table);
   // Continues a run from its checkpoint: the table (checked as replaceTable does; on a mismatch
   // returns what differs and changes nothing), the session's episode and step counts from the
-  // table's, and the solved window from the returns the checkpoint recorded (oldest first).
+  // table's, and the solved window from the returns the checkpoint recorded (oldest first). An
+  // episode under way (a table loaded through the service mid-episode) goes on; its steps so far
+  // are not in the table's count and are left out of the session's total too, so that the total
+  // stays the table's.
   std::string resume(QTable table, const std::vector<double>& recent_returns);
   // The solved window's returns, oldest first: what a checkpoint records for resume().
   std::vector<double> recentReturns() const
@@ -195,6 +198,9 @@ private:
     unsigned current = 0;
     std::size_t action = 0;
     unsigned steps = 0;
+    // Of steps, those taken before a table was loaded mid-episode (resume()): the loaded table's
+    // step count does not hold them, so the session's total does not add them either.
+    unsigned steps_before_table = 0;
     double episode_return = 0.0;
     double epsilon = 0.0;
     double alpha = 0.0;

@@ -200,6 +200,38 @@ TEST(TrainingSession, ALoadedTableResumesItsSchedules)
   EXPECT_EQ(401u, session.table().episodes);
 }
 
+// A table loaded mid-episode (the load service while training, as the tutorial does it) counts
+// from its own steps: when that episode ends, the session's total is the table's, so the run's
+// last line and the table it saves agree. (The episode's steps before the load were learnt by
+// the table replaced, not by this one.)
+TEST(TrainingSession, ATableLoadedMidEpisodeKeepsTheStepCountsInStep)
+{
+  const AgentParams agent;
+  TrainingSession session(TaskParams(), agent, 0);
+  QTable saved(agent.discretiser, agent.actions);
+  saved.episodes = 7;
+  saved.steps = 1000;
+  session.beginEpisode(CartPoleState::Zero());
+  for (int i = 0; i < 5; ++i)
+    ASSERT_FALSE(session.observe(CartPoleState(0.0, 0.0, 0.01, 0.0)).episode_over);
+  ASSERT_EQ("", session.resume(saved, {}));
+  EXPECT_EQ(1000u, session.lastEpisode().total_steps);
+  Decision d;
+  do
+    d = session.observe(CartPoleState(0.0, 0.0, 1.0, 0.0));
+  while (!d.episode_over);
+  EXPECT_EQ(1001u, session.table().steps);  // one step learnt after the load: the fall
+  EXPECT_EQ(session.table().steps, session.lastEpisode().total_steps);
+  EXPECT_EQ(6u, session.lastEpisode().steps);  // the episode itself was 6 steps long
+  EXPECT_EQ(8u, session.lastEpisode().episode);
+  // The next episode counts whole.
+  session.beginEpisode(CartPoleState::Zero());
+  do
+    d = session.observe(CartPoleState(0.0, 0.0, 1.0, 0.0));
+  while (!d.episode_over);
+  EXPECT_EQ(session.table().steps, session.lastEpisode().total_steps);
+}
+
 TEST(CartPoleSimulation, RandomStartsStayWithinTheBoundAndFollowTheSeed)
 {
   CartPoleSimulation a(CartPoleParams(), 0.05, 5);
