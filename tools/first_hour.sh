@@ -228,8 +228,8 @@ if start "train.launch stop_when_solved:=false" "roslaunch cartpole_qlearning tr
   # Stopped after 15 s, as a user would with Ctrl-C: rostopic alone took up to 5.1 s to print its
   # first message on a heavily loaded 2-core machine.
   run "rostopic echo episode_stats" 15 124 "rostopic echo /cartpole/episode_stats" "mean_return_100"
-  run "save_q_table, default path" 30 0 "rosservice call /cartpole/qlearning_controller/save_q_table \"path: ''\"" \
-    "success: True" "cartpole_qlearning/cartpole/q_table.yaml"
+  run "save_q_table now.yaml" 30 0 "rosservice call /cartpole/qlearning_controller/save_q_table \"path: 'now.yaml'\"" \
+    "success: True" "cartpole_qlearning/cartpole/now.yaml"
   run "save_q_table runs/my_table.yaml" 30 0 \
     "rosservice call /cartpole/qlearning_controller/save_q_table \"path: 'runs/my_table.yaml'\"" "success: True"
   check "the table is in ~/.ros/cartpole_qlearning/cartpole/runs/my_table.yaml" "test -s '$TABLES/runs/my_table.yaml'"
@@ -238,7 +238,9 @@ if start "train.launch stop_when_solved:=false" "roslaunch cartpole_qlearning tr
   stop_launch "Ctrl-C saves the run's checkpoint and leaves the default table" "$training" "$training_log" \
     "on shutdown: saved .* to .*/runs/.*/q_table.yaml" "the default table is left as it was"
 fi
-cp "$WORK/solved.yaml" "$TABLES/q_table.yaml"
+# The tutorial in order: its saves while training are named, so what it evaluates next is the
+# solved default table the first command saved.
+check "the saves while training left the solved default table" "cmp '$TABLES/q_table.yaml' '$WORK/solved.yaml'"
 
 # In real time: a machine busy with other work answers late and the pole may fall (a robot's
 # lot), so the verdict is checked for its form; the table's greedy worth is train_headless
@@ -246,6 +248,17 @@ cp "$WORK/solved.yaml" "$TABLES/q_table.yaml"
 run "evaluate.launch" 200 0 "roslaunch cartpole_qlearning evaluate.launch q_table:=q_table.yaml" \
   "evaluation episode 1: [0-9]+ steps" \
   "EVALUATED 5 episodes: [0-5] balanced to the step limit \(500 steps\), mean return [0-9.]+"
+# The tutorial's picture of the whole table (plot_policy writes it in the current folder).
+run "plot_policy q_table.yaml" 60 0 "rosrun cartpole_qlearning plot_policy q_table.yaml" \
+  "plot_policy: q_table_policy.png: 201x201 states of q_table.yaml"
+check "plot_policy wrote q_table_policy.png" "test -s q_table_policy.png"
+run "evaluate.launch q_table:=runs/my_table.yaml" 100 0 \
+  "roslaunch cartpole_qlearning evaluate.launch q_table:=runs/my_table.yaml episodes:=1" \
+  "cartpole_qlearning/cartpole/runs/my_table.yaml" "EVALUATED 1 episodes: [01] balanced to the step limit"
+# An absolute table, as train_headless --save wrote it: a launch argument is the user's own.
+run "evaluate.launch q_table:=/tmp/x.yaml" 100 0 \
+  "rosrun cartpole_qlearning train_headless --save /tmp/x.yaml --no-run-folder --quiet && roslaunch cartpole_qlearning evaluate.launch q_table:=/tmp/x.yaml episodes:=1" \
+  "loaded /tmp/x.yaml \(259 episodes" "EVALUATED 1 episodes: [01] balanced to the step limit"
 # Posing as a case of the suite, in lockstep: the verdict is train_headless's, figure for figure.
 run "evaluate.launch suite_case:=one_step_late" 200 0 \
   "roslaunch cartpole_qlearning evaluate.launch suite_case:=one_step_late mode:=lockstep" "EVALUATED 100 episodes"
@@ -312,6 +325,14 @@ run "learning curve" 120 0 \
   "rosrun cartpole_qlearning train_headless --quiet --stats-csv /tmp/episodes.csv && rosrun cartpole_qlearning plot_learning_curve /tmp/episodes.csv -o docs/images/learning_curve.png" \
   "wrote docs/images/learning_curve.png \(259 episodes, solved at episode 259\)"
 check "the README's learning curve is what its command draws" "cmp -s docs/images/learning_curve.png '$WORK/learning_curve_committed.png'"
+
+# A robot's profile tried without the robot (last: it replaces the default table, and says so).
+run "try_robot.launch robot:=openai_ros_cartpole" 400 0 \
+  "roslaunch cartpole_qlearning try_robot.launch robot:=openai_ros_cartpole" \
+  "SOLVED after" "replacing the one there \(" "ending the launch"
+run "try_robot.launch: evaluate the table" 200 0 \
+  "roslaunch cartpole_qlearning try_robot.launch robot:=openai_ros_cartpole mode:=evaluate load:=q_table.yaml" \
+  "EVALUATED 10 episodes: [0-9]+ balanced to the step limit \(500 steps\)"
 
 echo "[first-hour] not run: catkin_make tests and rostest (scripts/test.sh builds and runs every test with the \
 same commands in CI's workspace; a second build of every test here cost a good part of CI's time), rqt_plot (Debian 12 ships no rqt), plot_learning_curve --follow (runs until \

@@ -289,13 +289,20 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   expand_home("q_table_dir", run.q_table_dir);
   priv.read("q_table_path", run.q_table_path);
   expand_home("q_table_path", run.q_table_path);
-  try
+  // The node's parameters are the user's, as the launch arguments that set them: an absolute
+  // ~q_table_path or ~load_on_start is followed as given. Only a service's path (its caller is
+  // anyone on the graph) must stay inside ~q_table_dir (TableStore::resolveForService).
+  run.own_absolute_paths = true;
+  if (run.q_table_path.empty() || run.q_table_path.front() != '/')
   {
-    relativePathUnder(run.q_table_dir, run.q_table_path);
-  }
-  catch (const FileError& e)
-  {
-    priv.fail("q_table_path", "'" + run.q_table_path + "'", e.what());
+    try
+    {
+      relativePathUnder(run.q_table_dir, run.q_table_path);
+    }
+    catch (const FileError& e)
+    {
+      priv.fail("q_table_path", "'" + run.q_table_path + "'", e.what());
+    }
   }
   priv.read("load_on_start", run.load_on_start);
   expand_home("load_on_start", run.load_on_start);

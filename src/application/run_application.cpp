@@ -26,6 +26,22 @@ void append(LogLines& log, const LogLines& more)
 {
   log.insert(log.end(), more.begin(), more.end());
 }
+
+// What the default table held before a run replaces it (a solved table replaced by the next run's,
+// the tutorial's by a robust run's), said beside the save; "" when there was none to read.
+std::string replacedTableText(const TableStore& tables)
+{
+  try
+  {
+    const QTable before = tables.load("");
+    return formatText(", replacing the one there (%llu episodes, %llu steps)", count(before.episodes),
+                      count(before.steps));
+  }
+  catch (const std::exception&)  // none there yet, or not a table: nothing to say it replaced
+  {
+    return "";
+  }
+}
 }  // namespace
 
 struct RunApplication::Parts
@@ -149,6 +165,7 @@ std::string RunApplication::Parts::saveFinal(bool done_well, const char* finishe
   // as it was. The default table first: a crash between the two saves then leaves a run not yet
   // marked finished, which a respawn finishes again.
   const bool publishes = done_well && !settings.q_table_path.empty();
+  const std::string replaced = publishes ? replacedTableText(tables) : "";
   const ServiceAnswer published = publishes ? tables.serveSave(session.table(), "") : ServiceAnswer{};
   std::string saved;
   saved_ok = true;
@@ -164,7 +181,8 @@ std::string RunApplication::Parts::saveFinal(bool done_well, const char* finishe
   }
   final_saved = saved_ok || published.success;
   if (publishes)
-    saved += (published.success ? "; the default table: " : "; BUT NOT the default table: ") + published.message;
+    saved += (published.success ? "; the default table: " + published.message + replaced
+                                : "; BUT NOT the default table: " + published.message);
   else if (!settings.q_table_path.empty())
     saved += "; the default table " + tables.resolveForService("") + " is left as it was (this run did not " +
              (config.limits.until == TrainUntil::SuitePasses ? "pass the suite" : "solve") +

@@ -1,10 +1,10 @@
-// A profile of config/robots/ on the graph, as a user runs it (test/rostest/robot_profile_*.test): the sim poses as
-// that cart-pole in lockstep; the controller started by robot.launch robot:=NAME (in the .test, with a table folder and
-// stop_when_solved) trains until solved; this node then runs `roslaunch cartpole_qlearning robot.launch robot:=NAME
-// mode:=evaluate load:=q_table.yaml` against the same sim, as the user's next command, and reads its verdict.
-// Private parameters: ros_home (the folder under which the training wrote its tables, ROS_HOME for the evaluation),
-// robot (the profile), evaluate_args (what else the evaluation's command line needs: a reset for a robot that has
-// none over ROS).
+// A profile of config/robots/ on the graph, as a user tries it (test/rostest/robot_profile_*.test): try_robot.launch
+// robot:=NAME, the sim posing as that cart-pole in lockstep and the controller of robot.launch robot:=NAME (in the
+// .test, with a table folder) trains until solved; this node then runs `roslaunch cartpole_qlearning robot.launch
+// robot:=NAME mode:=evaluate load:=q_table.yaml` against the same sim, as the user's next command, and reads its
+// verdict. Private parameters: ros_home (the folder under which the training wrote its tables, ROS_HOME for the
+// evaluation), robot (the profile), evaluate_args (what else the evaluation's command line needs: a reset for a
+// robot that has none over ROS).
 #include "cartpole_qlearning/EpisodeStats.h"
 #include "ros_test_support.h"
 #include "rostest_main.h"

@@ -1,6 +1,9 @@
 // A table is a controller (table_alone.test): evaluated with no config, through robot.launch and evaluate.launch,
 // it runs with the configuration its file carries, in episodes of the evaluation's own length rather than the
 // training's; a config that contradicts it is refused with both values and both sources named.
+#include "cartpole_qlearning/LoadQTable.h"
+#include "cartpole_qlearning/SaveQTable.h"
+
 #include "rostest_main.h"
 #include "test_support.h"
 #include "text_match.h"
@@ -91,4 +94,52 @@ TEST(TableAlone, RobotAndEvaluateLaunchRunATableWithItsOwnConfigurationInTheEval
   EXPECT_EQ(0, status) << evaluated;
   EXPECT_NE(std::string::npos, evaluated.find("with the table's own configuration")) << evaluated;
   EXPECT_EQ(500, verdictSteps(evaluated, 2)) << evaluated;
+}
+
+// A launch argument is the user's own (issue 30): evaluate.launch q_table:=/abs/path.yaml loads a table
+// that lies outside the table folder (as train_headless --save /abs/path.yaml writes it). The services
+// stay confined to the folder: their caller is anyone on the graph.
+TEST(TableAlone, EvaluateLaunchLoadsAnAbsoluteTableWhileItsServicesStayInTheFolder)
+{
+  const std::string home = kRosHome.path() + "/absolute";
+  const std::string elsewhere = kRosHome.path() + "/elsewhere";
+  std::filesystem::create_directories(home);
+  std::filesystem::create_directories(elsewhere);
+  const std::string table = elsewhere + "/mine.yaml";
+  const auto trained =
+      runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --seed 0 --quiet --no-run-folder --save " + table);
+  ASSERT_EQ(0, trained.status) << trained.output;
+  ASSERT_TRUE(std::filesystem::exists(table)) << trained.output;
+
+  // Two episodes and a verdict: the launch ends by itself, having loaded the table where it lies.
+  int status = -1;
+  const std::string evaluated = launchOutput(
+      home, "absolute", "ns:=absolute mode:=lockstep episodes:=2 q_table:=" + table, "evaluate.launch", status);
+  EXPECT_EQ(0, status) << evaluated;
+  EXPECT_NE(std::string::npos, evaluated.find("loaded " + table + " (259 episodes, 61681 steps of training)"))
+      << evaluated;
+  EXPECT_NE(std::string::npos, evaluated.find("with the table's own configuration (" + table + ")")) << evaluated;
+  EXPECT_EQ(500, verdictSteps(evaluated, 2)) << evaluated;
+  EXPECT_EQ(std::string::npos, evaluated.find("outside")) << evaluated;
+
+  // Running on (episodes:=0), its services refuse that same absolute path, both ways.
+  TrainLaunch running(home, "absolute_services", "ns:=services mode:=lockstep episodes:=0 q_table:=" + table,
+                      "evaluate.launch");
+  const std::string load_name = "/services/qlearning_controller/load_q_table";
+  const std::string save_name = "/services/qlearning_controller/save_q_table";
+  ASSERT_TRUE(ros::service::waitForService(load_name, ros::Duration(60.0))) << running.output();
+  ASSERT_TRUE(ros::service::waitForService(save_name, ros::Duration(10.0))) << running.output();
+  const std::string before = cartpole_qlearning::test::fileText(table);
+  cartpole_qlearning::LoadQTable load;
+  load.request.path = table;
+  ASSERT_TRUE(ros::service::call(load_name, load));
+  EXPECT_FALSE(load.response.success);
+  EXPECT_NE(std::string::npos, load.response.message.find("is outside")) << load.response.message;
+  cartpole_qlearning::SaveQTable save;
+  save.request.path = elsewhere + "/written.yaml";
+  ASSERT_TRUE(ros::service::call(save_name, save));
+  EXPECT_FALSE(save.response.success);
+  EXPECT_NE(std::string::npos, save.response.message.find("nothing written")) << save.response.message;
+  EXPECT_FALSE(std::filesystem::exists(elsewhere + "/written.yaml"));
+  EXPECT_EQ(before, cartpole_qlearning::test::fileText(table));
 }

@@ -46,7 +46,7 @@ struct RunSettings
   std::string q_table_path = "q_table.yaml";  // the default table, relative to q_table_dir ("": none)
   std::string load_on_start;                  // a table to start from ("": none)
   // An absolute q_table_path or load_on_start is the user's own, followed as the shell would
-  // (train_headless's command line); else it must lie inside q_table_dir (the node's parameters).
+  // (train_headless's command line, the node's parameters); false: it must lie inside q_table_dir.
   bool own_absolute_paths = false;
   // "" the run's folder/episodes.csv (training; none when evaluating), "none" no file, else a
   // path (relative: under q_table_dir; absolute: the user's own).

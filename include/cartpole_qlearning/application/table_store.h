@@ -1,8 +1,8 @@
 // Where Q-tables are read and written: the table folder, the default table in it, and the path
 // rule the node's parameters, its services and train_headless's command line share. A relative
 // path lies under the folder; an absolute one given by the user (the settings, the command line)
-// is the user's file when the store is told so (train_headless), else it too must lie in the
-// folder; a path through a service always does. A path that escapes the folder is refused.
+// is the user's file when the store is told so (train_headless, the node's parameters), else it
+// too must lie in the folder; a path through a service always does. A path that escapes the folder is refused.
 #pragma once
 
 #include "cartpole_qlearning/common/log_line.h"
@@ -35,8 +35,8 @@ struct TableRead
 // What an absolute path the user gives (not a service's caller) names.
 enum class AbsolutePaths
 {
-  MustLieInTheFolder,  // the node's parameters
-  AreTheUsersFiles     // train_headless's command line: followed as the shell would
+  MustLieInTheFolder,
+  AreTheUsersFiles  // train_headless's command line, the node's parameters: followed as the shell would
 };
 
 class TableStore

@@ -243,14 +243,21 @@ TEST(ControllerSettings, KnowsTheKeysItWritesAndThoseOfLiveTuning)
   EXPECT_SAYS(controllerError("alpha_override: 0.1"), "unknown key alpha_override");
 }
 
-TEST(ControllerSettings, RefusesTablePathsThatLeaveTheirFolder)
+TEST(ControllerSettings, RefusesRelativeTablePathsThatLeaveTheirFolder)
 {
   EXPECT_SAYS(controllerError("q_table_dir: ''"), "q_table_dir = '' is not allowed (must name a directory)");
   const std::string path = controllerError("{q_table_dir: /tmp/t, q_table_path: ../q.yaml}");
   EXPECT_SAYS(path, "qlearning_controller: q_table_path = '../q.yaml' is not allowed (");
-  EXPECT_SAYS(controllerError("{q_table_dir: /tmp/t, q_table_path: /elsewhere/q.yaml}"),
-              "q_table_path = '/elsewhere/q.yaml' is not allowed (");
   EXPECT_EQ("", controllerError("{q_table_dir: /tmp/t, q_table_path: /tmp/t/sub/q.yaml}"));
+}
+
+TEST(ControllerSettings, AnAbsoluteTablePathIsTheUsersOwn)
+{
+  // A parameter is set by the user (a launch argument): an absolute table lies where they say.
+  // The services stay confined to the folder (RunApplicationTest.ServicesTakePathsUnderTheTableFolderOnly).
+  const ControllerSettings s = readController("{q_table_dir: /tmp/t, q_table_path: /elsewhere/q.yaml}");
+  EXPECT_EQ("/elsewhere/q.yaml", s.run.q_table_path);
+  EXPECT_TRUE(s.run.own_absolute_paths);
 }
 
 TEST(ControllerSettings, RefusesAStatsCsvOutsideItsFolder)

@@ -536,6 +536,25 @@ TEST_F(RunApplicationTest, ASolvedRunReplacesTheDefaultTable)
   EXPECT_TRUE(run.app->shutdown().empty());
 }
 
+// A table already there (a solved one, the tutorial's, replaced by a robust run's) is not replaced silently.
+TEST_F(RunApplicationTest, ASolvedRunSaysWhatDefaultTableItReplaced)
+{
+  Run run = startRun();
+  QTable before = run.session->table();
+  before.episodes = 7;
+  before.steps = 123;
+  const fs::path default_table = dir_ / "q_table.yaml";
+  saveQTableFile(before, default_table.string());
+  episode(run, true);
+  const EpisodeEnd end = episode(run, true, true);
+  ASSERT_TRUE(run.session->lastEpisode().solved);
+  EXPECT_EQ(2u, loadQTableFile(default_table.string()).episodes);
+  const LogLine solved = log(end.log, "SOLVED");
+  EXPECT_TRUE(says(end.log, "; the default table: saved 2 episodes, 10 steps of training to " + default_table.string() +
+                                ", replacing the one there (7 episodes, 123 steps)"))
+      << solved.text;
+}
+
 TEST_F(RunApplicationTest, AnUnsolvedRunLeavesTheDefaultTable)
 {
   config_.limits.max_episodes = 2;
