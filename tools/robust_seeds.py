@@ -83,9 +83,9 @@ def main():
         print('| %d | %s | %d | %d | %.1f | %s |' % (r['seed'], 'yes' if r['passed'] else '**no**', r['episodes'],
                                                     r['steps'], r['wall'], ' | '.join(str(b) for _, b in r['cases'])))
     median = lambda key: statistics.median(r[key] for r in rows)
-    print('| median | %d of %d | %g | %g | %.1f | %s |' % (
+    print('| median | %d of %d | %.10g | %.10g | %.1f | %s |' % (
         sum(r['passed'] for r in rows), len(rows), median('episodes'), median('steps'), median('wall'),
-        ' | '.join('%g' % statistics.median(r['cases'][i][1] for r in rows) for i in range(len(names)))))
+        ' | '.join('%.10g' % statistics.median(r['cases'][i][1] for r in rows) for i in range(len(names)))))
     print('| worst | | %d | %d | %.1f | %s |' % (
         max(r['episodes'] for r in rows), max(r['steps'] for r in rows), max(r['wall'] for r in rows),
         ' | '.join(str(min(r['cases'][i][1] for r in rows)) for i in range(len(names)))))
