@@ -6,11 +6,14 @@ of each column. The figures of docs/robust_tables.md come from one run of it:
 
   python3 tools/robust_seeds.py --config config/robust.yaml --seeds 0-19   (or --seeds 1,17,19)
 
+--jobs N runs N seeds at a time (default 1; each row's wall time is then that of a loaded machine).
+
 train_headless is found on PATH, else by catkin_find (source devel/setup.bash), or given with
 --train-headless.
 Nothing is written (--no-run-folder).
 """
 import argparse
+import concurrent.futures
 import re
 import shutil
 import statistics
@@ -51,9 +54,12 @@ def main():
     parser.add_argument('--config', required=True)
     parser.add_argument('--seeds', type=seeds, default=seeds('0-19'))
     parser.add_argument('--train-headless', default=find_train_headless())
+    parser.add_argument('--jobs', type=int, default=1, help='seeds trained at a time (default 1)')
     args = parser.parse_args()
-    rows = []
-    for seed in args.seeds:
+    if args.jobs < 1:
+        parser.error('--jobs %d: at least 1' % args.jobs)
+
+    def train(seed):
         start = time.time()
         out = subprocess.run([args.train_headless, '--config', args.config, '--seed', str(seed), '--no-run-folder'],
                              capture_output=True, text=True).stdout
@@ -64,9 +70,12 @@ def main():
         if not end or not verdict:
             sys.exit('seed %d: no verdict in the output:\n%s' % (seed, out))
         cases = re.findall(r'(\w+) (\d+)/(\d+)', verdict[-1])
-        rows.append(dict(seed=seed, passed=verdict[-1].endswith('PASSED'), episodes=int(end.group(2)),
-                         steps=int(end.group(3)), wall=wall, cases=[(n, int(b)) for n, b, _ in cases]))
         print('seed %d: %s' % (seed, verdict[-1]), file=sys.stderr, flush=True)
+        return dict(seed=seed, passed=verdict[-1].endswith('PASSED'), episodes=int(end.group(2)),
+                    steps=int(end.group(3)), wall=wall, cases=[(n, int(b)) for n, b, _ in cases])
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        rows = list(pool.map(train, args.seeds))
     names = [n for n, _ in rows[0]['cases']]
     print('| seed | passes | episodes | steps | wall s | ' + ' | '.join(names) + ' |')
     print('| --- ' * (5 + len(names)) + '|')
@@ -74,9 +83,9 @@ def main():
         print('| %d | %s | %d | %d | %.1f | %s |' % (r['seed'], 'yes' if r['passed'] else '**no**', r['episodes'],
                                                     r['steps'], r['wall'], ' | '.join(str(b) for _, b in r['cases'])))
     median = lambda key: statistics.median(r[key] for r in rows)
-    print('| median | %d of %d | %g | %g | %.1f | %s |' % (
+    print('| median | %d of %d | %.10g | %.10g | %.1f | %s |' % (
         sum(r['passed'] for r in rows), len(rows), median('episodes'), median('steps'), median('wall'),
-        ' | '.join('%g' % statistics.median(r['cases'][i][1] for r in rows) for i in range(len(names)))))
+        ' | '.join('%.10g' % statistics.median(r['cases'][i][1] for r in rows) for i in range(len(names)))))
     print('| worst | | %d | %d | %.1f | %s |' % (
         max(r['episodes'] for r in rows), max(r['steps'] for r in rows), max(r['wall'] for r in rows),
         ' | '.join(str(min(r['cases'][i][1] for r in rows)) for i in range(len(names)))))

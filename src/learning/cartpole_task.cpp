@@ -16,7 +16,10 @@ RewardScheme rewardSchemeFromString(const std::string& name)
     return RewardScheme::SuttonBarto;
   if (name == "alive")
     return RewardScheme::Alive;
-  throw std::invalid_argument("unknown reward scheme '" + name + "' (allowed: gymnasium, seed, sutton_barto, alive)");
+  if (name == "centred")
+    return RewardScheme::Centred;
+  throw std::invalid_argument("unknown reward scheme '" + name +
+                              "' (allowed: gymnasium, seed, sutton_barto, alive, centred)");
 }
 
 std::string toString(RewardScheme scheme)
@@ -31,6 +34,8 @@ std::string toString(RewardScheme scheme)
       return "sutton_barto";
     case RewardScheme::Alive:
       return "alive";
+    case RewardScheme::Centred:
+      return "centred";
   }
   return "unknown";
 }
@@ -110,6 +115,12 @@ StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned step
     case RewardScheme::Alive:
       outcome.reward = outcome.terminated ? 0.0 : 1.0;
       break;
+    case RewardScheme::Centred:
+    {
+      const double off_centre = new_state[0] / params_.x_threshold;
+      outcome.reward = outcome.terminated ? -1.0 : -kCentredCost * off_centre * off_centre;
+      break;
+    }
   }
   return outcome;
 }

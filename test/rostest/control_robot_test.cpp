@@ -3,8 +3,10 @@
 // minutes of the robot's time (lockstep: 15,000 decisions). What must hold: control_stats reports
 // the time, the longest stretch and the falls, and they add up with what the log says; every
 // fall is followed by a reset and control goes on; Ctrl-C ends it with a zero command and a last
-// line that says how it went. How long the table keeps the pole up is printed (issue 26: tables
-// that hold for minutes are the long suite's work), not asserted.
+// line that says how it went. How long the table keeps the pole up is printed, not asserted: a
+// table robust.yaml trains until it passes the one-minute suite (all_at_once 95 of 100) can
+// still fall in five minutes of all_at_once (docs/robust_tables.md). The seed is the .test's
+// `seed` argument (default 0): rostest cartpole_qlearning control_robot.test seed:=3
 #include "cartpole_qlearning/ControlStats.h"
 
 #include "ros_test_support.h"
@@ -43,8 +45,11 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
   const std::string home = kRosHome.path();
   ASSERT_FALSE(home.empty());
   std::filesystem::create_directories(home);
+  int seed = 0;
+  ros::param::get("~seed", seed);
   const auto trained = runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + CARTPOLE_CONFIG_DIR +
-                                  "/robust.yaml --seed 0 --quiet --no-run-folder --save robust.yaml");
+                                  "/robust.yaml --seed " + std::to_string(seed) +
+                                  " --quiet --no-run-folder --save robust.yaml");
   ASSERT_EQ(0, trained.status) << trained.output;
 
   ros::NodeHandle nh;
@@ -100,7 +105,8 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
       "control ended: balanced [0-9.]+ s of [0-9.]+ s, the longest stretch [0-9.]+ s, [0-9]+ falls?, 0 of "
       "[0-9]+ commands beyond the motor's 10 N"))
       << output;
-  std::printf("five minutes of control on all_at_once: %.1f s balanced, the longest stretch %.1f s, %llu falls\n",
-              at_five_minutes.balanced_seconds, at_five_minutes.longest_seconds,
+  std::printf("five minutes of control on all_at_once, seed %d's table: %.1f s balanced, the longest stretch %.1f s, "
+              "%llu falls\n",
+              seed, at_five_minutes.balanced_seconds, at_five_minutes.longest_seconds,
               static_cast<unsigned long long>(at_five_minutes.falls));
 }

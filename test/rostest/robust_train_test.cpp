@@ -34,7 +34,7 @@ TEST(RobustTrain, TrainsOnTheGraphToAPassingTableThatIsTrainHeadlesss)
       nh.subscribe<EpisodeStats>("/cartpole/episode_stats", 10000,
                                  boost::function<void(const cartpole_qlearning::EpisodeStatsConstPtr&)>(
                                      [&](const cartpole_qlearning::EpisodeStatsConstPtr& m) { stats.push_back(*m); }));
-  ASSERT_TRUE(spinUntil([&] { return !stats.empty() && !stats.back().robustness.empty(); }, 280.0))
+  ASSERT_TRUE(spinUntil([&] { return !stats.empty() && !stats.back().robustness.empty(); }, 500.0))
       << "no episode_stats with a robustness verdict; episodes seen: " << stats.size();
   const EpisodeStats& last = stats.back();
   EXPECT_NE(std::string::npos, last.robustness.find(": PASSED")) << last.robustness;

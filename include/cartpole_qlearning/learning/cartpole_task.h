@@ -13,10 +13,15 @@ enum class RewardScheme
   Gymnasium,    // +1 every step, the terminating one included (CartPole-v1)
   Seed,         // +1 while alive, -1 on the step that falls (the Q-learning tutorial's)
   SuttonBarto,  // 0 while alive, -1 on the step that falls (Barto, Sutton and Anderson 1983)
-  Alive         // +1 while alive, 0 on the step that falls (Gymnasium's InvertedPendulum-v5)
+  Alive,        // +1 while alive, 0 on the step that falls (Gymnasium's InvertedPendulum-v5)
+  Centred       // sutton_barto, and while alive -kCentredCost x (x / x_threshold)^2: a cart that drifts
+                // towards the end of the track costs before it falls (minutes-long control)
 };
 
-// Parses "gymnasium", "seed", "sutton_barto" or "alive"; throws std::invalid_argument otherwise.
+// What a step at the end of the track costs under RewardScheme::Centred, against -1 for the fall.
+constexpr double kCentredCost = 0.01;
+
+// Parses "gymnasium", "seed", "sutton_barto", "alive" or "centred"; throws std::invalid_argument otherwise.
 RewardScheme rewardSchemeFromString(const std::string& name);
 std::string toString(RewardScheme scheme);
 // What a return means under the scheme, for a reader of the logs: "0 a step, -1 on the fall".

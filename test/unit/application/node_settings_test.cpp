@@ -568,11 +568,11 @@ TEST(ControllerSettings, AnEvaluationOfASuiteCaseSaysTheCaseAndItsPassCount)
   EXPECT_EQ("case all_at_once of " + suite, s.run.evaluation_case);
   // The suite's episodes unless evaluation_episodes is set, the pass count scaled to them.
   EXPECT_EQ(100u, s.run.evaluation_episodes);
-  EXPECT_EQ(90u, s.run.evaluation_pass);
+  EXPECT_EQ(95u, s.run.evaluation_pass);
   const ControllerSettings shorter =
-      readController("{mode: evaluate, evaluation_episodes: 20, suite: " + suite + ", suite_case: nominal}");
+      readController("{mode: evaluate, evaluation_episodes: 20, suite: " + suite + ", suite_case: pushes}");
   EXPECT_EQ(20u, shorter.run.evaluation_episodes);
-  EXPECT_EQ(19u, shorter.run.evaluation_pass);  // 95 of 100: 19 of 20
+  EXPECT_EQ(20u, shorter.run.evaluation_pass);  // 98 of 100: 19.6 of 20, rounded up
   EXPECT_EQ("", readController("{mode: evaluate, suite: " + suite + "}").run.evaluation_case);
   EXPECT_SAYS(controllerError("{mode: train, suite: " + suite + ", suite_case: nominal}"),
               "suite_case = 'nominal' is not allowed (only with mode evaluate");

@@ -75,7 +75,7 @@ TEST(TrainingConfigText, TheSameConfigurationIsTheSameTextHoweverItWasWritten)
   const std::string robust = trainingConfigText(shipped("robust.yaml"));
   EXPECT_NE(trainingConfigText(readText("")), robust);
   EXPECT_NE(std::string::npos, robust.find("max_episode_steps: 200")) << robust;
-  EXPECT_NE(std::string::npos, robust.find("bins: [3, 3, 6, 12]")) << robust;
+  EXPECT_NE(std::string::npos, robust.find("bins: [3, 3, 8, 12]")) << robust;
 }
 
 TEST(TrainingConfigText, SaysWhetherASourceHoldsAConfiguration)
@@ -137,15 +137,15 @@ TEST(TableConfig, AContradictionNamesTheConfigsValueAndTheTablesWithBothSources)
   // Every key that differs, the config's value first (the refusal named neither).
   for (const std::string key : {"learning/bins", "learning/lower_bounds", "learning/upper_bounds"})
     EXPECT_NE(std::string::npos, said.find(key + " is ")) << key << ": " << said;
-  EXPECT_EQ(0u, said.find("learning/bins is [1, 1, 6, 12] in cartpole.yaml but [3, 3, 6, 12] in the table "
+  EXPECT_EQ(0u, said.find("learning/bins is [1, 1, 6, 12] in cartpole.yaml but [3, 3, 8, 12] in the table "
                           "/t/robust_table.yaml; "))
       << said;
 
   // One at a time, each named with both values.
   TrainingConfig bins = trained;
   bins.agent.discretiser.bins = {{1, 1, 6, 12}};
-  ASSERT_EQ((std::array<unsigned, 4>{{3, 3, 6, 12}}), trained.agent.discretiser.bins);
-  EXPECT_EQ("learning/bins is [1, 1, 6, 12] in my.yaml but [3, 3, 6, 12] in the table /t/q.yaml",
+  ASSERT_EQ((std::array<unsigned, 4>{{3, 3, 8, 12}}), trained.agent.discretiser.bins);
+  EXPECT_EQ("learning/bins is [1, 1, 6, 12] in my.yaml but [3, 3, 8, 12] in the table /t/q.yaml",
             tableContradiction(bins, "my.yaml", table, "/t/q.yaml"));
   TrainingConfig previous = trained;
   previous.agent.previous_action = true;
