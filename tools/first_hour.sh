@@ -259,6 +259,10 @@ run "evaluate.launch q_table:=runs/my_table.yaml" 100 0 \
 run "evaluate.launch q_table:=/tmp/x.yaml" 100 0 \
   "rosrun cartpole_qlearning train_headless --save /tmp/x.yaml --no-run-folder --quiet && roslaunch cartpole_qlearning evaluate.launch q_table:=/tmp/x.yaml episodes:=1" \
   "loaded /tmp/x.yaml \(259 episodes" "EVALUATED 1 episodes: [01] balanced to the step limit"
+# In lockstep the verdict is the same every run: the page's block, figure for figure.
+run "evaluate.launch mode:=lockstep" 200 0 "roslaunch cartpole_qlearning evaluate.launch q_table:=q_table.yaml mode:=lockstep" \
+  "EVALUATED 5 episodes"
+output docs/tutorial.md tutorial_evaluate_lockstep
 # Posing as a case of the suite, in lockstep: the verdict is train_headless's, figure for figure.
 run "evaluate.launch suite_case:=one_step_late" 200 0 \
   "roslaunch cartpole_qlearning evaluate.launch suite_case:=one_step_late mode:=lockstep" "EVALUATED 100 episodes"

@@ -52,13 +52,19 @@ std::string rewardMeaning(RewardScheme scheme)
       return "0 a step, -1 on the fall";
     case RewardScheme::Alive:
       return "+1 a step, 0 on the fall";
+    case RewardScheme::Centred: {
+      std::ostringstream out;
+      out << "-" << kCentredCost << " x (x / x_threshold)^2 a step, -1 on the fall";
+      return out.str();
+    }
   }
   return "unknown";
 }
 
 double TaskParams::largestReturn() const
 {
-  return reward == RewardScheme::SuttonBarto ? 0.0 : static_cast<double>(max_episode_steps);
+  return reward == RewardScheme::SuttonBarto || reward == RewardScheme::Centred ? 0.0
+                                                                                : static_cast<double>(max_episode_steps);
 }
 
 double TaskParams::thetaThresholdRad() const

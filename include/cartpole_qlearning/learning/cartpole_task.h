@@ -40,7 +40,7 @@ struct TaskParams
   double thetaThresholdRad() const;
   // The largest return an episode can have (one that balances to max_episode_steps).
   double largestReturn() const;
-  // Whether solved_mean_return can be reached at all: not under sutton_barto (at most 0), nor with
+  // Whether solved_mean_return can be reached at all: not under sutton_barto or centred (at most 0), nor with
   // episodes shorter than it. Training with such a task never says solved; its goal is elsewhere
   // (training/until suite_passes).
   bool solvable() const
