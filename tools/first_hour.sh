@@ -307,6 +307,11 @@ run "train_headless --robots 4" 120 0 "rosrun cartpole_qlearning train_headless 
 run "train_headless --save headless.yaml" 120 0 "rosrun cartpole_qlearning train_headless --save headless.yaml" \
   "the default table: saved .* to $TABLES/headless.yaml" "^until=solved reached=true solved=true"
 output docs/train_headless.md train_headless
+# A config that contradicts the table: refused, both sources named.
+run "robot.launch: a config that contradicts the table" 60 0 \
+  "roslaunch cartpole_qlearning robot.launch mode:=evaluate load:=headless.yaml config:=\$(rospack find cartpole_qlearning)/config/tiles.yaml" \
+  "cannot start from the table 'headless.yaml'"
+output docs/launch_files.md table_contradiction
 # Real time again, and the headless table balances 19 of 20 lockstep episodes (train_headless
 # --evaluate headless.yaml --episodes 20): the verdict is checked for its form.
 run "evaluate.launch q_table:=headless.yaml" 120 0 \
@@ -337,6 +342,17 @@ run "try_robot.launch robot:=openai_ros_cartpole" 400 0 \
 run "try_robot.launch: evaluate the table" 200 0 \
   "roslaunch cartpole_qlearning try_robot.launch robot:=openai_ros_cartpole mode:=evaluate load:=q_table.yaml" \
   "EVALUATED 10 episodes: [0-9]+ balanced to the step limit \(500 steps\)"
+# The table as a controller, until Ctrl-C: its reports are the page's in form (how long a table
+# holds the posed robot is the table's: checked for form only).
+if start "try_robot.launch mode:=control" \
+  "roslaunch cartpole_qlearning try_robot.launch robot:=openai_ros_cartpole mode:=control load:=q_table.yaml"; then
+  control=$BACKGROUND_PID
+  control_log=$LAST_LOG
+  wait_for 120 "$control_log" "control: balanced" || echo "[first-hour] no control report within 120 s"
+  stop_launch "try_robot.launch mode:=control ends on Ctrl-C" "$control" "$control_log" "control: balanced"
+  LAST_LOG=$control_log
+  output docs/launch_files.md control_report
+fi
 
 echo "[first-hour] not run: catkin_make tests and rostest (scripts/test.sh builds and runs every test with the \
 same commands in CI's workspace; a second build of every test here cost a good part of CI's time), rqt_plot (Debian 12 ships no rqt), plot_learning_curve --follow (runs until \
