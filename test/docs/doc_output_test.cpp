@@ -117,7 +117,7 @@ TEST(DocOutputBlocks, EveryMarkedBlockIsCheckedByFirstHour)
       const std::size_t from = at + 13;
       const std::string name = text.substr(from, text.find_first_of(", ", from) - from);
       ++marked;
-      EXPECT_NE(std::string::npos, first_hour.find("\noutput " + page + " " + name + "\n"))
+      EXPECT_NE(std::string::npos, first_hour.find("output " + page + " " + name + "\n"))
           << page << "'s output block " << name << " is not checked by tools/first_hour.sh";
     }
   }
