@@ -74,8 +74,16 @@ def main():
         return dict(seed=seed, passed=verdict[-1].endswith('PASSED'), episodes=int(end.group(2)),
                     steps=int(end.group(3)), wall=wall, cases=[(n, int(b)) for n, b, _ in cases])
 
+    # A seed without a verdict stops the whole run at once (sys.exit in a worker thread would only
+    # surface after every queued seed had trained): the seeds not started are cancelled.
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        rows = list(pool.map(train, args.seeds))
+        futures = [pool.submit(train, seed) for seed in args.seeds]
+        try:
+            rows = [future.result() for future in futures]
+        except SystemExit:
+            for future in futures:  # (cancel_futures= needs Python 3.9; Noetic's Ubuntu has 3.8)
+                future.cancel()
+            raise
     names = [n for n, _ in rows[0]['cases']]
     print('| seed | passes | episodes | steps | wall s | ' + ' | '.join(names) + ' |')
     print('| --- ' * (5 + len(names)) + '|')

@@ -153,7 +153,7 @@ SuiteResult BestTableKeeper::settle(TrainingSession& session, std::optional<Suit
                    formatText("robustness of the saved table, for information (%s, greedy, %llu episodes per case):\n",
                               suite_path_.c_str(), count(suite_->episodes)) +
                        last->rows() + verdict +
-                       ". This run trained until solved (the tutorial's goal); config/robust.yaml trains until this "
+                       ". This run's goal was solved (the tutorial's), not this suite; config/robust.yaml trains until this "
                        "suite passes (docs/robust_tables.md)",
                    false});
   }

@@ -208,7 +208,7 @@ void RunApplication::Parts::endTraining(const EpisodeSummary& s, bool passed, co
   }
   const bool until_suite = config.limits.until == TrainUntil::SuitePasses;
   // A run that went on after solving says when it solved and what its window holds now.
-  const bool went_on = !until_suite && !config.limits.stop_when_solved && first_solved > 0;
+  const bool went_on = config.limits.goesOnAfterSolved() && first_solved > 0;
   const std::string outcome = until_suite ? (passed ? "SUITE PASSED" : "suite NOT passed, max_episodes reached")
                               : went_on   ? formatText("SOLVED at episode %llu, went on: max_episodes reached",
                                                        count(first_solved))
@@ -289,7 +289,8 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
   }
   const bool passed = verdict && verdict->passed();
   const bool done_well = until_suite ? passed : s.solved;
-  end.goal_reached = training_finished && done_well;
+  // Where training was going: solved, the suite passed, or (going on after solved) max_episodes.
+  end.goal_reached = training_finished && (p.config.limits.goesOnAfterSolved() || done_well);
   const char* finished_as = !done_well ? "max_episodes" : until_suite ? "suite_passed" : "solved";
 
   // When training ends here, the table is saved before the caller says so: whoever acts on the

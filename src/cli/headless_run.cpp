@@ -99,7 +99,7 @@ TrainingResult HeadlessRun::run()
         // What the saved table is worth is a result, as the result line is: --quiet keeps it.
         if (options_.quiet && !end.robustness.empty())
           std::printf("robustness of the saved table%s: %s\n",
-                      config.limits.until == TrainUntil::SuitePasses ? "" : " (for information: trained until solved)",
+                      config.limits.until == TrainUntil::SuitePasses ? "" : " (for information: this run's goal was solved)",
                       end.robustness.c_str());
         verdict_seconds_ += end.verdict_seconds;
         goal_reached_ = goal_reached_ || end.goal_reached;

@@ -31,7 +31,8 @@ public:
 
   // Of run()'s seconds, those the saved table's final verdict (the suite) took.
   double verdictSeconds() const;
-  // Training ended where it trained to: solved, or under until suite_passes the suite passed.
+  // Training ended where it trained to: solved, under until suite_passes the suite passed, going on
+  // after solved max_episodes.
   bool goalReached() const;
   bool stopped() const;
   // A failure the mode found after the run (it has said it).

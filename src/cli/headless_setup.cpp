@@ -34,20 +34,22 @@ std::string lookUpPackage()
 {
   // rospack crawls every folder under the package path before it answers (Debian's adds
   // /usr/share: hundreds of folders, 0.1-0.3 s, most of a run to solved). The package is nearly
-  // always at the top of an entry (a workspace's src/cartpole_qlearning, or the entry itself):
-  // looked for there first, entry by entry in rospack's order; anywhere else, rospack finds it.
+  // always at the top of the first entry (a workspace's src/cartpole_qlearning, or the entry
+  // itself), which is where rospack's crawl would find it first too: looked for there; anywhere
+  // else (deeper, or in a later entry, where an earlier entry may hold it deeper), rospack finds it.
   if (const char* path = std::getenv("ROS_PACKAGE_PATH"))
   {
     std::istringstream entries(path);
-    std::string entry;
-    while (std::getline(entries, entry, ':'))
+    std::string first;
+    while (first.empty() && std::getline(entries, first, ':'))
     {
-      if (entry.empty())
-        continue;
-      if (isThisPackage(entry))
-        return entry;
-      if (isThisPackage(std::filesystem::path(entry) / "cartpole_qlearning"))
-        return (std::filesystem::path(entry) / "cartpole_qlearning").string();
+    }
+    if (!first.empty())
+    {
+      if (isThisPackage(first))
+        return first;
+      if (isThisPackage(std::filesystem::path(first) / "cartpole_qlearning"))
+        return (std::filesystem::path(first) / "cartpole_qlearning").string();
     }
   }
   return ros::package::getPath("cartpole_qlearning");

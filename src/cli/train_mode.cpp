@@ -13,7 +13,9 @@ namespace
 // What training runs until: "solved", "max_episodes" (it goes on after solved) or "suite_passes".
 const char* trainedUntil(const TrainingLimits& limits)
 {
-  return limits.until == TrainUntil::SuitePasses ? "suite_passes" : limits.stop_when_solved ? "solved" : "max_episodes";
+  return limits.until == TrainUntil::SuitePasses ? "suite_passes"
+         : limits.goesOnAfterSolved()            ? "max_episodes"
+                                                 : "solved";
 }
 
 // The result line: what the run trained until and whether it got there, whether the window ever
@@ -60,10 +62,11 @@ int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup)
   {
     // A resumed run that had finished: nothing to train; its counts, as a result line.
     const EpisodeSummary& last = run.session().lastEpisode();
-    // Its record says how it finished ("solved", "suite_passed" or "max_episodes").
-    const bool to_max_episodes = std::string(trainedUntil(setup.config.limits)) == "max_episodes";
-    printResult(setup.config, to_max_episodes || (from.record && from.record->finished != "max_episodes"), from.solved(), last.episode,
-                last.total_steps, 0.0, 0.0);
+    // Its record says how it finished ("solved", "suite_passed" or "max_episodes"): where it was
+    // going, unless it ran out of episodes first.
+    const bool reached = setup.config.limits.goesOnAfterSolved() ||
+                         (from.record && from.record->finished != "max_episodes");
+    printResult(setup.config, reached, from.solved(), last.episode, last.total_steps, 0.0, 0.0);
     return 0;
   }
   const TrainingResult result = run.run();
@@ -82,10 +85,7 @@ int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup)
   // too, and the line before this one says so: steps= counts what that table counts, so that the
   // two agree (episodes= counts finished episodes, as the table does).
   const std::uint64_t steps = run.stopped() ? run.session().table().steps : last.total_steps;
-  const TrainingLimits& limits = setup.config.limits;
-  const bool ran_them_all = !run.stopped() && last.episode >= limits.max_episodes;
-  const bool reached = limits.until == TrainUntil::Solved && !limits.stop_when_solved ? ran_them_all : run.goalReached();
-  printResult(setup.config, reached, result.solved, last.episode, steps, result.wall_s - run.verdictSeconds(),
+  printResult(setup.config, run.goalReached(), result.solved, last.episode, steps, result.wall_s - run.verdictSeconds(),
               run.verdictSeconds());
   return run.exitStatus();
 }

@@ -149,8 +149,9 @@ TEST_F(TrainHeadlessTest, SolvesAndEndsWithTheResultLine)
   EXPECT_NE(std::string::npos, run.output.find("mean_return_100")) << run.output;
 }
 
-// The package (its config/ folder) is found on ROS_PACKAGE_PATH as rospack finds it, whether an
-// entry is the package's folder, the folder holding it, or neither (then rospack's crawl).
+// The package (its config/ folder) is found on ROS_PACKAGE_PATH as rospack finds it, whether the
+// first entry is the package's folder or the folder holding it (looked at directly), or it lies
+// deeper or in a later entry (rospack's crawl).
 TEST_F(TrainHeadlessTest, ThePackageIsFoundWhereverThePackagePathHasIt)
 {
   const fs::path package = fs::canonical(fs::path(CARTPOLE_CONFIG_DIR).parent_path());
@@ -184,7 +185,7 @@ TEST_F(TrainHeadlessTest, EveryRunSaysWhatItsTableIsWorthOnTheRobustnessSuite)
   EXPECT_NE(std::string::npos, run.output.find("robustness of the saved table, for information (" CARTPOLE_CONFIG_DIR
                                                "/robust_suite.yaml, greedy, 100 episodes per case):"))
       << run.output;
-  EXPECT_TRUE(text_match::contains(run.output, "\none_step_late +0/100 +95 +[0-9.]+ +FAIL\n")) << run.output;
+  EXPECT_TRUE(text_match::contains(run.output, "\none_step_late +0/100 +[0-9]+ +[0-9.]+ +FAIL\n")) << run.output;
   EXPECT_TRUE(text_match::contains(run.output, "\n[0-9] of 8 cases pass: not yet a table for a real robot. .*"
                                                "config/robust.yaml trains until this suite passes.*\nSOLVED after "))
       << run.output;
@@ -236,7 +237,7 @@ TEST_F(TrainHeadlessTest, QuietKeepsTheRobustnessOfTheSavedTableBesideTheResultL
   // What the table is worth (a table of 5 episodes falls everywhere), then the result line; no
   // progress line, no other line of the suite.
   EXPECT_TRUE(text_match::contains(run.output,
-                                   "(^|\n)robustness of the saved table \\(for information: trained until solved\\): "
+                                   "(^|\n)robustness of the saved table \\(for information: this run's goal was solved\\): "
                                    "nominal [0-9]+/100, one_step_late [0-9]+/100, .*all_at_once [0-9]+/100: "
                                    "FAILED\nuntil=solved reached=false solved=false episodes=5 "))
       << run.output;

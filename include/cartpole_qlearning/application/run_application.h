@@ -64,7 +64,7 @@ struct EpisodeEnd
   // robustness); "" otherwise, or when there is no suite (training/suite none).
   std::string robustness;
   // Training ended here: whether it got where it trained to (solved; under until suite_passes, the
-  // suite passed; when it goes on after solved, the last window solved).
+  // suite passed; when it goes on after solved, max_episodes: always, ended here).
   bool goal_reached = false;
   // Training ended here: the wall seconds the saved table's final verdict (the suite) took, apart
   // from the training's.

@@ -249,6 +249,11 @@ struct TrainingLimits
   std::uint64_t suite_every = 0;  // [episodes] also evaluate it during training, keeping the best table (0: never)
   TrainUntil until = TrainUntil::Solved;
 
+  // Training goes on after solved, to max_episodes (stop_when_solved false, until solved).
+  bool goesOnAfterSolved() const
+  {
+    return until == TrainUntil::Solved && !stop_when_solved;
+  }
   // Whether training ends after the episode that made `episodes` in all, `solved` or not (a
   // suite that passes ends it too: the run application decides that).
   bool reached(std::uint64_t episodes, bool solved) const

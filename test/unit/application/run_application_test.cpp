@@ -938,9 +938,9 @@ TEST_F(RunApplicationTest, EveryRunSaysWhatItsSavedTableIsWorthAndTheDefaultOneT
   EXPECT_NE(std::string::npos, said.find(verdict.rows())) << said;
   ASSERT_FALSE(verdict.passed());
   EXPECT_NE(std::string::npos, said.find("\n" + std::to_string(verdict.casesPassed()) +
-                                         " of 8 cases pass: not yet a table for a real robot. This run trained "
-                                         "until solved (the tutorial's goal); config/robust.yaml trains until this "
-                                         "suite passes (docs/robust_tables.md)"))
+                                         " of 8 cases pass: not yet a table for a real robot. This run's goal was "
+                                         "solved (the tutorial's), not this suite; config/robust.yaml trains until "
+                                         "this suite passes (docs/robust_tables.md)"))
       << said;
   EXPECT_EQ(std::string::npos, said.find("FAILED")) << said;
   const RunRecord record = parseRunRecord(text(dir_ / folderName() / "run.yaml"));
