@@ -145,17 +145,17 @@ SuiteResult BestTableKeeper::settle(TrainingSession& session, std::optional<Suit
   {
     // Not this run's goal: what the table would be worth on a robot, with where to go for that,
     // rather than a FAILED beside the SOLVED that follows.
-    const std::string verdict =
-        last->passed() ? "every case passes: robust by this suite as well"
-                       : formatText("%zu of %zu cases pass: not yet a table for a real robot", last->casesPassed(),
-                                    last->cases_in_suite);
-    log.push_back({LogLine::Level::Info,
-                   formatText("robustness of the saved table, for information (%s, greedy, %llu episodes per case):\n",
-                              suite_path_.c_str(), count(suite_->episodes)) +
-                       last->rows() + verdict +
-                       ". This run's goal was solved (the tutorial's), not this suite; config/robust.yaml trains until this "
-                       "suite passes (docs/robust_tables.md)",
-                   false});
+    const std::string verdict = last->passed() ? "every case passes: robust by this suite as well"
+                                               : formatText("%zu of %zu cases pass: not yet a table for a real robot",
+                                                            last->casesPassed(), last->cases_in_suite);
+    log.push_back(
+        {LogLine::Level::Info,
+         formatText("robustness of the saved table, for information (%s, greedy, %llu episodes per case):\n",
+                    suite_path_.c_str(), count(suite_->episodes)) +
+             last->rows() + verdict +
+             ". This run's goal was solved (the tutorial's), not this suite; config/robust.yaml trains until this "
+             "suite passes (docs/robust_tables.md)",
+         false});
   }
   return *last;
 }

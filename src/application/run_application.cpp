@@ -87,7 +87,7 @@ struct RunApplication::Parts
   BestTableKeeper keeper;
   RunMeters meters;
   std::function<std::chrono::steady_clock::time_point()> steady;  // times the final verdict
-  std::vector<std::string> state_names;  // as the trace names the rows
+  std::vector<std::string> state_names;                           // as the trace names the rows
   // A table to load has this run's shape (useTable refuses any other): its file is at most this
   // long. Fixed for the run, so readTable() reads it without a lock. (After session: initialised
   // from it.)
@@ -209,13 +209,13 @@ void RunApplication::Parts::endTraining(const EpisodeSummary& s, bool passed, co
   const bool until_suite = config.limits.until == TrainUntil::SuitePasses;
   // A run that went on after solving says when it solved and what its window holds now.
   const bool went_on = config.limits.goesOnAfterSolved() && first_solved > 0;
-  const std::string outcome = until_suite ? (passed ? "SUITE PASSED" : "suite NOT passed, max_episodes reached")
-                              : went_on   ? formatText("SOLVED at episode %llu, went on: max_episodes reached",
-                                                       count(first_solved))
-                              : s.solved  ? "SOLVED"
-                                          : "NOT solved, max_episodes reached";
-  std::string window = formatText("mean return of the last %u: %.2f", config.task.solved_window,
-                                  shownReturn(s.mean_return_window, 2));
+  const std::string outcome =
+      until_suite ? (passed ? "SUITE PASSED" : "suite NOT passed, max_episodes reached")
+      : went_on   ? formatText("SOLVED at episode %llu, went on: max_episodes reached", count(first_solved))
+      : s.solved  ? "SOLVED"
+                  : "NOT solved, max_episodes reached";
+  std::string window =
+      formatText("mean return of the last %u: %.2f", config.task.solved_window, shownReturn(s.mean_return_window, 2));
   if (went_on)
     window += s.solved ? ", still solved" : formatText(", below %g now", config.task.solved_mean_return);
   if (config.task.reward != RewardScheme::Gymnasium)

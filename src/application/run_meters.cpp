@@ -78,10 +78,10 @@ bool RunMeters::addEvaluationEpisode(const EpisodeSummary& s, LogLines& log)
   const RewardScheme reward = config_.task.reward;
   const std::string meaning =
       reward == RewardScheme::Gymnasium ? "" : " (" + toString(reward) + "'s reward: " + rewardMeaning(reward) + ")";
-  log.push_back({LogLine::Level::Info,
-                 formatText("evaluation episode %llu: %u steps, return %.1f%s, %s", count(s.episode), s.steps,
-                            s.episode_return, s.episode == 1 ? meaning.c_str() : "",
-                            s.terminated ? "fell" : "balanced to the step limit")});
+  log.push_back(
+      {LogLine::Level::Info,
+       formatText("evaluation episode %llu: %u steps, return %.1f%s, %s", count(s.episode), s.steps, s.episode_return,
+                  s.episode == 1 ? meaning.c_str() : "", s.terminated ? "fell" : "balanced to the step limit")});
   if (evaluation_episodes_ == 0 || s.episode < evaluation_episodes_)
     return false;
   std::string verdict = formatText(

@@ -98,9 +98,10 @@ TrainingResult HeadlessRun::run()
         error_ = printLog(end.log, options_.quiet) || error_;
         // What the saved table is worth is a result, as the result line is: --quiet keeps it.
         if (options_.quiet && !end.robustness.empty())
-          std::printf("robustness of the saved table%s: %s\n",
-                      config.limits.until == TrainUntil::SuitePasses ? "" : " (for information: this run's goal was solved)",
-                      end.robustness.c_str());
+          std::printf(
+              "robustness of the saved table%s: %s\n",
+              config.limits.until == TrainUntil::SuitePasses ? "" : " (for information: this run's goal was solved)",
+              end.robustness.c_str());
         verdict_seconds_ += end.verdict_seconds;
         goal_reached_ = goal_reached_ || end.goal_reached;
         return end.finished || training_finished;

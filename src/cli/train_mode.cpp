@@ -27,16 +27,18 @@ void printResult(const TrainingConfig& config, bool reached, bool solved, std::u
 {
   std::printf("until=%s reached=%s solved=%s episodes=%llu steps=%llu train_s=%.6f verdict_s=%.6f\n",
               trainedUntil(config.limits), reached ? "true" : "false",
-              !config.task.solvable() ? "n/a" : solved ? "true" : "false", static_cast<unsigned long long>(episodes),
-              static_cast<unsigned long long>(steps), train_s, verdict_s);
+              !config.task.solvable() ? "n/a"
+              : solved                ? "true"
+                                      : "false",
+              static_cast<unsigned long long>(episodes), static_cast<unsigned long long>(steps), train_s, verdict_s);
 }
 }  // namespace
 
 // Training: from scratch, from a table (--load) or on from a run folder's checkpoint (--resume),
 // ending with "until=U reached=true|false solved=true|false|n/a episodes=N steps=M train_s=T
 // verdict_s=V" (the session's counts: a loaded or resumed table's episodes included, as the node
-// counts them; after a stop, M is the saved table's steps, the unfinished episode's included). Exit 2 when it cannot start (a bad
-// table or folder, nothing left to train), 1 when a table could not be saved.
+// counts them; after a stop, M is the saved table's steps, the unfinished episode's included). Exit 2 when it cannot
+// start (a bad table or folder, nothing left to train), 1 when a table could not be saved.
 int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup)
 {
   const bool resuming = !options.resume_folder.empty();
@@ -64,8 +66,8 @@ int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup)
     const EpisodeSummary& last = run.session().lastEpisode();
     // Its record says how it finished ("solved", "suite_passed" or "max_episodes"): where it was
     // going, unless it ran out of episodes first.
-    const bool reached = setup.config.limits.goesOnAfterSolved() ||
-                         (from.record && from.record->finished != "max_episodes");
+    const bool reached =
+        setup.config.limits.goesOnAfterSolved() || (from.record && from.record->finished != "max_episodes");
     printResult(setup.config, reached, from.solved(), last.episode, last.total_steps, 0.0, 0.0);
     return 0;
   }

@@ -63,8 +63,9 @@ std::string rewardMeaning(RewardScheme scheme)
 
 double TaskParams::largestReturn() const
 {
-  return reward == RewardScheme::SuttonBarto || reward == RewardScheme::Centred ? 0.0
-                                                                                : static_cast<double>(max_episode_steps);
+  return reward == RewardScheme::SuttonBarto || reward == RewardScheme::Centred
+             ? 0.0
+             : static_cast<double>(max_episode_steps);
 }
 
 double TaskParams::thetaThresholdRad() const
@@ -121,8 +122,7 @@ StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned step
     case RewardScheme::Alive:
       outcome.reward = outcome.terminated ? 0.0 : 1.0;
       break;
-    case RewardScheme::Centred:
-    {
+    case RewardScheme::Centred: {
       const double off_centre = new_state[0] / params_.x_threshold;
       outcome.reward = outcome.terminated ? -1.0 : -kCentredCost * off_centre * off_centre;
       break;

@@ -138,7 +138,8 @@ TEST_F(TrainHeadlessTest, SolvesAndEndsWithTheResultLine)
   EXPECT_EQ(0, run.status) << run.output;
   text_match::Groups seconds;
   ASSERT_TRUE(text_match::matchesWhole(
-      run.lastLine(), "until=solved reached=true solved=true episodes=[0-9]+ steps=[0-9]+ train_s=([0-9.]+) verdict_s=([0-9.]+)",
+      run.lastLine(),
+      "until=solved reached=true solved=true episodes=[0-9]+ steps=[0-9]+ train_s=([0-9.]+) verdict_s=([0-9.]+)",
       &seconds))
       << run.lastLine();
   // The saved table's verdict (the default config's suite, 800 greedy episodes) is timed apart
@@ -186,8 +187,9 @@ TEST_F(TrainHeadlessTest, EveryRunSaysWhatItsTableIsWorthOnTheRobustnessSuite)
                                                "/robust_suite.yaml, greedy, 100 episodes per case):"))
       << run.output;
   EXPECT_TRUE(text_match::contains(run.output, "\none_step_late +0/100 +[0-9]+ +[0-9.]+ +FAIL\n")) << run.output;
-  EXPECT_TRUE(text_match::contains(run.output, "\n[0-9] of 8 cases pass: not yet a table for a real robot. .*"
-                                               "config/robust.yaml trains until this suite passes.*\nSOLVED after "))
+  EXPECT_TRUE(text_match::contains(run.output,
+                                   "\n[0-9] of 8 cases pass: not yet a table for a real robot. .*"
+                                   "config/robust.yaml trains until this suite passes.*\nSOLVED after "))
       << run.output;
   EXPECT_EQ(std::string::npos, run.output.find("FAILED")) << run.output;
 }
@@ -196,8 +198,10 @@ TEST_F(TrainHeadlessTest, EveryRunSaysWhatItsTableIsWorthOnTheRobustnessSuite)
 // result line says what it trained until.
 TEST_F(TrainHeadlessTest, ARunThatGoesOnAfterSolvedSaysWhenItSolved)
 {
-  const CommandRun run = trainHeadless("--config " + file("go_on.yaml", "training:\n  stop_when_solved: false\n"
-                                                                         "  max_episodes: 400\n") +
+  const CommandRun run = trainHeadless("--config " +
+                                       file("go_on.yaml",
+                                            "training:\n  stop_when_solved: false\n"
+                                            "  max_episodes: 400\n") +
                                        " --seed 0 --no-run-folder");
   EXPECT_EQ(0, run.status) << run.output;
   // Seed 0 solves at episode 259 (as SolvesAndEndsWithTheResultLine's run, the same episodes).
@@ -236,10 +240,11 @@ TEST_F(TrainHeadlessTest, QuietKeepsTheRobustnessOfTheSavedTableBesideTheResultL
   EXPECT_EQ(0, run.status) << run.output;
   // What the table is worth (a table of 5 episodes falls everywhere), then the result line; no
   // progress line, no other line of the suite.
-  EXPECT_TRUE(text_match::contains(run.output,
-                                   "(^|\n)robustness of the saved table \\(for information: this run's goal was solved\\): "
-                                   "nominal [0-9]+/100, one_step_late [0-9]+/100, .*all_at_once [0-9]+/100: "
-                                   "FAILED\nuntil=solved reached=false solved=false episodes=5 "))
+  EXPECT_TRUE(
+      text_match::contains(run.output,
+                           "(^|\n)robustness of the saved table \\(for information: this run's goal was solved\\): "
+                           "nominal [0-9]+/100, one_step_late [0-9]+/100, .*all_at_once [0-9]+/100: "
+                           "FAILED\nuntil=solved reached=false solved=false episodes=5 "))
       << run.output;
   EXPECT_EQ(0u, run.lastLine().find("until=solved reached=false solved=false episodes=5 ")) << run.output;
   EXPECT_EQ(std::string::npos, run.output.find("robustness at episode")) << run.output;
@@ -529,7 +534,9 @@ TEST_F(TrainHeadlessTest, LoadTrainsFurtherFromTheTablesCounters)
   // Ten more episodes, numbered on from 31; the steps add up from the table's (+1 a step).
   text_match::Groups result;
   const std::string last = loaded.lastLine();
-  ASSERT_TRUE(text_match::matchesWhole(last, "until=solved reached=false solved=false episodes=40 steps=([0-9]+) train_s=.*", &result)) << last;
+  ASSERT_TRUE(text_match::matchesWhole(
+      last, "until=solved reached=false solved=false episodes=40 steps=([0-9]+) train_s=.*", &result))
+      << last;
   text_match::Groups returns;
   ASSERT_TRUE(text_match::contains(loaded.output, "returns=([0-9 ]+)\n", &returns)) << loaded.output;
   std::istringstream values(returns[1]);
@@ -575,7 +582,8 @@ TEST_F(TrainHeadlessTest, TheStatsCsvHasOneRowPerEpisodeEndingWhereTheResultLine
   ASSERT_EQ(0, run.status) << run.output;
   text_match::Groups result;
   const std::string last = run.lastLine();
-  ASSERT_TRUE(text_match::matchesWhole(last, "until=solved reached=true solved=true episodes=([0-9]+) steps=([0-9]+) train_s=.*", &result))
+  ASSERT_TRUE(text_match::matchesWhole(
+      last, "until=solved reached=true solved=true episodes=([0-9]+) steps=([0-9]+) train_s=.*", &result))
       << last;
   const unsigned long episodes = std::stoul(result[1]);
   const unsigned long steps = std::stoul(result[2]);
@@ -626,15 +634,18 @@ TEST_F(TrainHeadlessTest, UnsolvedRunSaysSo)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
   EXPECT_EQ(0, run.status);
-  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "until=solved reached=false solved=false episodes=5 steps=[0-9]+ train_s=[0-9.]+ verdict_s=[0-9.]+"))
+  EXPECT_TRUE(text_match::matchesWhole(
+      run.lastLine(),
+      "until=solved reached=false solved=false episodes=5 steps=[0-9]+ train_s=[0-9.]+ verdict_s=[0-9.]+"))
       << run.lastLine();
 }
 
 TEST_F(TrainHeadlessTest, WallTimeHasMicrosecondsSoAFewMillisecondsCanBeRead)
 {
   const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --max-episodes 5");
-  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(), "until=solved reached=false solved=false episodes=5 steps=[0-9]+ "
-                                                               "train_s=[0-9]+\\.[0-9]{6} verdict_s=[0-9]+\\.[0-9]{6}"))
+  EXPECT_TRUE(text_match::matchesWhole(run.lastLine(),
+                                       "until=solved reached=false solved=false episodes=5 steps=[0-9]+ "
+                                       "train_s=[0-9]+\\.[0-9]{6} verdict_s=[0-9]+\\.[0-9]{6}"))
       << run.lastLine();
 }
 
@@ -644,7 +655,9 @@ TEST_F(TrainHeadlessTest, ReturnsListsEveryEpisodesReturnBeforeTheResultLine)
   EXPECT_EQ(0, run.status) << run.output;
   text_match::Groups result;
   const std::string last = run.lastLine();
-  ASSERT_TRUE(text_match::matchesWhole(last, "until=solved reached=false solved=false episodes=7 steps=([0-9]+) train_s=[0-9.]+ verdict_s=[0-9.]+", &result))
+  ASSERT_TRUE(text_match::matchesWhole(
+      last, "until=solved reached=false solved=false episodes=7 steps=([0-9]+) train_s=[0-9.]+ verdict_s=[0-9.]+",
+      &result))
       << run.output;
   text_match::Groups returns;
   ASSERT_TRUE(text_match::contains(run.output, "returns=([0-9 ]+)\n", &returns)) << run.output;
@@ -806,8 +819,8 @@ TEST_P(TrainHeadlessStopTest, AStoppedRunGoesOnWithResume)
     // Saved where it stopped: every episode in the curve is in the table.
     EXPECT_EQ(record.episodes, curveEpisodes(curve).back());
     const CommandRun as_run{0, output};
-    EXPECT_TRUE(text_match::matchesWhole(as_run.lastLine(),
-                                         "until=max_episodes reached=false solved=(true|false) " + counts + "train_s=.*"))
+    EXPECT_TRUE(text_match::matchesWhole(
+        as_run.lastLine(), "until=max_episodes reached=false solved=(true|false) " + counts + "train_s=.*"))
         << output;
   }
 
@@ -821,8 +834,9 @@ TEST_P(TrainHeadlessStopTest, AStoppedRunGoesOnWithResume)
                                                    std::to_string(checkpoint.steps) + " steps"))
       << resumed.output;
   // (It may end solved: the last 100 episodes of so long a run balance.)
-  EXPECT_TRUE(
-      text_match::matchesWhole(resumed.lastLine(), "until=max_episodes reached=true solved=(true|false) episodes=" + std::to_string(until) + " .*"))
+  EXPECT_TRUE(text_match::matchesWhole(
+      resumed.lastLine(),
+      "until=max_episodes reached=true solved=(true|false) episodes=" + std::to_string(until) + " .*"))
       << resumed.output;
   const cartpole_qlearning::QTable table =
       cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string());
@@ -838,15 +852,16 @@ TEST_P(TrainHeadlessStopTest, AStoppedRunGoesOnWithResume)
   // A finished run has nothing left to do.
   const CommandRun again = trainHeadless(endlessConfig() + " --resume " + folder);
   EXPECT_EQ(0, again.status) << again.output;
-  EXPECT_NE(std::string::npos, again.output.find("has finished already (" + finished + ", episode " +
-                                                  std::to_string(until) + ", " + std::to_string(table.steps) +
-                                                  " steps); nothing left to do"))
+  EXPECT_NE(std::string::npos,
+            again.output.find("has finished already (" + finished + ", episode " + std::to_string(until) + ", " +
+                              std::to_string(table.steps) + " steps); nothing left to do"))
       << again.output;
   // Nothing on either stream says it goes on (stderr is in output too).
   EXPECT_EQ(std::string::npos, again.output.find("goes on from")) << again.output;
   // Trained until max_episodes (endless.yaml goes on after solved): it got there.
-  EXPECT_EQ("until=max_episodes reached=true solved=" + std::string(finished == "solved" ? "true" : "false") + " episodes=" +
-                std::to_string(until) + " steps=" + std::to_string(table.steps) + " train_s=0.000000 verdict_s=0.000000",
+  EXPECT_EQ("until=max_episodes reached=true solved=" + std::string(finished == "solved" ? "true" : "false") +
+                " episodes=" + std::to_string(until) + " steps=" + std::to_string(table.steps) +
+                " train_s=0.000000 verdict_s=0.000000",
             again.lastLine());
   EXPECT_EQ(until, cartpole_qlearning::loadQTableFile((tables() / folder / "q_table.yaml").string()).episodes);
 }
@@ -887,7 +902,9 @@ TEST_F(TrainHeadlessTest, ResumeCountsMaxEpisodesFromTheCheckpointTableNotTheRec
   // One more allowed: it trains exactly one, from the table's count.
   const CommandRun more = trainHeadless(endlessConfig() + " --resume " + folder + " --max-episodes 41 --quiet");
   EXPECT_EQ(0, more.status) << more.output;
-  EXPECT_TRUE(text_match::contains(more.lastLine(), "^until=max_episodes reached=true solved=(true|false) episodes=41 ")) << more.output;
+  EXPECT_TRUE(
+      text_match::contains(more.lastLine(), "^until=max_episodes reached=true solved=(true|false) episodes=41 "))
+      << more.output;
 }
 
 // Several robots are named as train.launch robots:=N names their namespaces, as the node logs.

@@ -47,17 +47,19 @@ protected:
 };
 
 // A run's output as roslaunch prints it: colours, a prefix on each line, lines the page leaves out.
-const char* const kLog = "\x1b[0m[ INFO] [1796227543.07]: episode    250  mean_return_100  450.49  epsilon 0.030  "
-                         "alpha 0.050  steps/s 146005  time 0.40 s\x1b[0m\n"
-                         "[ INFO] [1796227543.21]: qlearning_controller: SOLVED after 259 episodes, 61681 steps, 0.4 s "
-                         "(mean return of the last 100: 477.66); saved to /home/user/.ros/cartpole_qlearning/q.yaml\n"
-                         "[ INFO] [1796227543.22]: qlearning_controller: done; ending the launch\n";
+const char* const kLog =
+    "\x1b[0m[ INFO] [1796227543.07]: episode    250  mean_return_100  450.49  epsilon 0.030  "
+    "alpha 0.050  steps/s 146005  time 0.40 s\x1b[0m\n"
+    "[ INFO] [1796227543.21]: qlearning_controller: SOLVED after 259 episodes, 61681 steps, 0.4 s "
+    "(mean return of the last 100: 477.66); saved to /home/user/.ros/cartpole_qlearning/q.yaml\n"
+    "[ INFO] [1796227543.22]: qlearning_controller: done; ending the launch\n";
 
-const char* const kPage = "Some prose.\n\n<!-- output: end -->\n```\n$ roslaunch cartpole_qlearning train.launch\n...\n"
-                          "episode    250  mean_return_100  450.49  epsilon 0.030  alpha 0.050  ...\n"
-                          "qlearning_controller: SOLVED after 259 episodes, 61681 steps, ... (mean return of the last "
-                          "100: 477.66); saved to ~/.ros/cartpole_qlearning/q.yaml\n"
-                          "qlearning_controller: done; ending the launch\n```\n";
+const char* const kPage =
+    "Some prose.\n\n<!-- output: end -->\n```\n$ roslaunch cartpole_qlearning train.launch\n...\n"
+    "episode    250  mean_return_100  450.49  epsilon 0.030  alpha 0.050  ...\n"
+    "qlearning_controller: SOLVED after 259 episodes, 61681 steps, ... (mean return of the last "
+    "100: 477.66); saved to ~/.ros/cartpole_qlearning/q.yaml\n"
+    "qlearning_controller: done; ending the launch\n```\n";
 
 TEST_F(DocOutputTest, ABlockThatIsWhatTheCommandPrintedPasses)
 {
@@ -73,7 +75,8 @@ TEST_F(DocOutputTest, ABlockThatDiffersFromTheOutputFailsNamingTheLine)
   changed.replace(changed.find("after 259"), 9, "after 260");
   const CommandRun run = check(write("page.md", changed), "end", log);
   EXPECT_EQ(1, run.status) << run.output;
-  EXPECT_NE(std::string::npos, run.output.find("not in the output after '[ INFO] [1796227543.07]: episode    250")) << run.output;
+  EXPECT_NE(std::string::npos, run.output.find("not in the output after '[ INFO] [1796227543.07]: episode    250"))
+      << run.output;
   EXPECT_NE(std::string::npos, run.output.find("SOLVED after 260 episodes")) << run.output;
   // Lines out of order fail too: the block's order is the output's.
   std::string swapped = kPage;
