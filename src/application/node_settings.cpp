@@ -389,6 +389,7 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   }
   useModelJoints(robot_engine, settings.robot);
   readRobotInterface(priv, settings.training.physics.tau, settings.robot);
+  protocol.commands_unstamped = settings.robot.command_type != CommandType::JointState;
   // The freshness guard's bound: a few decision periods, and no less than 0.1 s (a real-time
   // machine's hiccup is not a robot gone). 0 turns it off: a lockstep sim holds no command.
   settings.freshness_timeout = std::max(0.1, 5.0 * settings.robot.decision_period);

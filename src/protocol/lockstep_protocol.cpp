@@ -141,6 +141,7 @@ void ControllerProtocol::answer(Reaction& reaction, double effort)
   reaction.answer = true;
   reaction.effort = effort;
   last_effort_ = effort;
+  answered_ = reaction.stamp;
 }
 
 void ControllerProtocol::begin(Reaction& reaction, const CartPoleState& state)
@@ -220,8 +221,12 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
     reaction.kind = Reaction::Kind::Repeat;
     // Not while a failed reset is waited on: the fallen state a lockstep sim repeats was never
     // answered, and answering it would step the sim on, flat out, for as long as no reset works.
-    if (phase_ == Phase::InEpisode || (phase_ == Phase::WaitingForPerson && !reset_failing_))
-      answer(reaction, last_effort_);
+    if (!(phase_ == Phase::InEpisode || (phase_ == Phase::WaitingForPerson && !reset_failing_)))
+      return reaction;
+    if (params_.commands_unstamped && answered_ == stamp && ++repeats_held_back_ < kRepeatsBeforeAnsweringAgain)
+      return reaction;
+    repeats_held_back_ = 0;
+    answer(reaction, last_effort_);
     return reaction;
   }
 
@@ -250,6 +255,7 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
 {
   reaction.kind = Reaction::Kind::New;
   ++counts_.states;
+  repeats_held_back_ = 0;
   older_seen_.reset();
   older_run_ = 0;
   if (reaction.stamp != 0)

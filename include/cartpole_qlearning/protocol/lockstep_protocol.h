@@ -207,6 +207,12 @@ struct ControllerProtocolParams
   TrainingLimits limits;
   // Which of the session's robots this protocol serves (one protocol per robot).
   std::size_t robot = 0;
+  // The robot's commands carry no stamp (std_msgs/Float64): a lockstep sim cannot tell the answer
+  // to a repeat from the answer to its next state and steps on both, and from then on every
+  // command lands a step late. A repeat of a state already answered is then answered only at
+  // every kRepeatsBeforeAnsweringAgain-th repeat: the sim has waited that long, the answer was lost
+  // (a connection not up yet), not late (a loaded machine answering after the sim's timeout).
+  bool commands_unstamped = false;
 };
 
 class ControllerProtocol
@@ -270,7 +276,10 @@ private:
   Stamp last_ = 0;
   std::optional<Stamp> older_seen_;  // an older stamp seen once: a restart if it comes again
   static constexpr int kTimeSetBack = 3;
-  int older_run_ = 0;  // older states in a row, each newer than the one before
+  static constexpr int kRepeatsBeforeAnsweringAgain = 3;  // commands_unstamped
+  std::optional<Stamp> answered_;                         // the stamp of the last state answered
+  int repeats_held_back_ = 0;                             // repeats of it not answered (commands_unstamped)
+  int older_run_ = 0;                                     // older states in a row, each newer than the one before
   double last_effort_ = 0.0;
   bool reset_failing_ = false;  // the last reset failed, none has succeeded since
   Counts counts_;

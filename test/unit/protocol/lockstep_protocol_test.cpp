@@ -1044,6 +1044,16 @@ struct Faults
   unsigned duplicate_answer = 0;
   unsigned late_answer = 0;    // a copy of an answer arrives after the next answer
   unsigned stray_command = 0;  // a third party's command: off-grid, older, or without a stamp
+  unsigned slow_answer = 0;    // an answer arrives after the sim's timeout: the state went out again first
+};
+
+// What the commands carry: a stamp (JointState), or none (Float64, which a lockstep sim steps on
+// whatever it answers), with the controller told so (~command_type float64) or not.
+enum class Commands
+{
+  Stamped,
+  Unstamped,
+  UnstampedControllerNotTold
 };
 
 // The sim node and the controller node as they drive the protocol classes, wired by hand
@@ -1052,14 +1062,16 @@ struct Faults
 class ScriptedLink
 {
 public:
-  ScriptedLink(const TrainingConfig& config, std::uint64_t seed, const Faults& faults)
+  ScriptedLink(const TrainingConfig& config, std::uint64_t seed, const Faults& faults,
+               Commands commands = Commands::Stamped)
     : config_(config),
       seed_(seed),
       faults_(faults),
+      commands_(commands),
       simulation_(config.physics, config.start_state_bound, seed),
       sim_(tickOf(config.physics.tau), kRepeatAfter),
       session_(config.task, config.agent, seed),
-      controller_(session_, paramsOf(config))
+      controller_(session_, paramsOf(config, commands))
   {
   }
 
@@ -1146,6 +1158,11 @@ public:
   {
     return sim_steps_;
   }
+  // Steps the sim took on a command that answered another state than the one it stepped from.
+  std::uint64_t stepsOnAnotherStatesAnswer() const
+  {
+    return steps_on_another_states_answer_;
+  }
 
 private:
   struct StateMessage
@@ -1157,12 +1174,14 @@ private:
   {
     Stamp stamp;
     double effort;
+    Stamp answers = 0;  // the state it answers, which an unstamped command does not carry
   };
 
-  static ControllerProtocolParams paramsOf(const TrainingConfig& config)
+  static ControllerProtocolParams paramsOf(const TrainingConfig& config, Commands commands)
   {
     ControllerProtocolParams params;
     params.limits = config.limits;
+    params.commands_unstamped = commands == Commands::Unstamped;
     return params;
   }
 
@@ -1206,9 +1225,20 @@ private:
       send({reaction.stamp, reaction.effort});
   }
 
-  void send(const CommandMessage& answer)
+  void send(CommandMessage answer)
   {
     ++answers_sent_;
+    answer.answers = answer.stamp;
+    if (commands_ != Commands::Stamped)
+      answer.stamp = 0;
+    if (strikes(faults_.slow_answer, answers_sent_))
+    {
+      // A loaded machine: the sim's timer fires before the answer comes, and the state it sends
+      // again reaches the controller first (states are delivered first).
+      now_ += kRepeatAfter;
+      if (sim_.repeatDue(now_))
+        publish(sim_.pending());
+    }
     if (strikes(faults_.stray_command, answers_sent_))
     {
       // A third party's commands, with efforts that would show in the trajectory.
@@ -1231,8 +1261,13 @@ private:
 
   void onCommand(const CommandMessage& message)
   {
-    if (sim_.onCommand(message.stamp, now_) != SimProtocol::Verdict::Step)
+    // cartpole_sim steps on every Float64 command (onEffort): it has no stamp to check.
+    const SimProtocol::Verdict verdict =
+        commands_ == Commands::Stamped ? sim_.onCommand(message.stamp, now_) : sim_.onUnstampedCommand(now_);
+    if (verdict != SimProtocol::Verdict::Step)
       return;
+    if (message.answers != 0 && message.answers + kTick != sim_.pending())
+      ++steps_on_another_states_answer_;
     simulation_.step(message.effort);
     ++sim_steps_;
     publish(sim_.pending());
@@ -1241,6 +1276,7 @@ private:
   TrainingConfig config_;
   std::uint64_t seed_;
   Faults faults_;
+  Commands commands_;
   CartPoleSimulation simulation_;
   SimProtocol sim_;
   TrainingSession session_;
@@ -1255,6 +1291,7 @@ private:
   std::uint64_t states_published_ = 0;
   std::uint64_t answers_sent_ = 0;
   std::uint64_t sim_steps_ = 0;
+  std::uint64_t steps_on_another_states_answer_ = 0;
   std::vector<Reaction> reactions_;
   bool finished_ = false;
 };
@@ -1323,6 +1360,76 @@ TEST(LockstepProtocol, LostDuplicatedReplayedAndStrayMessagesLeaveTheTableBitFor
     EXPECT_GT(controller.stray, 0u) << "seed " << seed;
     EXPECT_EQ(0u, controller.restarts) << "seed " << seed;
   }
+}
+
+TEST(LockstepProtocol, UnstampedCommandsLateOrLostLeaveTheTableBitForBitAsWithout)
+{
+  // Float64 commands (robot profiles behind ros_control's JointEffortController, the sim posing as
+  // them): answers that come after the sim's timeout, answers lost, states lost.
+  const TrainingConfig config = shortConfig(30);
+  Faults faults;
+  faults.slow_answer = 5;
+  faults.drop_answer = 11;
+  faults.drop_state = 7;
+  for (std::uint64_t seed = 0; seed < 3; ++seed)
+  {
+    ScriptedLink link(config, seed, faults, Commands::Unstamped);
+    link.start();
+    link.run(1000);
+    HeadlessTrainer headless(config, seed);
+    const TrainingResult result = headless.run();
+    ASSERT_TRUE(link.finished()) << "seed " << seed;
+    EXPECT_EQ(result.steps, link.simSteps()) << "seed " << seed;
+    EXPECT_EQ(0u, link.stepsOnAnotherStatesAnswer()) << "seed " << seed;
+    EXPECT_TRUE(bitIdentical(headless.session().table().values(), link.session().table().values())) << "seed " << seed;
+    EXPECT_GT(link.sim().counts().repeats, 0u) << "seed " << seed;
+    EXPECT_GT(link.controller().counts().repeats, 0u) << "seed " << seed;
+  }
+}
+
+TEST(LockstepProtocol, AControllerNotToldItsCommandsAreUnstampedStepsTheSimTwiceOnALateAnswer)
+{
+  // What commands_unstamped prevents: the repeat of a late answer's state answered too, both
+  // answers stepping the sim, and from then on every command a step late: the sim steps more
+  // often than the controller decides, and the table is not the one headless training makes.
+  const TrainingConfig config = shortConfig(30);
+  Faults faults;
+  faults.slow_answer = 50;
+  ScriptedLink link(config, 0, faults, Commands::UnstampedControllerNotTold);
+  link.start();
+  link.run(1000);
+  HeadlessTrainer headless(config, 0);
+  headless.run();
+  EXPECT_GT(link.stepsOnAnotherStatesAnswer(), link.simSteps() / 2)
+      << link.stepsOnAnotherStatesAnswer() << " of " << link.simSteps();
+  EXPECT_FALSE(bitIdentical(headless.session().table().values(), link.session().table().values()));
+}
+
+TEST_F(ControllerProtocolTest, WithUnstampedCommandsARepeatOfAnAnsweredStateIsAnsweredOnlyEveryThirdTime)
+{
+  params_.commands_unstamped = true;
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(1), kUpright);
+  const Reaction first = controller.onState(tick(2), kSmall);
+  ASSERT_TRUE(first.answer);
+  std::vector<bool> answered;
+  for (int repeat = 0; repeat < 7; ++repeat)
+  {
+    const Reaction r = controller.onState(tick(2), kSmall);
+    EXPECT_EQ(Reaction::Kind::Repeat, r.kind);
+    answered.push_back(r.answer);
+    if (r.answer)
+    {
+      EXPECT_EQ(first.effort, r.effort);
+    }
+  }
+  // The answer may have been lost (the sim's subscription not connected yet): the third repeat
+  // is answered, and so on; a late answer is long in by then.
+  EXPECT_EQ((std::vector<bool>{false, false, true, false, false, true, false}), answered);
+  // A new state is answered at once, and its first repeat held back again.
+  EXPECT_TRUE(controller.onState(tick(3), kSmall).answer);
+  EXPECT_FALSE(controller.onState(tick(3), kSmall).answer);
+  EXPECT_EQ(7u + 1u, controller.counts().repeats);
 }
 
 TEST(LockstepProtocol, ASimRestartedMidEpisodeIsTakenUpOnItsFirstRepeatAndTrainingGoesOn)
