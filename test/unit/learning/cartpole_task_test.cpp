@@ -100,8 +100,8 @@ TEST(CartPoleTask, AliveQuadraticCostsTheCartsPlaceAndSpeedAndNothingOnTheFall)
   TaskParams plain;
   plain.reward = RewardScheme::AliveQuadratic;
   EXPECT_EQ(1.0, CartPoleTask(plain).evaluate(CartPoleState(0.7, -0.4, 0.1, 0.2), 3).reward);
-  EXPECT_EQ(RewardScheme::AliveQuadratic, rewardSchemeFromString("alive_quadratic"));
-  EXPECT_EQ("alive_quadratic", toString(RewardScheme::AliveQuadratic));
+  EXPECT_EQ(RewardScheme::AliveQuadratic, cartpole_qlearning::rewardSchemeFromString("alive_quadratic"));
+  EXPECT_EQ("alive_quadratic", cartpole_qlearning::toString(RewardScheme::AliveQuadratic));
   // The costs belong to alive_quadratic alone, and are never negative.
   TaskParams other;
   other.x_cost = 0.1;
