@@ -244,8 +244,9 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
 
   SuiteResult result;
   result.cases_in_suite = suite.cases.size();
-  if (config.task.reward != RewardScheme::Gymnasium)
-    result.reward_note = toString(config.task.reward) + "'s reward, " + rewardMeaning(config.task.reward);
+  const RewardScheme score = config.task.scoreReward();
+  if (score != RewardScheme::Gymnasium)
+    result.reward_note = toString(score) + "'s reward, " + rewardMeaning(score);
   const std::size_t kept = how.stop_at_first_failure ? std::min(first_failure.load() + 1, order.size()) : order.size();
   for (std::size_t p = 0; p < kept; ++p)
     result.cases.push_back(results[p]);

@@ -218,8 +218,11 @@ void RunApplication::Parts::endTraining(const EpisodeSummary& s, bool passed, co
       formatText("mean return of the last %u: %.2f", config.task.solved_window, shownReturn(s.mean_return_window, 2));
   if (went_on)
     window += s.solved ? ", still solved" : formatText(", below %g now", config.task.solved_mean_return);
-  if (config.task.reward != RewardScheme::Gymnasium)
-    window += "; " + toString(config.task.reward) + "'s reward: " + rewardMeaning(config.task.reward);
+  const RewardScheme score = config.task.scoreReward();
+  if (score != RewardScheme::Gymnasium)
+    window += "; " + toString(score) + "'s reward: " + rewardMeaning(score);
+  if (config.task.solved_reward && *config.task.solved_reward != config.task.reward)
+    window += " (trained on " + toString(config.task.reward) + "'s)";
   say(end.log, LogLine::Level::Info,
       formatText("%s after %llu episodes, %llu steps, %.1f s (%s); %s", outcome.c_str(), count(s.episode),
                  count(s.total_steps), meters.secondsRunning(), window.c_str(), saved.c_str()));

@@ -75,7 +75,7 @@ bool RunMeters::addEvaluationEpisode(const EpisodeSummary& s, LogLines& log)
   balanced_ += s.truncated && !s.terminated;
   // A return other than CartPole-v1's (+1 a step) is said with its meaning: on the first episode
   // and on the verdict.
-  const RewardScheme reward = config_.task.reward;
+  const RewardScheme reward = config_.task.scoreReward();
   const std::string meaning =
       reward == RewardScheme::Gymnasium ? "" : " (" + toString(reward) + "'s reward: " + rewardMeaning(reward) + ")";
   log.push_back(

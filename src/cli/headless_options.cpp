@@ -42,6 +42,7 @@ const RuleOption kCheckpoints{"--checkpoint-every",
 const RuleOption kNoRunFolder{"--no-run-folder", [](const HeadlessOptions& o) { return o.no_run_folder; }};
 const RuleOption kStatsCsv{"--stats-csv", [](const HeadlessOptions& o) { return !o.stats_csv_path.empty(); }};
 const RuleOption kReturns{"--returns", [](const HeadlessOptions& o) { return o.print_returns; }};
+const RuleOption kGreedyCheck{"--greedy-check", [](const HeadlessOptions& o) { return o.greedy_check > 0; }};
 const RuleOption kTrace{"--trace", [](const HeadlessOptions& o) { return o.trace; }};
 const RuleOption kEvaluate{"--evaluate", [](const HeadlessOptions& o) { return o.evaluating(); }};
 const RuleOption kEpisodes{"--episodes", [](const HeadlessOptions& o) { return o.episodes_given; }};
@@ -115,11 +116,11 @@ const std::vector<OptionRule>& headlessOptionRules()
        "is how long --evaluate's episodes are (training's: the config's task/max_episode_steps)"},
       {Kind::Excludes,
        kEvaluate,
-       {kLoad, kResume, kSave, kMaxEpisodes, kCheckpointEvery, kNoRunFolder, kStatsCsv, kTrace, kReplay},
+       {kLoad, kResume, kSave, kMaxEpisodes, kCheckpointEvery, kNoRunFolder, kStatsCsv, kTrace, kReplay, kGreedyCheck},
        "an evaluation learns nothing and writes nothing"},
       {Kind::Excludes,
        kReplay,
-       {kRobots, kMaxEpisodes, kStatsCsv, kLoad, kResume, kCheckpointEvery, kNoRunFolder},
+       {kRobots, kMaxEpisodes, kStatsCsv, kLoad, kResume, kCheckpointEvery, kNoRunFolder, kGreedyCheck},
        "a replay learns from its file alone"},
       {Kind::Requires, kEvaluate, {kSuite}, "runs a table: give it with --evaluate TABLE"},
       {Kind::Excludes,
@@ -218,6 +219,11 @@ HeadlessCommandLine parseHeadlessOptions(const std::vector<std::string>& args)
       if (!parseCount(args[++i], o.max_steps) || o.max_steps == 0 || o.max_steps > std::numeric_limits<int>::max())
         return refuse(arg, args[i],
                       "must be a whole number in [1, " + std::to_string(std::numeric_limits<int>::max()) + "]");
+    }
+    else if (arg == "--greedy-check" && has_value)
+    {
+      if (!parseCount(args[++i], o.greedy_check) || o.greedy_check == 0 || o.greedy_check > 1000)
+        return refuse(arg, args[i], "must be a whole number in [1, 1000]");
     }
     else if (arg == "--episodes" && has_value)
     {

@@ -35,6 +35,7 @@ struct HeadlessOptions
   bool quiet = false;
   bool print_returns = false;
   bool trace = false;
+  std::uint64_t greedy_check = 0;  // training: N greedy episodes after each episode until all balance (0: none)
 
   std::string evaluate_path;
   std::uint64_t evaluation_episodes = 100;

@@ -31,6 +31,9 @@ HeadlessRun::HeadlessRun(const HeadlessOptions& options, const HeadlessSetup& se
     trainer_(setup.config, seed, options.robots, !options.evaluating()),
     robot_names_(robotNamespaces(options.robots))
 {
+  if (options.greedy_check > 0 && !options.evaluating())
+    greedy_check_ =
+        std::make_unique<GreedyCheck>(setup.config, static_cast<unsigned>(options.greedy_check), greedyCheckSeed(seed));
   settings_.config_origin = setup.config_origin;
   settings_.config_warning = setup.config_warning;
 }
@@ -103,6 +106,11 @@ TrainingResult HeadlessRun::run()
               config.limits.until == TrainUntil::SuitePasses ? "" : " (for information: this run's goal was solved)",
               end.robustness.c_str());
         verdict_seconds_ += end.verdict_seconds;
+        if (greedy_check_ && greedy_pass_episode_ == 0 && greedy_check_->passes(trainer_.session().table()))
+        {
+          greedy_pass_episode_ = s.episode;
+          greedy_pass_steps_ = s.total_steps;
+        }
         goal_reached_ = goal_reached_ || end.goal_reached;
         return end.finished || training_finished;
       },

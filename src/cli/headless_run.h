@@ -5,6 +5,7 @@
 
 #include "headless_modes.h"
 
+#include "cartpole_qlearning/application/greedy_check.h"
 #include "cartpole_qlearning/application/headless_trainer.h"
 #include "cartpole_qlearning/application/run_application.h"
 
@@ -40,6 +41,16 @@ public:
   // 128 + the signal's number when stopped, else 1 when an error was said, else 0.
   int exitStatus() const;
 
+  // --greedy-check: the first episode after which it passed, and the training steps then (0: never).
+  std::uint64_t greedyPassEpisode() const
+  {
+    return greedy_pass_episode_;
+  }
+  std::uint64_t greedyPassSteps() const
+  {
+    return greedy_pass_steps_;
+  }
+
   RunApplication& application();
   const TrainingSession& session() const;
   const RunSettings& settings() const;
@@ -51,6 +62,9 @@ private:
   HeadlessTrainer trainer_;
   std::vector<std::string> robot_names_;
   std::unique_ptr<RunApplication> application_;
+  std::unique_ptr<GreedyCheck> greedy_check_;
+  std::uint64_t greedy_pass_episode_ = 0;
+  std::uint64_t greedy_pass_steps_ = 0;
   double verdict_seconds_ = 0.0;
   bool goal_reached_ = false;
   bool stopped_ = false;

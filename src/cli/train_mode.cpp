@@ -87,6 +87,17 @@ int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup)
   // too, and the line before this one says so: steps= counts what that table counts, so that the
   // two agree (episodes= counts finished episodes, as the table does).
   const std::uint64_t steps = run.stopped() ? run.session().table().steps : last.total_steps;
+  if (options.greedy_check > 0)
+  {
+    if (run.greedyPassEpisode() > 0)
+      std::printf("greedy_check=%llu first_pass_steps=%llu first_pass_episode=%llu\n",
+                  static_cast<unsigned long long>(options.greedy_check),
+                  static_cast<unsigned long long>(run.greedyPassSteps()),
+                  static_cast<unsigned long long>(run.greedyPassEpisode()));
+    else
+      std::printf("greedy_check=%llu first_pass_steps=never first_pass_episode=never\n",
+                  static_cast<unsigned long long>(options.greedy_check));
+  }
   printResult(setup.config, run.goalReached(), result.solved, last.episode, steps, result.wall_s - run.verdictSeconds(),
               run.verdictSeconds());
   return run.exitStatus();

@@ -18,8 +18,10 @@ RewardScheme rewardSchemeFromString(const std::string& name)
     return RewardScheme::Alive;
   if (name == "centred")
     return RewardScheme::Centred;
+  if (name == "alive_quadratic")
+    return RewardScheme::AliveQuadratic;
   throw std::invalid_argument("unknown reward scheme '" + name +
-                              "' (allowed: gymnasium, seed, sutton_barto, alive, centred)");
+                              "' (allowed: gymnasium, seed, sutton_barto, alive, centred, alive_quadratic)");
 }
 
 std::string toString(RewardScheme scheme)
@@ -36,6 +38,8 @@ std::string toString(RewardScheme scheme)
       return "alive";
     case RewardScheme::Centred:
       return "centred";
+    case RewardScheme::AliveQuadratic:
+      return "alive_quadratic";
   }
   return "unknown";
 }
@@ -57,15 +61,17 @@ std::string rewardMeaning(RewardScheme scheme)
       out << "-" << kCentredCost << " x (x / x_threshold)^2 a step, -1 on the fall";
       return out.str();
     }
+    case RewardScheme::AliveQuadratic:
+      return "+1 - x_cost x^2 - x_dot_cost x_dot^2 a step, 0 on the fall";
   }
   return "unknown";
 }
 
 double TaskParams::largestReturn() const
 {
-  return reward == RewardScheme::SuttonBarto || reward == RewardScheme::Centred
-             ? 0.0
-             : static_cast<double>(max_episode_steps);
+  const RewardScheme score = scoreReward();
+  return score == RewardScheme::SuttonBarto || score == RewardScheme::Centred ? 0.0
+                                                                              : static_cast<double>(max_episode_steps);
 }
 
 double TaskParams::thetaThresholdRad() const
@@ -86,6 +92,13 @@ std::string TaskParams::validate() const
     out << "solved_mean_return = " << solved_mean_return << " is not allowed (must be finite)";
   else if (solved_window == 0)
     out << "solved_window = 0 is not allowed (must be >= 1)";
+  else if (!(std::isfinite(x_cost) && x_cost >= 0.0))
+    out << "x_cost = " << x_cost << " is not allowed (must be finite and >= 0)";
+  else if (!(std::isfinite(x_dot_cost) && x_dot_cost >= 0.0))
+    out << "x_dot_cost = " << x_dot_cost << " is not allowed (must be finite and >= 0)";
+  else if (reward != RewardScheme::AliveQuadratic && (x_cost != 0.0 || x_dot_cost != 0.0))
+    out << "x_cost = " << x_cost << " and x_dot_cost = " << x_dot_cost << " are not allowed with reward "
+        << toString(reward) << " (only alive_quadratic reads them: must be 0)";
   return out.str();
 }
 
@@ -108,27 +121,34 @@ StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned step
   outcome.terminated = isTerminal(new_state);
   // A step that both falls and hits the limit counts as a fall: there is no future to bootstrap on.
   outcome.truncated = !outcome.terminated && steps_taken >= params_.max_episode_steps;
-  switch (params_.reward)
+  outcome.reward = rewardOf(params_.reward, new_state, outcome.terminated);
+  outcome.score =
+      params_.solved_reward ? rewardOf(*params_.solved_reward, new_state, outcome.terminated) : outcome.reward;
+  return outcome;
+}
+
+double CartPoleTask::rewardOf(RewardScheme scheme, const CartPoleState& new_state, bool terminated) const
+{
+  switch (scheme)
   {
     case RewardScheme::Gymnasium:
-      outcome.reward = 1.0;
-      break;
+      return 1.0;
     case RewardScheme::Seed:
-      outcome.reward = outcome.terminated ? -1.0 : 1.0;
-      break;
+      return terminated ? -1.0 : 1.0;
     case RewardScheme::SuttonBarto:
-      outcome.reward = outcome.terminated ? -1.0 : 0.0;
-      break;
+      return terminated ? -1.0 : 0.0;
     case RewardScheme::Alive:
-      outcome.reward = outcome.terminated ? 0.0 : 1.0;
-      break;
+      return terminated ? 0.0 : 1.0;
     case RewardScheme::Centred: {
       const double off_centre = new_state[0] / params_.x_threshold;
-      outcome.reward = outcome.terminated ? -1.0 : -kCentredCost * off_centre * off_centre;
-      break;
+      return terminated ? -1.0 : -kCentredCost * off_centre * off_centre;
     }
+    case RewardScheme::AliveQuadratic:
+      return terminated ? 0.0
+                        : 1.0 - params_.x_cost * new_state[0] * new_state[0] -
+                              params_.x_dot_cost * new_state[1] * new_state[1];
   }
-  return outcome;
+  return 0.0;
 }
 
 }  // namespace cartpole_qlearning

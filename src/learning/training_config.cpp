@@ -392,6 +392,21 @@ TaskParams readTask(const ParameterSource& source)
   reader.read("theta_threshold_deg", task.theta_threshold_deg);
   reader.read("max_episode_steps", task.max_episode_steps, 1, std::numeric_limits<int>::max());
   readEnum(reader, "reward", task.reward, rewardSchemeFromString);
+  std::string solved_reward;
+  reader.read("solved_reward", solved_reward);
+  if (!solved_reward.empty())
+  {
+    try
+    {
+      task.solved_reward = rewardSchemeFromString(solved_reward);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      reader.fail("solved_reward", "'" + solved_reward + "'", e.what());
+    }
+  }
+  reader.read("x_cost", task.x_cost);
+  reader.read("x_dot_cost", task.x_dot_cost);
   reader.read("solved_mean_return", task.solved_mean_return);
   reader.read("solved_window", task.solved_window, 1, 1000000);
   reader.refuseUnknown();
@@ -570,6 +585,14 @@ std::string trainingConfigText(const TrainingConfig& config)
   emitNumber(out, "theta_threshold_deg", task.theta_threshold_deg);
   out << YAML::Key << "max_episode_steps" << YAML::Value << task.max_episode_steps;
   out << YAML::Key << "reward" << YAML::Value << toString(task.reward);
+  // Only when set, so that the tables of configs without them stay as they were.
+  if (task.solved_reward)
+    out << YAML::Key << "solved_reward" << YAML::Value << toString(*task.solved_reward);
+  if (task.reward == RewardScheme::AliveQuadratic)
+  {
+    emitNumber(out, "x_cost", task.x_cost);
+    emitNumber(out, "x_dot_cost", task.x_dot_cost);
+  }
   emitNumber(out, "solved_mean_return", task.solved_mean_return);
   out << YAML::Key << "solved_window" << YAML::Value << task.solved_window;
   out << YAML::EndMap;

@@ -68,7 +68,7 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   Decision decision;
   ++e.steps;
   decision.outcome = task_.evaluate(state, e.steps);
-  e.episode_return += decision.outcome.reward;
+  e.episode_return += decision.outcome.score;
   // The action just taken: with previous_action, part of what the learner sees of this state.
   agent_.activeRows(state, e.next(), e.action + 1);
   if (learning_)

@@ -96,6 +96,8 @@ TEST(HeadlessOptions, EveryOptionGoesIntoItsField)
   EXPECT_EQ("/abs", parse("--ns /abs").options.name_space);
   EXPECT_EQ("runs/x", parse("--resume runs/x --no-run-folder").options.resume_folder);
   EXPECT_TRUE(parse("--no-run-folder").options.no_run_folder);
+  EXPECT_EQ(10u, parse("--greedy-check 10").options.greedy_check);
+  EXPECT_EQ(0u, parse("").options.greedy_check);
 }
 
 TEST(HeadlessOptions, HelpStopsReadingWhateverFollows)
@@ -128,6 +130,8 @@ TEST(HeadlessOptions, BadValuesAreRefusedNamingTheOptionTheValueAndWhatIsAllowed
   EXPECT_EQ("--grid 1001 is not allowed (must be a whole number in [2, 1000])", refusal("--policy t.yaml --grid 1001"));
   EXPECT_EQ("--ns 'a/../b' is not allowed (must be a ROS namespace)", refusal("--ns a/../b"));
   EXPECT_EQ("--ns '' is not allowed (must be a ROS namespace)", parseHeadlessOptions({"--ns", ""}).error);
+  EXPECT_EQ("--greedy-check 0 is not allowed (must be a whole number in [1, 1000])", refusal("--greedy-check 0"));
+  EXPECT_EQ("--greedy-check ten is not allowed (must be a whole number in [1, 1000])", refusal("--greedy-check ten"));
   // The first bad value is the one refused.
   EXPECT_EQ("--robots 0 is not allowed (must be a whole number in [1, 1000])", refusal("--robots 0 --seed x"));
 }
@@ -161,11 +165,11 @@ TEST(HeadlessOptions, EachRuleRefusesWhatDoesNotGoTogether)
             refusal("--max-steps 3000"));
   const std::string evaluation = " with --evaluate: an evaluation learns nothing and writes nothing";
   for (const std::string option : {"--load l", "--resume r", "--save s", "--max-episodes 3", "--checkpoint-every 0",
-                                   "--no-run-folder", "--stats-csv c", "--trace", "--replay r"})
+                                   "--no-run-folder", "--stats-csv c", "--trace", "--replay r", "--greedy-check 10"})
     EXPECT_EQ(words(option)[0] + evaluation, refusal("--evaluate t.yaml " + option));
   const std::string replay = " with --replay: a replay learns from its file alone";
-  for (const std::string option :
-       {"--robots 2", "--max-episodes 3", "--stats-csv c", "--load l", "--checkpoint-every 0", "--no-run-folder"})
+  for (const std::string option : {"--robots 2", "--max-episodes 3", "--stats-csv c", "--load l",
+                                   "--checkpoint-every 0", "--no-run-folder", "--greedy-check 10"})
     EXPECT_EQ(words(option)[0] + replay, refusal("--replay r.yaml " + option));
   EXPECT_EQ("--resume with --replay: a replay learns from its file alone", refusal("--replay r.yaml --resume x"));
   EXPECT_EQ("", parse("--replay r.yaml --robots 1 --seed 2 --save s.yaml --config c.yaml --quiet").error);

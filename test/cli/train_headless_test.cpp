@@ -674,6 +674,35 @@ TEST_F(TrainHeadlessTest, ReturnsListsEveryEpisodesReturnBeforeTheResultLine)
   EXPECT_EQ(std::string::npos, without.output.find("returns=")) << without.output;
 }
 
+TEST_F(TrainHeadlessTest, GreedyCheckSaysTheTrainingStepsAtItsFirstPassBeforeTheResultLine)
+{
+  // Seed 0 solves CartPole-v1 in 259 episodes; 10 greedy episodes of 500 steps first all balance
+  // somewhere before the run ends, at a step the run has reached.
+  const CommandRun run = trainHeadless(config() + " --seed 0 --quiet --greedy-check 10");
+  EXPECT_EQ(0, run.status) << run.output;
+  text_match::Groups result;
+  ASSERT_TRUE(text_match::matchesWhole(
+      run.lastLine(),
+      "until=solved reached=true solved=true episodes=([0-9]+) steps=([0-9]+) train_s=[0-9.]+ verdict_s=[0-9.]+",
+      &result))
+      << run.output;
+  text_match::Groups check;
+  ASSERT_TRUE(text_match::contains(run.output,
+                                   "greedy_check=10 first_pass_steps=([0-9]+) first_pass_episode=([0-9]+)\n", &check))
+      << run.output;
+  EXPECT_LE(std::stoull(check[1]), std::stoull(result[2]));
+  EXPECT_LE(std::stoull(check[2]), std::stoull(result[1]));
+  // The check learns nothing and draws nothing of training's: the same table, episodes and steps.
+  const CommandRun plain = trainHeadless(config() + " --seed 0 --quiet");
+  EXPECT_EQ(result[1] + " steps=" + result[2],
+            plain.lastLine().substr(plain.lastLine().find("episodes=") + 9,
+                                    plain.lastLine().find(" train_s=") - plain.lastLine().find("episodes=") - 9));
+  // One episode of training does not hold the pole: never.
+  const CommandRun early = trainHeadless(config() + " --seed 0 --quiet --max-episodes 1 --greedy-check 10");
+  EXPECT_NE(std::string::npos, early.output.find("greedy_check=10 first_pass_steps=never first_pass_episode=never\n"))
+      << early.output;
+}
+
 TEST_F(TrainHeadlessTest, BadConfigStopsWithTheKeyTheValueAndTheRange)
 {
   const CommandRun bad_value = trainHeadless("--config " + file("bad.yaml", "learning:\n  gamma: 2.0\n"));

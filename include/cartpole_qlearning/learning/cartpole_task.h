@@ -4,24 +4,28 @@
 
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
 
+#include <optional>
 #include <string>
 
 namespace cartpole_qlearning
 {
 enum class RewardScheme
 {
-  Gymnasium,    // +1 every step, the terminating one included (CartPole-v1)
-  Seed,         // +1 while alive, -1 on the step that falls (the Q-learning tutorial's)
-  SuttonBarto,  // 0 while alive, -1 on the step that falls (Barto, Sutton and Anderson 1983)
-  Alive,        // +1 while alive, 0 on the step that falls (Gymnasium's InvertedPendulum-v5)
-  Centred       // sutton_barto, and while alive -kCentredCost x (x / x_threshold)^2: a cart that drifts
-                // towards the end of the track costs before it falls (minutes-long control)
+  Gymnasium,      // +1 every step, the terminating one included (CartPole-v1)
+  Seed,           // +1 while alive, -1 on the step that falls (the Q-learning tutorial's)
+  SuttonBarto,    // 0 while alive, -1 on the step that falls (Barto, Sutton and Anderson 1983)
+  Alive,          // +1 while alive, 0 on the step that falls (Gymnasium's InvertedPendulum-v5)
+  Centred,        // sutton_barto, and while alive -kCentredCost x (x / x_threshold)^2: a cart that drifts
+                  // towards the end of the track costs before it falls (minutes-long control)
+  AliveQuadratic  // alive, less TaskParams::x_cost x^2 + x_dot_cost x_dot^2 a step: a cart that drifts or
+                  // runs costs long before the track's end does (a shaped training reward)
 };
 
 // What a step at the end of the track costs under RewardScheme::Centred, against -1 for the fall.
 constexpr double kCentredCost = 0.01;
 
-// Parses "gymnasium", "seed", "sutton_barto", "alive" or "centred"; throws std::invalid_argument otherwise.
+// Parses "gymnasium", "seed", "sutton_barto", "alive", "centred" or "alive_quadratic"; throws
+// std::invalid_argument otherwise.
 RewardScheme rewardSchemeFromString(const std::string& name);
 std::string toString(RewardScheme scheme);
 // What a return means under the scheme, for a reader of the logs: "0 a step, -1 on the fall".
@@ -29,18 +33,28 @@ std::string rewardMeaning(RewardScheme scheme);
 
 struct TaskParams
 {
-  double x_threshold = 2.4;           // [m] terminated when |x| > this
-  double theta_threshold_deg = 12.0;  // [deg] terminated when |theta| > this
-  unsigned max_episode_steps = 500;   // truncated after this many steps
-  RewardScheme reward = RewardScheme::Gymnasium;
+  double x_threshold = 2.4;                       // [m] terminated when |x| > this
+  double theta_threshold_deg = 12.0;              // [deg] terminated when |theta| > this
+  unsigned max_episode_steps = 500;               // truncated after this many steps
+  RewardScheme reward = RewardScheme::Gymnasium;  // what the learner trains on
+  // The reward whose returns the solved window averages (and episodes report); none: `reward`'s. A
+  // shaped training reward is then judged by the task's own (e.g. InvertedPendulum-v5's steps alive).
+  std::optional<RewardScheme> solved_reward;
+  double x_cost = 0.0;                // [1/m^2] alive_quadratic's cost of x^2 a step
+  double x_dot_cost = 0.0;            // [s^2/m^2] alive_quadratic's cost of x_dot^2 a step
   double solved_mean_return = 475.0;  // solved when the mean return of the last window episodes >= this
   unsigned solved_window = 100;       // episodes in that window
 
   // The threshold in radians, computed the way Gymnasium does (12 * 2 * pi / 360).
   double thetaThresholdRad() const;
-  // The largest return an episode can have (one that balances to max_episode_steps).
+  // The reward the solved window judges: solved_reward, else reward.
+  RewardScheme scoreReward() const
+  {
+    return solved_reward.value_or(reward);
+  }
+  // The largest return (of scoreReward()) an episode can have (one that balances to max_episode_steps).
   double largestReturn() const;
-  // Whether solved_mean_return can be reached at all: not under sutton_barto or centred (at most 0), nor with
+  // Whether solved_mean_return can be reached at all: not when scored by sutton_barto or centred (at most 0), nor with
   // episodes shorter than it. Training with such a task never says solved; its goal is elsewhere
   // (training/until suite_passes).
   bool solvable() const
@@ -53,7 +67,8 @@ struct TaskParams
 
 struct StepOutcome
 {
-  double reward = 0.0;
+  double reward = 0.0;      // the training reward (TaskParams::reward)
+  double score = 0.0;       // what the step adds to the episode's return (TaskParams::scoreReward())
   bool terminated = false;  // fell: the transition does not bootstrap
   bool truncated = false;   // out of time: the transition bootstraps
   bool done() const
@@ -79,6 +94,8 @@ public:
   StepOutcome evaluate(const CartPoleState& new_state, unsigned steps_taken) const;
 
 private:
+  double rewardOf(RewardScheme scheme, const CartPoleState& new_state, bool terminated) const;
+
   TaskParams params_;
   double theta_threshold_rad_;
 };

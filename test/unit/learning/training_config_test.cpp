@@ -242,5 +242,31 @@ TEST(Config, TheCentredRewardCostsACartOffTheCentreAndTheFallMore)
   EXPECT_TRUE(last.truncated);
   EXPECT_DOUBLE_EQ(-0.25 * kCentredCost, last.reward);
   EXPECT_EQ("centred", toString(RewardScheme::Centred));
-  EXPECT_EQ(RewardScheme::Centred, readTrainingConfig(*parseYamlParameters("task: {reward: centred}", "t")).task.reward);
+  EXPECT_EQ(RewardScheme::Centred,
+            readTrainingConfig(*parseYamlParameters("task: {reward: centred}", "t")).task.reward);
+}
+
+TEST(Config, ASolvedRewardAndAliveQuadraticsCostsAreReadAndWrittenOnlyWhenGiven)
+{
+  const TrainingConfig config =
+      parse("task: {reward: alive_quadratic, x_cost: 0.5, x_dot_cost: 0.25, solved_reward: alive}");
+  EXPECT_EQ(RewardScheme::AliveQuadratic, config.task.reward);
+  ASSERT_TRUE(config.task.solved_reward.has_value());
+  EXPECT_EQ(RewardScheme::Alive, *config.task.solved_reward);
+  EXPECT_EQ(0.5, config.task.x_cost);
+  EXPECT_EQ(0.25, config.task.x_dot_cost);
+  const std::string text = trainingConfigText(config);
+  EXPECT_NE(std::string::npos, text.find("solved_reward: alive")) << text;
+  EXPECT_NE(std::string::npos, text.find("x_cost: 0.5")) << text;
+  const TrainingConfig back = parse(text);
+  EXPECT_EQ(text, trainingConfigText(back));
+  // Absent: no key in the text (the tables of configs without them stay byte for byte).
+  const std::string plain = trainingConfigText(parse("task: {reward: alive}"));
+  EXPECT_EQ(std::string::npos, plain.find("solved_reward")) << plain;
+  EXPECT_EQ(std::string::npos, plain.find("x_cost")) << plain;
+  EXPECT_FALSE(parse("").task.solved_reward.has_value());
+  const std::string bad = errorOf("task: {solved_reward: steps}");
+  EXPECT_NE(std::string::npos, bad.find("task/solved_reward")) << bad;
+  const std::string cost = errorOf("task: {reward: alive, x_cost: 1.0}");
+  EXPECT_NE(std::string::npos, cost.find("only alive_quadratic reads them")) << cost;
 }

@@ -277,3 +277,39 @@ TEST(TrainingSession, AnEvaluatedTableKeepsWhatItSaysOfItsTraining)
   EXPECT_EQ("learning: {gamma: 0.5}\n", session.table().trained_with);
   EXPECT_EQ(0.0, session.table().tau);
 }
+
+TEST(TrainingSession, TheLearnerTrainsOnTheRewardAndTheReturnsAreTheSolvedRewards)
+{
+  // alive_quadratic trains (a cart off centre is worth less than 1 a step), alive scores: the
+  // episode's return and the solved window count steps alive, as InvertedPendulum-v5's do.
+  TaskParams task;
+  task.reward = RewardScheme::AliveQuadratic;
+  task.x_cost = 1.0;
+  task.solved_reward = RewardScheme::Alive;
+  task.max_episode_steps = 3;
+  task.solved_window = 1;
+  task.solved_mean_return = 3.0;
+  AgentParams agent;
+  agent.gamma = 0.0;  // Q is the last reward itself
+  agent.epsilon.type = ScheduleType::Constant;
+  agent.epsilon.start = agent.epsilon.min = 0.0;
+  agent.alpha.type = ScheduleType::Constant;
+  agent.alpha.start = agent.alpha.min = 1.0;
+  TrainingSession session(task, agent, 0);
+  const Discretiser& d = session.agent().discretiser();
+  const CartPoleState off_centre(0.5, 0.0, 0.0, 0.0);
+  session.beginEpisode(off_centre);
+  Decision decision;
+  for (int step = 0; step < 3; ++step)
+    decision = session.observe(off_centre);
+  ASSERT_TRUE(decision.episode_over);
+  EXPECT_DOUBLE_EQ(0.75, decision.outcome.reward);
+  EXPECT_EQ(1.0, decision.outcome.score);
+  const std::size_t row = d.index(off_centre);
+  double learnt = 0.0;
+  for (std::size_t a = 0; a < agent.actions.size(); ++a)
+    learnt = std::max(learnt, session.table().at(row, a));
+  EXPECT_DOUBLE_EQ(0.75, learnt);
+  EXPECT_EQ(3.0, session.lastEpisode().episode_return);
+  EXPECT_TRUE(session.lastEpisode().solved);
+}
