@@ -96,39 +96,4 @@ CartPoleTask::CartPoleTask(const TaskParams& params) : params_(params), theta_th
     throw std::invalid_argument(error);
 }
 
-bool CartPoleTask::isTerminal(const CartPoleState& state) const
-{
-  return state[0] < -params_.x_threshold || state[0] > params_.x_threshold || state[2] < -theta_threshold_rad_ ||
-         state[2] > theta_threshold_rad_;
-}
-
-StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned steps_taken) const
-{
-  StepOutcome outcome;
-  outcome.terminated = isTerminal(new_state);
-  // A step that both falls and hits the limit counts as a fall: there is no future to bootstrap on.
-  outcome.truncated = !outcome.terminated && steps_taken >= params_.max_episode_steps;
-  switch (params_.reward)
-  {
-    case RewardScheme::Gymnasium:
-      outcome.reward = 1.0;
-      break;
-    case RewardScheme::Seed:
-      outcome.reward = outcome.terminated ? -1.0 : 1.0;
-      break;
-    case RewardScheme::SuttonBarto:
-      outcome.reward = outcome.terminated ? -1.0 : 0.0;
-      break;
-    case RewardScheme::Alive:
-      outcome.reward = outcome.terminated ? 0.0 : 1.0;
-      break;
-    case RewardScheme::Centred: {
-      const double off_centre = new_state[0] / params_.x_threshold;
-      outcome.reward = outcome.terminated ? -1.0 : -kCentredCost * off_centre * off_centre;
-      break;
-    }
-  }
-  return outcome;
-}
-
 }  // namespace cartpole_qlearning

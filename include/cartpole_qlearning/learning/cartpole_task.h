@@ -76,11 +76,47 @@ public:
   bool isTerminal(const CartPoleState& state) const;
 
   // Judges the step that produced new_state, the steps_taken-th of its episode (1-based).
+  // Inline (below) with isTerminal: every step of training and of the suite's verdicts asks.
   StepOutcome evaluate(const CartPoleState& new_state, unsigned steps_taken) const;
 
 private:
   TaskParams params_;
   double theta_threshold_rad_;
 };
+
+inline bool CartPoleTask::isTerminal(const CartPoleState& state) const
+{
+  return state[0] < -params_.x_threshold || state[0] > params_.x_threshold || state[2] < -theta_threshold_rad_ ||
+         state[2] > theta_threshold_rad_;
+}
+
+inline StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned steps_taken) const
+{
+  StepOutcome outcome;
+  outcome.terminated = isTerminal(new_state);
+  // A step that both falls and hits the limit counts as a fall: there is no future to bootstrap on.
+  outcome.truncated = !outcome.terminated && steps_taken >= params_.max_episode_steps;
+  switch (params_.reward)
+  {
+    case RewardScheme::Gymnasium:
+      outcome.reward = 1.0;
+      break;
+    case RewardScheme::Seed:
+      outcome.reward = outcome.terminated ? -1.0 : 1.0;
+      break;
+    case RewardScheme::SuttonBarto:
+      outcome.reward = outcome.terminated ? -1.0 : 0.0;
+      break;
+    case RewardScheme::Alive:
+      outcome.reward = outcome.terminated ? 0.0 : 1.0;
+      break;
+    case RewardScheme::Centred: {
+      const double off_centre = new_state[0] / params_.x_threshold;
+      outcome.reward = outcome.terminated ? -1.0 : -kCentredCost * off_centre * off_centre;
+      break;
+    }
+  }
+  return outcome;
+}
 
 }  // namespace cartpole_qlearning
