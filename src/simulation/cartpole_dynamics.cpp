@@ -87,4 +87,14 @@ CartPoleDynamics::CartPoleDynamics(const CartPoleParams& params) : params_(param
     throw std::invalid_argument(error);
 }
 
+CartPoleState CartPoleDynamics::rk4Step(const CartPoleState& state, double force) const
+{
+  const double tau = params_.tau;
+  const CartPoleState d = derivative(state, force);
+  const CartPoleState k2 = derivative(state + 0.5 * tau * d, force);
+  const CartPoleState k3 = derivative(state + 0.5 * tau * k2, force);
+  const CartPoleState k4 = derivative(state + tau * k3, force);
+  return state + (tau / 6.0) * (d + 2.0 * k2 + 2.0 * k3 + k4);
+}
+
 }  // namespace cartpole_qlearning
