@@ -1,7 +1,8 @@
 #include "cartpole_qlearning/application/robustness_suite.h"
 
 #include "cartpole_qlearning/simulation/physics_engines.h"
-#include "cartpole_qlearning/learning/training_session.h"
+#include "cartpole_qlearning/learning/cartpole_task.h"
+#include "cartpole_qlearning/learning/q_learning_agent.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -52,6 +53,19 @@ double boundValue(const YAML::Node& node, const std::string& where)
   if (!(std::isfinite(value) && value >= 0.0))
     throw ConfigError(where + " = '" + YAML::Dump(node) + "' is not allowed (must be a finite number >= 0)");
   return value;
+}
+
+// A case's step, in steps of the unperturbed model: each noisy value draws a normal (a log, a
+// cosine and two draws, about half the physics' step: perf on the shipped suite), a push a draw.
+double stepCost(const SuiteCase& c)
+{
+  const PerturbationParams& p = c.perturbations;
+  double cost = 1.0;
+  for (std::size_t i = 0; i < p.noise_std.size(); ++i)
+    cost += p.noise_std[i] != 0.0 || p.noise_fraction[i] != 0.0 ? 0.5 : 0.0;
+  if (p.push_probability > 0.0 && p.push_force != 0.0)
+    cost += 0.1;
+  return cost;
 }
 }  // namespace
 
@@ -139,10 +153,19 @@ RobustnessSuite loadRobustnessSuite(const std::string& path, const TrainingConfi
 CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
                         std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided, std::uint64_t target)
 {
-  TrainingSession session(config.task, config.agent, seed, false);
-  const std::string mismatch = session.replaceTable(table);
+  // Greedy, and nothing else: the steps a TrainingSession that does not learn takes (the same
+  // rows, the same first-best action, the same task, returns summed in the same order), without
+  // its bookkeeping (the learning branch, the solved window, episode summaries) or an agent that
+  // holds a copy of the table.
+  const CartPoleTask task(config.task);
+  const std::string invalid = config.agent.validate();
+  if (!invalid.empty())
+    throw std::invalid_argument(invalid);
+  const std::string mismatch = tableShapeMismatch(config.agent.featureParams(), config.agent.actions, table);
   if (!mismatch.empty())
     throw ConfigError("the table does not fit the configuration: " + mismatch);
+  const FeatureMap features(config.agent.featureParams(), config.agent.actions.size());
+  const std::vector<double>& efforts = table.actions();
   CartPoleSimulation simulation = makeSimulation(suite_case.physics, suite_case.engine, suite_case.start_state_bound,
                                                  seed, suite_case.perturbations);
   CaseResult result;
@@ -154,22 +177,29 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
   const std::uint64_t decided_at = result.decidedAgainst();
   const std::uint64_t falls_to_fail = episodes >= decided_at ? episodes - decided_at + 1 : 0;
   double returns = 0.0;
+  ActiveRows rows;
   for (std::uint64_t e = 0; e < episodes; ++e)
   {
     simulation.resetRandom();
-    double effort = session.beginEpisode(simulation.observation());
+    features.activeRows(simulation.observation(), rows);
+    std::size_t action = QLearningAgent::greedyAction(table, rows);
+    unsigned steps = 0;
+    double episode_return = 0.0;
+    StepOutcome outcome;
     for (;;)
     {
-      simulation.step(effort);
-      const Decision decision = session.observe(simulation.observation());
-      if (decision.episode_over)
+      simulation.step(efforts[action]);
+      outcome = task.evaluate(simulation.observation(), ++steps);
+      episode_return += outcome.score;  // the return the solved window counts (TaskParams::scoreReward())
+      if (outcome.done())
         break;
-      effort = decision.effort;
+      // The action just taken is part of what a previous_action table sees of the state.
+      features.activeRows(simulation.observation(), rows, action + 1);
+      action = QLearningAgent::greedyAction(table, rows);
     }
-    const EpisodeSummary& s = session.lastEpisode();
-    result.steps += s.steps;
-    result.balanced += s.truncated && !s.terminated;
-    returns += s.episode_return;
+    result.steps += steps;
+    result.balanced += outcome.truncated && !outcome.terminated;
+    returns += episode_return;
     result.run = e + 1;
     if (stop_when_decided && (result.balanced >= decided_at || result.run - result.balanced >= falls_to_fail))
       break;
@@ -193,15 +223,25 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
 
   // Positions are taken in order, so when the case at position p fails every position before p
   // has been taken and runs to its end: the cases kept (up to the first failure) are the same
-  // whatever the number of threads.
+  // whatever the number of threads. A complete verdict keeps every case, so it takes the costliest
+  // first (the threads then end together, not one of them alone on a noisy case); each result
+  // still goes to its own position.
+  std::vector<std::size_t> taken(order.size());
+  for (std::size_t p = 0; p < taken.size(); ++p)
+    taken[p] = p;
+  if (!how.stop_at_first_failure)
+    std::stable_sort(taken.begin(), taken.end(), [&](std::size_t a, std::size_t b) {
+      return stepCost(suite.cases[order[a]]) > stepCost(suite.cases[order[b]]);
+    });
   std::vector<CaseResult> results(order.size());
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> first_failure{order.size()};
   std::exception_ptr error;
   std::mutex error_mutex;
   const auto work = [&]() {
-    for (std::size_t p = next++; p < order.size(); p = next++)
+    for (std::size_t t = next++; t < taken.size(); t = next++)
     {
+      const std::size_t p = taken[t];
       if (how.stop_at_first_failure && p > first_failure.load())
         return;
       try

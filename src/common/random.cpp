@@ -22,11 +22,6 @@ RandomStream::RandomStream(std::uint64_t seed, std::uint64_t stream_id)
 {
 }
 
-double RandomStream::uniform01()
-{
-  return static_cast<double>(engine_() >> 11) * 0x1.0p-53;
-}
-
 double RandomStream::uniform(double low, double high)
 {
   return low + (high - low) * uniform01();

@@ -109,46 +109,4 @@ CartPoleTask::CartPoleTask(const TaskParams& params) : params_(params), theta_th
     throw std::invalid_argument(error);
 }
 
-bool CartPoleTask::isTerminal(const CartPoleState& state) const
-{
-  return state[0] < -params_.x_threshold || state[0] > params_.x_threshold || state[2] < -theta_threshold_rad_ ||
-         state[2] > theta_threshold_rad_;
-}
-
-StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned steps_taken) const
-{
-  StepOutcome outcome;
-  outcome.terminated = isTerminal(new_state);
-  // A step that both falls and hits the limit counts as a fall: there is no future to bootstrap on.
-  outcome.truncated = !outcome.terminated && steps_taken >= params_.max_episode_steps;
-  outcome.reward = rewardOf(params_.reward, new_state, outcome.terminated);
-  outcome.score =
-      params_.solved_reward ? rewardOf(*params_.solved_reward, new_state, outcome.terminated) : outcome.reward;
-  return outcome;
-}
-
-double CartPoleTask::rewardOf(RewardScheme scheme, const CartPoleState& new_state, bool terminated) const
-{
-  switch (scheme)
-  {
-    case RewardScheme::Gymnasium:
-      return 1.0;
-    case RewardScheme::Seed:
-      return terminated ? -1.0 : 1.0;
-    case RewardScheme::SuttonBarto:
-      return terminated ? -1.0 : 0.0;
-    case RewardScheme::Alive:
-      return terminated ? 0.0 : 1.0;
-    case RewardScheme::Centred: {
-      const double off_centre = new_state[0] / params_.x_threshold;
-      return terminated ? -1.0 : -kCentredCost * off_centre * off_centre;
-    }
-    case RewardScheme::AliveQuadratic:
-      return terminated ? 0.0
-                        : 1.0 - params_.x_cost * new_state[0] * new_state[0] -
-                              params_.x_dot_cost * new_state[1] * new_state[1];
-  }
-  return 0.0;
-}
-
 }  // namespace cartpole_qlearning

@@ -70,24 +70,11 @@ Discretiser::Discretiser(const DiscretiserParams& params) : params_(params), sta
   const std::string error = params_.validate();
   if (!error.empty())
     throw std::invalid_argument(error);
-  for (unsigned b : params_.bins)
-    state_count_ *= b;
-}
-
-unsigned Discretiser::bin(std::size_t dimension, double value) const
-{
-  const unsigned n = params_.bins[dimension];
-  if (n == 1)
-    return 0;
-  return uniformBin(value, params_.lower[dimension], params_.upper[dimension], n);
-}
-
-std::size_t Discretiser::index(const CartPoleState& state) const
-{
-  std::size_t row = 0;
   for (std::size_t d = 0; d < kStateDimensions; ++d)
-    row = row * params_.bins[d] + bin(d, state[d]);
-  return row;
+  {
+    state_count_ *= params_.bins[d];
+    widths_[d] = (params_.upper[d] - params_.lower[d]) / params_.bins[d];
+  }
 }
 
 }  // namespace cartpole_qlearning

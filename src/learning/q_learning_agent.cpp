@@ -154,12 +154,12 @@ double QLearningAgent::value(const ActiveRows& state, std::size_t action) const
   return q;
 }
 
-std::size_t QLearningAgent::greedyAction(const ActiveRows& state, double* best_q) const
+std::size_t QLearningAgent::bestAction(const QTable& table, const ActiveRows& state, double* best_q)
 {
-  const std::size_t actions = table_.actionCount();
+  const std::size_t actions = table.actionCount();
   // Row by row, all actions at once: each row's weights are contiguous.
   std::array<double, kMaxActions> q;
-  const double* const values = table_.values().data();
+  const double* const values = table.values().data();
   const double* first = values + state.rows[0] * actions;
   std::copy(first, first + actions, q.begin());
   for (unsigned i = 1; i < state.count; ++i)
@@ -179,19 +179,12 @@ std::size_t QLearningAgent::greedyAction(const ActiveRows& state, double* best_q
   return best;
 }
 
-std::size_t QLearningAgent::greedyAction(const ActiveRows& state) const
-{
-  if (state.count == 1)
-    return table_.argmax(state.rows[0]);
-  return greedyAction(state, nullptr);
-}
-
 double QLearningAgent::maxValue(const ActiveRows& state) const
 {
   if (state.count == 1)
     return table_.max(state.rows[0]);
   double best_q = 0.0;
-  greedyAction(state, &best_q);
+  bestAction(table_, state, &best_q);
   return best_q;
 }
 

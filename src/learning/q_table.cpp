@@ -36,18 +36,6 @@ QTable::QTable(const FeatureParams& features, const std::vector<double>& actions
   values_.assign(state_count_ * actions_.size(), 0.0);
 }
 
-std::size_t QTable::argmax(std::size_t state) const
-{
-  const double* row = &values_[state * actions_.size()];
-  std::size_t best = 0;
-  for (std::size_t a = 1; a < actions_.size(); ++a)
-  {
-    if (row[a] > row[best])
-      best = a;
-  }
-  return best;
-}
-
 double QTable::max(std::size_t state) const
 {
   return at(state, argmax(state));
@@ -67,10 +55,15 @@ void QTable::setValues(std::vector<double> values)
 
 std::string QTable::shapeMismatch(const QTable& other) const
 {
-  const std::string features = features_.mismatch(other.features_);
-  if (!features.empty())
-    return features;
-  if (actions_ != other.actions_)
+  return tableShapeMismatch(features_, actions_, other);
+}
+
+std::string tableShapeMismatch(const FeatureParams& features, const std::vector<double>& actions, const QTable& other)
+{
+  const std::string differs = features.mismatch(other.features());
+  if (!differs.empty())
+    return differs;
+  if (actions != other.actions())
   {
     std::ostringstream out;
     out.precision(17);
@@ -81,9 +74,9 @@ std::string QTable::shapeMismatch(const QTable& other) const
       out << "]";
     };
     out << "actions ";
-    list(other.actions_);
+    list(other.actions());
     out << " differ from ";
-    list(actions_);
+    list(actions);
     return out.str();
   }
   return "";

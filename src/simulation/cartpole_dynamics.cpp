@@ -87,67 +87,14 @@ CartPoleDynamics::CartPoleDynamics(const CartPoleParams& params) : params_(param
     throw std::invalid_argument(error);
 }
 
-CartPoleState CartPoleDynamics::derivative(const CartPoleState& state, double force) const
-{
-  // Written in Gymnasium's order of operations so that Euler steps agree with it to the last bits.
-  const double total_mass = params_.mass_pole + params_.mass_cart;
-  const double polemass_length = params_.mass_pole * params_.half_length;
-  const double theta = state[2];
-  const double theta_dot = state[3];
-  const double costheta = std::cos(theta);
-  const double sintheta = std::sin(theta);
-  if (params_.cart_friction != 0.0 || params_.pole_friction != 0.0)
-  {
-    // Barto, Sutton and Anderson's equations with their friction terms (kept apart, so that the
-    // frictionless model stays Gymnasium's operation for operation).
-    const double sign_x_dot = state[1] > 0.0 ? 1.0 : (state[1] < 0.0 ? -1.0 : 0.0);
-    const double temp =
-        (force + polemass_length * (theta_dot * theta_dot) * sintheta - params_.cart_friction * sign_x_dot) /
-        total_mass;
-    const double thetaacc =
-        (params_.gravity * sintheta - costheta * temp - params_.pole_friction * theta_dot / polemass_length) /
-        (params_.half_length * (4.0 / 3.0 - params_.mass_pole * (costheta * costheta) / total_mass));
-    const double xacc = temp - polemass_length * thetaacc * costheta / total_mass;
-    return CartPoleState(state[1], xacc, theta_dot, thetaacc);
-  }
-  const double temp = (force + polemass_length * (theta_dot * theta_dot) * sintheta) / total_mass;
-  const double thetaacc = (params_.gravity * sintheta - costheta * temp) /
-                          (params_.half_length * (4.0 / 3.0 - params_.mass_pole * (costheta * costheta) / total_mass));
-  const double xacc = temp - polemass_length * thetaacc * costheta / total_mass;
-  return CartPoleState(state[1], xacc, theta_dot, thetaacc);
-}
-
-CartPoleState CartPoleDynamics::step(const CartPoleState& state, double force) const
+CartPoleState CartPoleDynamics::rk4Step(const CartPoleState& state, double force) const
 {
   const double tau = params_.tau;
   const CartPoleState d = derivative(state, force);
-  CartPoleState next;
-  switch (params_.integrator)
-  {
-    case Integrator::Euler:
-      next = CartPoleState(state[0] + tau * state[1], state[1] + tau * d[1], state[2] + tau * state[3],
-                           state[3] + tau * d[3]);
-      break;
-    case Integrator::SemiImplicitEuler: {
-      const double x_dot = state[1] + tau * d[1];
-      const double theta_dot = state[3] + tau * d[3];
-      next = CartPoleState(state[0] + tau * x_dot, x_dot, state[2] + tau * theta_dot, theta_dot);
-      break;
-    }
-    case Integrator::Rk4: {
-      const CartPoleState k2 = derivative(state + 0.5 * tau * d, force);
-      const CartPoleState k3 = derivative(state + 0.5 * tau * k2, force);
-      const CartPoleState k4 = derivative(state + tau * k3, force);
-      next = state + (tau / 6.0) * (d + 2.0 * k2 + 2.0 * k3 + k4);
-      break;
-    }
-  }
-  return next;
-}
-
-double CartPoleDynamics::clampForce(double force) const
-{
-  return std::clamp(force, -params_.force_mag, params_.force_mag);
+  const CartPoleState k2 = derivative(state + 0.5 * tau * d, force);
+  const CartPoleState k3 = derivative(state + 0.5 * tau * k2, force);
+  const CartPoleState k4 = derivative(state + tau * k3, force);
+  return state + (tau / 6.0) * (d + 2.0 * k2 + 2.0 * k3 + k4);
 }
 
 }  // namespace cartpole_qlearning

@@ -15,8 +15,11 @@ CartPoleSimulation::CartPoleSimulation(const CartPoleParams& params, double star
 CartPoleSimulation::CartPoleSimulation(std::unique_ptr<PhysicsEngine> engine, double start_state_bound,
                                        std::uint64_t seed, const PerturbationParams& perturbations)
   : engine_(std::move(engine)),
+    equations_(dynamic_cast<EquationsEngine*>(engine_.get())),
     start_state_bound_(start_state_bound),
     perturbations_(perturbations),
+    noisy_(perturbations.noisy()),
+    pushes_(perturbations.push_probability > 0.0 && perturbations.push_force != 0.0),
     rng_(seed, kEnvironmentStream),
     noise_rng_(seed, kNoiseStream),
     perturbation_rng_(seed, kPerturbationStream),
@@ -30,7 +33,7 @@ CartPoleSimulation::CartPoleSimulation(std::unique_ptr<PhysicsEngine> engine, do
   const std::string error = perturbations.validate();
   if (!error.empty())
     throw std::invalid_argument("perturbations: " + error);
-  if (perturbations.half_length.varies() && dynamic_cast<const EquationsEngine*>(engine_.get()) == nullptr)
+  if (perturbations.half_length.varies() && equations_ == nullptr)
     throw std::invalid_argument(
         "perturbations: half_length is not allowed with this engine (a model's pole is its geometry: "
         "scale it in the model)");
@@ -38,8 +41,11 @@ CartPoleSimulation::CartPoleSimulation(std::unique_ptr<PhysicsEngine> engine, do
 
 CartPoleSimulation::CartPoleSimulation(const CartPoleSimulation& other)
   : engine_(other.engine_->clone()),
+    equations_(dynamic_cast<EquationsEngine*>(engine_.get())),
     start_state_bound_(other.start_state_bound_),
     perturbations_(other.perturbations_),
+    noisy_(other.noisy_),
+    pushes_(other.pushes_),
     rng_(other.rng_),
     noise_rng_(other.noise_rng_),
     perturbation_rng_(other.perturbation_rng_),
@@ -60,10 +66,9 @@ CartPoleSimulation& CartPoleSimulation::operator=(const CartPoleSimulation& othe
 
 const CartPoleDynamics& CartPoleSimulation::dynamics() const
 {
-  const auto* equations = dynamic_cast<const EquationsEngine*>(engine_.get());
-  if (equations == nullptr)
+  if (equations_ == nullptr)
     throw std::logic_error("CartPoleSimulation::dynamics: the engine is not the equations");
-  return equations->dynamics();
+  return equations_->dynamics();
 }
 
 void CartPoleSimulation::beginEpisode()
@@ -80,7 +85,7 @@ void CartPoleSimulation::beginEpisode()
   }
   delay_.reset(delay);
   const CartPoleState& state = engine_->state();
-  observation_ = perturbations_.noisy() ? addSensorNoise(state, perturbations_, noise_rng_) : state;
+  observation_ = noisy_ ? addSensorNoise(state, perturbations_, noise_rng_) : state;
 }
 
 const CartPoleState& CartPoleSimulation::resetRandom()
@@ -102,12 +107,12 @@ const CartPoleState& CartPoleSimulation::step(double command)
 {
   last_push_ = 0.0;
   const double acting = delay_.apply(command);
-  if (perturbations_.push_probability > 0.0 && perturbations_.push_force != 0.0 &&
-      perturbation_rng_.uniform01() < perturbations_.push_probability)
+  if (pushes_ && perturbation_rng_.uniform01() < perturbations_.push_probability)
     last_push_ = perturbation_rng_.uniform01() < 0.5 ? -perturbations_.push_force : perturbations_.push_force;
-  applied_force_ = engine_->step(acting, last_push_);
-  const CartPoleState& state = engine_->state();
-  observation_ = perturbations_.noisy() ? addSensorNoise(state, perturbations_, noise_rng_) : state;
+  // EquationsEngine is final: through its own pointer the step is inlined here.
+  applied_force_ = equations_ != nullptr ? equations_->step(acting, last_push_) : engine_->step(acting, last_push_);
+  const CartPoleState& state = equations_ != nullptr ? equations_->state() : engine_->state();
+  observation_ = noisy_ ? addSensorNoise(state, perturbations_, noise_rng_) : state;
   return state;
 }
 

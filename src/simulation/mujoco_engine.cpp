@@ -257,3 +257,11 @@ void MujocoEngine::readState()
 }
 
 }  // namespace cartpole_qlearning
+
+// What physics_engines.cpp looks up after loading this library on a config's first MuJoCo engine
+// (dlopen): the engine made, or the EngineError its constructor throws.
+extern "C" void cartpole_qlearning_make_mujoco_engine(const cartpole_qlearning::EngineParams& params, double tau,
+                                                      std::unique_ptr<cartpole_qlearning::PhysicsEngine>& made)
+{
+  made = std::make_unique<cartpole_qlearning::MujocoEngine>(params, tau);
+}

@@ -87,16 +87,7 @@ void ActuationDelay::reset(unsigned steps)
 {
   steps_ = steps;
   line_.assign(steps_, 0.0);
-}
-
-double ActuationDelay::apply(double command)
-{
-  if (steps_ == 0)
-    return command;
-  line_.push_back(command);
-  const double acting = line_.front();
-  line_.pop_front();
-  return acting;
+  next_ = 0;
 }
 
 std::string describePerturbations(const PerturbationParams& p, double tau)

@@ -30,16 +30,4 @@ void EquationsEngine::setFactors(const EpisodeFactors& factors)
   motor_factor_ = factors.motor;
 }
 
-double EquationsEngine::step(double command, double push)
-{
-  // The clamp is the configured force_mag's (the drive's limit); a weaker motor gives less of it.
-  const double clamped = dynamics_.clampForce(command);
-  clamps_ += clamped != command;
-  double force = motor_factor_ * clamped;
-  if (push != 0.0)
-    force += push;
-  state_ = dynamics_.step(state_, force);
-  return force;
-}
-
 }  // namespace cartpole_qlearning

@@ -15,8 +15,11 @@ public:
   // stream_id keeps the environment's and the agent's draws independent for one seed.
   RandomStream(std::uint64_t seed, std::uint64_t stream_id);
 
-  // Uniform in [0, 1), 53 random bits.
-  double uniform01();
+  // Uniform in [0, 1), 53 random bits. Inline: the simulation draws it every step (pushes).
+  double uniform01()
+  {
+    return static_cast<double>(engine_() >> 11) * 0x1.0p-53;
+  }
   // Uniform in [low, high).
   double uniform(double low, double high);
   // Standard normal (Box-Muller, two uniform draws per value).

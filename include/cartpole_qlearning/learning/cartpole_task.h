@@ -91,6 +91,7 @@ public:
   bool isTerminal(const CartPoleState& state) const;
 
   // Judges the step that produced new_state, the steps_taken-th of its episode (1-based).
+  // Inline (below) with isTerminal: every step of training and of the suite's verdicts asks.
   StepOutcome evaluate(const CartPoleState& new_state, unsigned steps_taken) const;
 
 private:
@@ -99,5 +100,47 @@ private:
   TaskParams params_;
   double theta_threshold_rad_;
 };
+
+inline bool CartPoleTask::isTerminal(const CartPoleState& state) const
+{
+  return state[0] < -params_.x_threshold || state[0] > params_.x_threshold || state[2] < -theta_threshold_rad_ ||
+         state[2] > theta_threshold_rad_;
+}
+
+inline StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned steps_taken) const
+{
+  StepOutcome outcome;
+  outcome.terminated = isTerminal(new_state);
+  // A step that both falls and hits the limit counts as a fall: there is no future to bootstrap on.
+  outcome.truncated = !outcome.terminated && steps_taken >= params_.max_episode_steps;
+  outcome.reward = rewardOf(params_.reward, new_state, outcome.terminated);
+  outcome.score =
+      params_.solved_reward ? rewardOf(*params_.solved_reward, new_state, outcome.terminated) : outcome.reward;
+  return outcome;
+}
+
+inline double CartPoleTask::rewardOf(RewardScheme scheme, const CartPoleState& new_state, bool terminated) const
+{
+  switch (scheme)
+  {
+    case RewardScheme::Gymnasium:
+      return 1.0;
+    case RewardScheme::Seed:
+      return terminated ? -1.0 : 1.0;
+    case RewardScheme::SuttonBarto:
+      return terminated ? -1.0 : 0.0;
+    case RewardScheme::Alive:
+      return terminated ? 0.0 : 1.0;
+    case RewardScheme::Centred: {
+      const double off_centre = new_state[0] / params_.x_threshold;
+      return terminated ? -1.0 : -kCentredCost * off_centre * off_centre;
+    }
+    case RewardScheme::AliveQuadratic:
+      return terminated ? 0.0
+                        : 1.0 - params_.x_cost * new_state[0] * new_state[0] -
+                              params_.x_dot_cost * new_state[1] * new_state[1];
+  }
+  return 0.0;
+}
 
 }  // namespace cartpole_qlearning

@@ -47,13 +47,14 @@ bool sameUniformGrid(const std::array<unsigned, kStateDimensions>& counts,
 // [lower + i*w, lower + (i+1)*w) with w = (upper - lower) / n; values below lower (and NaN) go to
 // bin 0, values at or above upper to bin n - 1. A value on an edge always lands in the bin that
 // starts there, even where the division rounds across it. n >= 1, lower < upper.
-inline unsigned uniformBin(double value, double lower, double upper, unsigned n)
+// width: (upper - lower) / n, computed once by a caller that bins many values (the same
+// quotient every time: the same bins).
+inline unsigned uniformBin(double value, double lower, double upper, unsigned n, double width)
 {
   if (!(value >= lower))  // below the range, or NaN
     return 0;
   if (value >= upper)
     return n - 1;
-  const double width = (upper - lower) / n;
   unsigned i = static_cast<unsigned>((value - lower) / width);
   if (i >= n)
     i = n - 1;
@@ -62,6 +63,10 @@ inline unsigned uniformBin(double value, double lower, double upper, unsigned n)
   else if (i + 1 < n && value >= lower + (i + 1) * width)
     ++i;
   return i;
+}
+inline unsigned uniformBin(double value, double lower, double upper, unsigned n)
+{
+  return uniformBin(value, lower, upper, n, (upper - lower) / n);
 }
 
 class Discretiser
@@ -81,14 +86,30 @@ public:
   }
 
   // The bin of one dimension's value (uniformBin over that dimension's bins and bounds). No allocation.
-  unsigned bin(std::size_t dimension, double value) const;
+  // Inline, as index() is: every step of training and of the robustness suite bins a state.
+  unsigned bin(std::size_t dimension, double value) const
+  {
+    const unsigned n = params_.bins[dimension];
+    if (n == 1)
+      return 0;
+    return uniformBin(value, params_.lower[dimension], params_.upper[dimension], n, widths_[dimension]);
+  }
 
   // The row of a state: the bins combined in mixed radix, first dimension most significant.
-  std::size_t index(const CartPoleState& state) const;
+  std::size_t index(const CartPoleState& state) const
+  {
+    std::size_t row = 0;
+    for (std::size_t d = 0; d < kStateDimensions; ++d)
+      row = row * params_.bins[d] + bin(d, state[d]);
+    return row;
+  }
 
 private:
   DiscretiserParams params_;
   std::size_t state_count_;
+  // Each dimension's bin width, (upper - lower) / bins: the quotient uniformBin would compute on
+  // every call, computed once.
+  std::array<double, kStateDimensions> widths_{};
 };
 
 }  // namespace cartpole_qlearning

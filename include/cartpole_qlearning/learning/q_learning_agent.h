@@ -111,7 +111,16 @@ public:
   // draw for the coin and, when exploring, one for the action.
   std::size_t selectAction(const ActiveRows& state, double epsilon);
   // The first action with the largest Q (ties go to the lowest index, as numpy's argmax).
-  std::size_t greedyAction(const ActiveRows& state) const;
+  std::size_t greedyAction(const ActiveRows& state) const
+  {
+    return greedyAction(table_, state);
+  }
+  // The same on any table of this shape: what an evaluation, which learns nothing and so needs no
+  // agent, runs (robustness_suite.cpp).
+  static std::size_t greedyAction(const QTable& table, const ActiveRows& state)
+  {
+    return state.count == 1 ? table.argmax(state.rows[0]) : bestAction(table, state, nullptr);
+  }
   // The same for a bins state given as its row.
   std::size_t selectAction(std::size_t state, double epsilon)
   {
@@ -142,7 +151,7 @@ public:
 
 private:
   // Over several rows: the greedy action, and its Q in best_q when given.
-  std::size_t greedyAction(const ActiveRows& state, double* best_q) const;
+  static std::size_t bestAction(const QTable& table, const ActiveRows& state, double* best_q);
   double maxValue(const ActiveRows& state) const;
 
   AgentParams params_;

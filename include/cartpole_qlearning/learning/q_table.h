@@ -53,7 +53,18 @@ public:
   }
 
   // The first action with the largest value (ties go to the lowest index, as numpy's argmax).
-  std::size_t argmax(std::size_t state) const;
+  // Inline: a greedy step's choice.
+  std::size_t argmax(std::size_t state) const
+  {
+    const double* row = &values_[state * actions_.size()];
+    std::size_t best = 0;
+    for (std::size_t a = 1; a < actions_.size(); ++a)
+    {
+      if (row[a] > row[best])
+        best = a;
+    }
+    return best;
+  }
   double max(std::size_t state) const;
 
   const FeatureParams& features() const
@@ -98,5 +109,9 @@ private:
   std::size_t state_count_ = 0;
   std::vector<double> values_;
 };
+
+// QTable::shapeMismatch against a table of these features and actions, without making one (a
+// table may hold 160 MB of zeros).
+std::string tableShapeMismatch(const FeatureParams& features, const std::vector<double>& actions, const QTable& other);
 
 }  // namespace cartpole_qlearning

@@ -94,8 +94,14 @@ private:
   void beginEpisode();
 
   std::unique_ptr<PhysicsEngine> engine_;
+  // engine_ when it is the equations (else null): stepped without a virtual call. It points into
+  // the engine's own heap object, so a moved simulation keeps it valid.
+  EquationsEngine* equations_ = nullptr;
   double start_state_bound_;
   PerturbationParams perturbations_;
+  // What the perturbations ask of every step, worked out once.
+  bool noisy_ = false;
+  bool pushes_ = false;
   RandomStream rng_;
   RandomStream noise_rng_;
   RandomStream perturbation_rng_;

@@ -10,8 +10,8 @@
 #include "cartpole_qlearning/common/random.h"
 
 #include <array>
-#include <deque>
 #include <string>
+#include <vector>
 
 namespace cartpole_qlearning
 {
@@ -81,11 +81,22 @@ public:
     return steps_;
   }
   // Takes the command for this step and returns the one that acts now.
-  double apply(double command);
+  double apply(double command)
+  {
+    if (steps_ == 0)
+      return command;
+    // A ring of steps_ commands: the oldest acts now and the newest takes its place (a deque
+    // allocated a block every few dozen steps).
+    const double acting = line_[next_];
+    line_[next_] = command;
+    next_ = next_ + 1 == steps_ ? 0 : next_ + 1;
+    return acting;
+  }
 
 private:
   unsigned steps_;
-  std::deque<double> line_;
+  std::vector<double> line_;
+  unsigned next_ = 0;  // the oldest command's place in line_
 };
 
 // What is on, for a log line: "delay 1 step (0.02 s), noise_std [0.01, 0, 0.0087, 0], motor x[0.8, 0.8]"

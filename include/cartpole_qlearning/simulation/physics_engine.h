@@ -87,8 +87,9 @@ public:
   }
 };
 
-// CartPole-v1's equations (cartpole_dynamics.h) as an engine.
-class EquationsEngine : public PhysicsEngine
+// CartPole-v1's equations (cartpole_dynamics.h) as an engine. Final, with step() inline: a
+// simulation that knows its engine is this one steps it without a virtual call.
+class EquationsEngine final : public PhysicsEngine
 {
 public:
   explicit EquationsEngine(const CartPoleParams& params);
@@ -110,7 +111,17 @@ public:
   {
     state_ = state;
   }
-  double step(double command, double push) override;
+  double step(double command, double push) override
+  {
+    // The clamp is the configured force_mag's (the drive's limit); a weaker motor gives less of it.
+    const double clamped = dynamics_.clampForce(command);
+    clamps_ += clamped != command;
+    double force = motor_factor_ * clamped;
+    if (push != 0.0)
+      force += push;
+    state_ = dynamics_.step(state_, force);
+    return force;
+  }
   const CartPoleState& state() const override
   {
     return state_;

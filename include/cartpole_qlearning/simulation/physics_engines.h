@@ -1,8 +1,8 @@
 // The engine a config asks for (physics/engine), made here: the only code that knows every engine.
 // Built as its own library (cartpole_qlearning_engines) that links the simulation layer and, when
-// the build found MuJoCo, cartpole_qlearning_mujoco; the layers above link it, and the simulation
-// layer itself never links MuJoCo. Without MuJoCo, asking for it throws EngineError saying how
-// to get it.
+// the build found MuJoCo, loads cartpole_qlearning_mujoco (built beside it) the first time a config
+// asks for MuJoCo; the layers above link it, and the simulation layer itself never links MuJoCo. Without MuJoCo, asking
+// for it throws EngineError saying how to get it.
 #pragma once
 
 #include "cartpole_qlearning/simulation/cartpole_simulation.h"

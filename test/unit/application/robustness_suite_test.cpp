@@ -2,10 +2,15 @@
 #include "cartpole_qlearning/application/headless_trainer.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/common/random.h"
+#include "cartpole_qlearning/learning/training_session.h"
+#include "cartpole_qlearning/simulation/physics_engines.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
+#include <vector>
 
 using namespace cartpole_qlearning;
 
@@ -350,4 +355,87 @@ TEST(RobustnessSuite, AnOrderThatDoesNotNameEachCaseOnceIsRefused)
   EXPECT_THROW(evaluateSuite(QTable(), TrainingConfig(), suite, how), std::invalid_argument);
   how.order = {0, 1};
   EXPECT_THROW(evaluateSuite(QTable(), TrainingConfig(), suite, how), std::invalid_argument);
+}
+
+namespace
+{
+// The verdict's steps as they were taken before the greedy path (issue 29): through a session that
+// does not learn. The reference evaluateCase must agree with, count for count and bit for bit.
+CaseResult throughASession(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
+                           std::uint64_t episodes, std::uint64_t seed)
+{
+  TrainingSession session(config.task, config.agent, seed, false);
+  EXPECT_EQ(session.replaceTable(table), "");
+  CartPoleSimulation simulation = makeSimulation(suite_case.physics, suite_case.engine, suite_case.start_state_bound,
+                                                 seed, suite_case.perturbations);
+  CaseResult result;
+  double returns = 0.0;
+  for (std::uint64_t e = 0; e < episodes; ++e)
+  {
+    simulation.resetRandom();
+    double effort = session.beginEpisode(simulation.observation());
+    for (;;)
+    {
+      simulation.step(effort);
+      const Decision decision = session.observe(simulation.observation());
+      if (decision.episode_over)
+        break;
+      effort = decision.effort;
+    }
+    const EpisodeSummary& s = session.lastEpisode();
+    result.steps += s.steps;
+    result.balanced += s.truncated && !s.terminated;
+    returns += s.episode_return;
+    result.run = e + 1;
+  }
+  result.mean_return = returns / static_cast<double>(result.run);
+  return result;
+}
+
+// A table of random values: greedy actions that change from row to row.
+QTable randomTable(const TrainingConfig& config, std::uint64_t seed)
+{
+  QTable table(config.agent.featureParams(), config.agent.actions);
+  RandomStream rng(seed, 7);
+  std::vector<double> values(table.values().size());
+  for (double& v : values)
+    v = rng.uniform(-1.0, 1.0);
+  table.setValues(values);
+  return table;
+}
+}  // namespace
+
+TEST(RobustnessSuite, TheGreedyPathTakesTheStepsOfASessionThatDoesNotLearn)
+{
+  // Tables trained to solved, random tables, bins with the previous action and tiles, on every
+  // case of the shipped suite (perturbations, delays, noise, pushes, drawn physics), in episodes
+  // of the task's length (200 steps for the configs here: many falls and many balanced episodes).
+  std::vector<std::pair<TrainingConfig, QTable>> tables;
+  for (std::uint64_t seed = 0; seed < 3; ++seed)
+    tables.emplace_back(TrainingConfig(), trainedTable(seed));
+  TrainingConfig previous;
+  previous.agent.previous_action = true;
+  previous.agent.discretiser.bins = {{3, 3, 8, 12}};
+  tables.emplace_back(previous, randomTable(previous, 1));
+  TrainingConfig tiles;
+  tiles.agent.features = FeatureKind::Tiles;
+  tables.emplace_back(tiles, randomTable(tiles, 2));
+  TrainingConfig three = TrainingConfig();
+  three.agent.actions = {-10.0, 0.0, 10.0};
+  tables.emplace_back(three, randomTable(three, 3));
+  for (const auto& [config, table] : tables)
+  {
+    RobustnessSuite suite = loadRobustnessSuite(kSuite, config);
+    for (const SuiteCase& c : suite.cases)
+    {
+      TrainingConfig judged = config;
+      judged.task.max_episode_steps = 200;
+      const CaseResult expected = throughASession(table, judged, c, 30, suite.seed);
+      const CaseResult greedy = evaluateCase(table, judged, c, 30, suite.seed);
+      EXPECT_EQ(greedy.steps, expected.steps) << c.name;
+      EXPECT_EQ(greedy.balanced, expected.balanced) << c.name;
+      EXPECT_EQ(greedy.run, expected.run) << c.name;
+      EXPECT_EQ(greedy.mean_return, expected.mean_return) << c.name;
+    }
+  }
 }

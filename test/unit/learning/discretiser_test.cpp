@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 using cartpole_qlearning::CartPoleState;
@@ -95,4 +97,47 @@ TEST(Discretiser, BadParametersAreRefusedWithTheirName)
   p = exampleParams();
   p.lower[1] = p.upper[1] = std::nan("");
   EXPECT_EQ("", p.validate());
+}
+
+TEST(Discretiser, ItsWidthsWorkedOutOnceBinAsUniformBinsOwnDivision)
+{
+  // The discretiser divides each dimension's range by its bins once, not on every value: the same
+  // quotient, so the same bins, checked on every edge, its neighbours either side and values
+  // between, for grids whose edges are exact in binary and grids whose edges are not.
+  const std::array<DiscretiserParams, 3> grids = [] {
+    std::array<DiscretiserParams, 3> g;
+    g[0] = exampleParams();
+    g[1].bins = {{3, 3, 8, 12}};
+    g[1].lower = {{-1.0, -1.0, -0.20943951023931953, -0.8726646259971648}};
+    g[1].upper = {{1.0, 1.0, 0.20943951023931953, 0.8726646259971648}};
+    g[2].bins = {{7, 99, 13, 1000}};
+    g[2].lower = {{-2.4, -3.1, -0.3, -1e-3}};
+    g[2].upper = {{2.3, 3.7, 0.1, 7e-3}};
+    return g;
+  }();
+  std::uint64_t checked = 0;
+  for (const DiscretiserParams& p : grids)
+  {
+    const Discretiser d(p);
+    for (std::size_t dim = 0; dim < 4; ++dim)
+    {
+      const unsigned n = p.bins[dim];
+      if (n == 1)
+        continue;
+      const double width = (p.upper[dim] - p.lower[dim]) / n;
+      for (unsigned i = 0; i <= n; ++i)
+      {
+        const double edge = p.lower[dim] + i * width;
+        for (const double v : {edge, std::nextafter(edge, -1e9), std::nextafter(edge, 1e9),
+                               std::nextafter(std::nextafter(edge, -1e9), -1e9), edge + 0.5 * width,
+                               edge - 0.25 * width, edge + 1e-12, edge - 1e-12})
+        {
+          EXPECT_EQ(d.bin(dim, v), cartpole_qlearning::uniformBin(v, p.lower[dim], p.upper[dim], n))
+              << "dimension " << dim << " value " << v;
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 9000u);
 }
