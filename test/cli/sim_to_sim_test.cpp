@@ -25,8 +25,8 @@ TEST(SimToSim, ARobustTableTrainedOnTheEquationsBalancesTheMujocoCartPole)
   const fs::path dir = fs::temp_directory_path() / ("sim_to_sim_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string table_file = (dir / "robust.yaml").string();
-  // Seed 1 passes robust_suite.yaml in 420 episodes (docs/robust_tables.md), about a second's
-  // training; on the model it balanced 100 and 98 of 100 when this was written (docs/mujoco.md).
+  // Seed 1 passes robust_suite.yaml in 5,955 episodes (docs/robust_tables.md), about a minute of
+  // train_headless; on the model it balanced 100 and 98 of 100 when this was written (docs/mujoco.md).
   const CommandRun training =
       runCommand("ROS_HOME=" + dir.string() + " " + TRAIN_HEADLESS + " --config " +
                  CARTPOLE_CONFIG_DIR "/robust.yaml --seed 1 --quiet --no-run-folder --save " + table_file);
