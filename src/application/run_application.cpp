@@ -186,8 +186,9 @@ std::string RunApplication::Parts::saveFinal(bool done_well, const char* finishe
   else if (!settings.q_table_path.empty())
     saved += "; the default table " + tables.resolveForService("") + " is left as it was (this run did not " +
              (config.limits.until == TrainUntil::SuitePasses ? "pass the suite" : "solve") +
-             (settings.command_line ? ": copy the run's table there if you want it)"
-                                    : ": ~save_q_table saves it there if you want it)");
+             (!settings.command_line ? ": ~save_q_table saves it there if you want it)"
+              : settings.run_folder  ? ": copy the run's table there if you want it)"
+                                     : "; with no run folder its table is not kept)");
   return saved;
 }
 

@@ -346,6 +346,20 @@ TEST_F(TrainHeadlessTest, AnUnsolvedRunLeavesSavesFileAloneAndSaysWhereItsTableI
   EXPECT_FALSE(fs::exists(tables() / "q_table.yaml"));
 }
 
+TEST_F(TrainHeadlessTest, AnUnsolvedRunWithNoRunFolderSaysItsTableIsNotKept)
+{
+  // Its table is nowhere to copy from: the message must not send the user to a run folder.
+  const std::string mine = file("mine.yaml", "the user's own table\n");
+  const CommandRun run = trainHeadless(config() + " --seed 0 --max-episodes 5 --no-run-folder --save " + mine);
+  ASSERT_EQ(0, run.status) << run.output;
+  EXPECT_EQ("the user's own table\n", fileText(mine));
+  EXPECT_NE(std::string::npos,
+            run.output.find("the default table " + mine +
+                            " is left as it was (this run did not solve; with no run folder its table is not kept)"))
+      << run.output;
+  EXPECT_EQ(std::string::npos, run.output.find("copy the run's table")) << run.output;
+}
+
 TEST_F(TrainHeadlessTest, NoRunFolderWritesNothingButSave)
 {
   const CommandRun unsaved = trainHeadless(config() + " --seed 0 --no-run-folder");
