@@ -116,10 +116,11 @@ bool FreshnessGuard::check(WallClock::time_point now, LogLines& log)
   if (stopped_ || !stale(now))
     return false;
   stopped_ = true;
-  stop_said_ = !stop_said_at_ || now - *stop_said_at_ >= kSayStopEvery;
+  std::optional<WallClock::time_point>& said_at = stop_said_at_[static_cast<int>(cause())];
+  stop_said_ = !said_at || now - *said_at >= kSayStopEvery;
   if (stop_said_)
   {
-    stop_said_at_ = now;
+    said_at = now;
     log.push_back({LogLine::Level::Warn, describeStop(now)});
   }
   return true;

@@ -78,15 +78,18 @@ private:
   bool stamped_ = false;  // a stamped (non-zero) state has been decided on
   bool stopped_ = false;
   // What arrived since the last decision, by cause (Silence is never counted).
-  std::uint64_t since_decision_[6] = {0, 0, 0, 0, 0, 0};
+  static constexpr int kCauses = static_cast<int>(Cause::Older) + 1;
+  std::uint64_t since_decision_[kCauses] = {};
   std::optional<Cause> last_cause_;
   // The publisher whose states are taken, and when it was last heard.
   std::string publisher_;
   WallClock::time_point publisher_heard_at_;
   std::string refused_publisher_;  // the second one, said once
   // A robot whose states come and go (a loaded machine in real time) is stopped each time, but
-  // said so at most once per kSayStopEvery; its return is said when its stop was.
-  std::optional<WallClock::time_point> stop_said_at_;
+  // said so at most once per kSayStopEvery for each cause; its return is said when its stop was.
+  // Per cause, so that a hiccup of silence never hides a new misbehaviour (stamps dropping to 0
+  // a second later) from the log.
+  std::optional<WallClock::time_point> stop_said_at_[kCauses];
   bool stop_said_ = false;
 };
 

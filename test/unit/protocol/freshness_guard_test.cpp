@@ -277,3 +277,22 @@ TEST(FreshnessGuard, AStreamThatComesAndGoesIsStoppedEachTimeAndSaidOncePerTenSe
   s.wait(milliseconds(200));
   EXPECT_EQ(2, s.linesAt(LogLine::Level::Warn)) << "ten seconds on, a stop is said again";
 }
+
+TEST(FreshnessGuard, ANewCauseIsSaidWithinTenSecondsOfAStopForAnother)
+{
+  // A hiccup of silence (a loaded machine), then, a second later, a driver whose stamps drop to
+  // 0: the second stop has another cause and is said too; a second hiccup is not.
+  Script s;
+  Stamp next = s.freshRun(kTick, 10);
+  s.wait(milliseconds(200));
+  EXPECT_EQ(1, s.linesAt(LogLine::Level::Warn)) << s.text();
+  next = s.freshRun(next, 50);
+  for (int i = 0; i < 20; ++i)
+    s.message(0);
+  EXPECT_EQ(Cause::Unstamped, s.guard_.cause());
+  EXPECT_EQ(2, s.linesAt(LogLine::Level::Warn)) << s.text();
+  EXPECT_NE(std::string::npos, s.text().find("without a stamp")) << s.text();
+  next = s.freshRun(next, 50);
+  s.wait(milliseconds(200));
+  EXPECT_EQ(2, s.linesAt(LogLine::Level::Warn)) << "silence again within 10 s: not said again\n" << s.text();
+}
