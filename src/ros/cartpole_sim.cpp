@@ -249,9 +249,12 @@ void CartPoleSimNode::stepLockstep(double effort)
   const Stamp period = tickOf(settings_.publish_period);
   Stamp stamp = lockstep_->pending();  // the answered state's, one period on
   const std::uint64_t steps = sampled_->stepsAfter(stamp - period);
+  // The state before the last step is shown only when that step ends after the stamp (samples
+  // faster than the steps): else no message is made for it.
+  const bool shown_before_last = sampled_->showsBeforeLastStep(stamp);
   for (std::uint64_t i = 0; i < steps; ++i)
   {
-    if (i + 1 == steps)
+    if (i + 1 == steps && shown_before_last)
       before_last_step_ = stateMessage();
     step(effort);
   }

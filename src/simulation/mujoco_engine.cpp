@@ -3,6 +3,8 @@
 #include <mujoco/mujoco.h>
 
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <sstream>
@@ -129,6 +131,9 @@ MujocoEngine::MujocoEngine(const EngineParams& params, double tau) : params_(par
 
   model_ = mj_copyModel(nullptr, m);
   data_ = mj_makeData(model_);
+  mj_resetData(model_, data_);
+  const auto* header = reinterpret_cast<const unsigned char*>(data_);
+  reset_header_.assign(header, header + offsetof(mjData, buffer));
   // Which way theta grows: a turn about the hinge's axis moves the pole's centre of mass by
   // axis x (centre - anchor); positive theta leans it toward the slide's +x.
   mj_forward(model_, data_);
@@ -170,7 +175,8 @@ MujocoEngine::MujocoEngine(const MujocoEngine& other)
     theta_sign_(other.theta_sign_),
     state_(other.state_),
     motor_factor_(other.motor_factor_),
-    clamps_(other.clamps_)
+    clamps_(other.clamps_),
+    reset_header_(other.reset_header_)
 {
   for (int k = 0; k < 3; ++k)
     slide_axis_[k] = other.slide_axis_[k];
@@ -219,7 +225,7 @@ void MujocoEngine::setFactors(const EpisodeFactors& factors)
 void MujocoEngine::setState(const CartPoleState& state)
 {
   const CartPoleState start = state;  // (it may be state_ itself)
-  mj_resetData(model_, data_);
+  resetData();
   data_->qpos[cart_qpos_] = start[0];
   data_->qvel[cart_dof_] = start[1];
   data_->qpos[pole_qpos_] = theta_sign_ * start[2];
@@ -248,6 +254,42 @@ double MujocoEngine::step(double command, double push)
     applied[k] = 0.0;
   readState();
   return motor_factor_ * gear_ * ctrl + push;
+}
+
+void MujocoEngine::resetData()
+{
+#if mjVERSION_HEADER < 230
+  // MuJoCo 2.2's mj_resetData zeroes all of mjData's memory: its buffer (3 MB for
+  // mjcf/cartpole.xml's default sizes, the constraint arrays for njmax rows) and its stack (10 MB),
+  // about 200 us and every cache line with it, at each episode's start. mj_forward computes
+  // everything but the simulation's state and inputs from those, so only they are set as
+  // mj_resetData sets them (MuJoCo's documentation, "Simulation state"): time and the counters
+  // (the header as a reset leaves it), qpos0, zero velocities, activations, warm-start
+  // accelerations, controls, applied forces and user data, mocap bodies where the model puts them.
+  // Tables trained so are byte for byte those trained with mj_resetData (mujoco_cartpole.yaml
+  // seeds 0-2, inverted_pendulum_v5.yaml seed 0, its slider limited).
+  std::memcpy(static_cast<void*>(data_), reset_header_.data(), reset_header_.size());
+  const mjModel* m = model_;
+  mju_copy(data_->qpos, m->qpos0, m->nq);
+  mju_zero(data_->qvel, m->nv);
+  mju_zero(data_->act, m->na);
+  mju_zero(data_->qacc_warmstart, m->nv);
+  mju_zero(data_->ctrl, m->nu);
+  mju_zero(data_->qfrc_applied, m->nv);
+  mju_zero(data_->xfrc_applied, 6 * m->nbody);
+  mju_zero(data_->userdata, m->nuserdata);
+  for (int b = 0; b < m->nbody; ++b)
+  {
+    const int mocap = m->body_mocapid[b];
+    if (mocap >= 0)
+    {
+      mju_copy3(data_->mocap_pos + 3 * mocap, m->body_pos + 3 * b);
+      mju_copy4(data_->mocap_quat + 4 * mocap, m->body_quat + 4 * b);
+    }
+  }
+#else
+  mj_resetData(model_, data_);
+#endif
 }
 
 void MujocoEngine::readState()

@@ -9,6 +9,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 // MuJoCo's types, declared here so that this header does not need MuJoCo's.
 typedef struct mjModel_ mjModel;
@@ -87,6 +88,8 @@ public:
 
 private:
   void readState();
+  // mj_resetData's outcome without its cost (resetData in the .cpp).
+  void resetData();
 
   EngineParams params_;
   double tau_;
@@ -102,6 +105,9 @@ private:
   CartPoleState state_ = CartPoleState::Zero();
   double motor_factor_ = 1.0;
   std::uint64_t clamps_ = 0;
+  // mjData's header (sizes, counters, time) as mj_resetData leaves it, restored at each start
+  // (MuJoCo 2.2: see resetData).
+  std::vector<unsigned char> reset_header_;
 };
 
 }  // namespace cartpole_qlearning
