@@ -14,8 +14,11 @@ double seconds(WallClock::duration d)
 }
 
 // A first publisher silent this long (or the guard's bound, when longer) has gone: a publisher
-// that comes after it takes over (a driver restarted under a new anonymous name).
-constexpr WallClock::duration kPublisherGone = std::chrono::milliseconds(500);
+// that comes after it takes over (a driver restarted under a new anonymous name, which takes
+// seconds to start anyway). Four times a lockstep sim's repeat (sim.yaml's lockstep_timeout,
+// 0.5 s): a sim whose answer was lost is silent that long before it repeats, and a stray
+// publisher must not take its place then (bad_messages.test's flood did, and training stalled).
+constexpr WallClock::duration kPublisherGone = std::chrono::seconds(2);
 constexpr WallClock::duration kSayStopEvery = std::chrono::seconds(10);
 }  // namespace
 
@@ -47,6 +50,10 @@ FreshnessGuard::FreshnessGuard(WallClock::duration bound, std::string robot)
 bool FreshnessGuard::onMessage(Stamp stamp, bool valid, const std::string& publisher, WallClock::time_point now,
                                LogLines& log)
 {
+  // Off, off entirely: a lockstep sim's stamps already keep a stray publisher's states from
+  // being taken for the sim's (lockstep_protocol.h), and no publisher is refused.
+  if (!enabled())
+    return true;
   if (!publisher.empty())
   {
     const bool first_gone = now - publisher_heard_at_ > std::max(bound_, kPublisherGone);

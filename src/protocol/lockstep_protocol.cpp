@@ -177,6 +177,8 @@ void ControllerProtocol::onResetOutcome(bool succeeded)
   }
   else if (succeeded && phase_ == Phase::WaitingForPerson)
     phase_ = Phase::AwaitingReset;  // the next state that is not fallen is the reset's start
+  reset_served_ = succeeded && phase_ == Phase::AwaitingReset;
+  fallen_repeats_ = 0;
 }
 
 bool ControllerProtocol::takesAsNew(Stamp stamp) const
@@ -219,6 +221,16 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
   {
     ++counts_.repeats;
     reaction.kind = Reaction::Kind::Repeat;
+    // The reset asked for was served, yet a lockstep sim waits on a fallen state: something moved
+    // it after the reset (a hand on cart_effort, a stray command) and the reset's start was never
+    // seen. Nothing would answer it; ask again. The second repeat, not the first: a repeat of the
+    // fall sent before the reset may still be in flight.
+    if (phase_ == Phase::AwaitingReset && reset_served_ && session_.task().isTerminal(state) &&
+        !inStartRegion(state) && ++fallen_repeats_ >= 2)
+    {
+      requestReset(reaction);
+      return reaction;
+    }
     // Not while a failed reset is waited on: the fallen state a lockstep sim repeats was never
     // answered, and answering it would step the sim on, flat out, for as long as no reset works.
     if (!(phase_ == Phase::InEpisode || (phase_ == Phase::WaitingForPerson && !reset_failing_)))
@@ -251,11 +263,20 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
   return onNewState(reaction, state);
 }
 
+void ControllerProtocol::requestReset(Reaction& reaction)
+{
+  reaction.request_reset = true;
+  phase_ = Phase::AwaitingReset;
+  reset_served_ = false;
+  fallen_repeats_ = 0;
+}
+
 Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& state)
 {
   reaction.kind = Reaction::Kind::New;
   ++counts_.states;
   repeats_held_back_ = 0;
+  fallen_repeats_ = 0;
   older_seen_.reset();
   older_run_ = 0;
   if (reaction.stamp != 0)
@@ -295,8 +316,7 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
       if (terminal && !inStartRegion(state))
       {
         // Joining a sim that waits on a fallen pole: nothing to learn from, ask for a start.
-        reaction.request_reset = true;
-        phase_ = Phase::AwaitingReset;
+        requestReset(reaction);
         break;
       }
       begin(reaction, state);
@@ -319,8 +339,7 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
       }
       if (params_.reset_service)
       {
-        reaction.request_reset = true;
-        phase_ = Phase::AwaitingReset;
+        requestReset(reaction);
         break;
       }
       reaction.waiting_for_start = true;

@@ -58,7 +58,9 @@
 //     answered with 0 and the episode starts on the next state after the answer. With resets
 //     that work, nothing of this happens: the normal path is as it was.
 //   - A first state that is terminal (joining a sim that waits on a fallen pole) asks for a
-//     reset without learning.
+//     reset without learning. So does a fallen state repeated twice after the reset asked for
+//     came back done: the sim waits on a fall that is not the reset's start (something moved it
+//     after the reset), and nothing else would answer it.
 //   - Training ends after the episode that reaches the limits (solved or max_episodes); every
 //     state after it is ignored.
 #pragma once
@@ -264,6 +266,8 @@ private:
   Reaction onNewState(Reaction reaction, const CartPoleState& state);
   void begin(Reaction& reaction, const CartPoleState& state);
   void answer(Reaction& reaction, double effort);
+  // Asks for a reset and awaits its start.
+  void requestReset(Reaction& reaction);
   // No reset to count on: begins on a state inside the start region, else commands 0.
   void waitForStartRegion(Reaction& reaction, const CartPoleState& state, bool terminal);
   bool inStartRegion(const CartPoleState& state) const;
@@ -282,6 +286,8 @@ private:
   int older_run_ = 0;                                     // older states in a row, each newer than the one before
   double last_effort_ = 0.0;
   bool reset_failing_ = false;  // the last reset failed, none has succeeded since
+  bool reset_served_ = false;   // AwaitingReset: the reset asked for came back done
+  int fallen_repeats_ = 0;      // repeats of a fallen state since then
   Counts counts_;
 };
 

@@ -227,11 +227,23 @@ TEST(FreshnessGuard, ADriverRestartedUnderANewNameTakesOverOnceTheOldOneIsGone)
 {
   Script s;
   const Stamp next = s.freshRun(kTick, 10);
-  s.wait(milliseconds(600));
+  s.wait(milliseconds(2100));
   EXPECT_TRUE(s.message(next, true, true, "/driver_restarted"));
   EXPECT_TRUE(s.pushes());
   EXPECT_EQ(0, s.linesAt(LogLine::Level::Error)) << s.text();
   EXPECT_NE(std::string::npos, s.text().find("now come from /driver_restarted")) << s.text();
+}
+
+TEST(FreshnessGuard, AStrayPublisherDoesNotTakeThePlaceOfASimWaitingToRepeat)
+{
+  // A lockstep sim whose answer was lost is silent for its lockstep_timeout (0.5 s) and then
+  // publishes its state again; a stray publisher flooding the topic meanwhile stays refused.
+  Script s;
+  const Stamp next = s.freshRun(kTick, 10);
+  for (int i = 0; i < 30; ++i)  // 0.6 s of the stray alone
+    EXPECT_FALSE(s.message(next + static_cast<Stamp>(i) * kTick, true, false, "/stray")) << i;
+  EXPECT_TRUE(s.message(next - kTick, true, false, "/driver")) << "the sim's repeat";
+  EXPECT_EQ(std::string::npos, s.text().find("now come from")) << s.text();
 }
 
 TEST(FreshnessGuard, AStampJumpForwardThenBackStops)
@@ -251,6 +263,12 @@ TEST(FreshnessGuard, ABoundOfZeroIsOff)
   for (int i = 0; i < 100; ++i)
     s.message(next - kTick);
   s.wait(milliseconds(5000));
+  // No publisher is refused either: a stray one beside a lockstep sim is the protocol's (stamps).
+  for (int i = 0; i < 10; ++i)
+  {
+    EXPECT_TRUE(s.message(next + static_cast<Stamp>(i) * kTick, true, false, "/driver"));
+    EXPECT_TRUE(s.message(next + static_cast<Stamp>(i) * kTick, true, false, "/stray"));
+  }
   EXPECT_FALSE(s.guard_.enabled());
   EXPECT_TRUE(s.pushes());
   EXPECT_EQ(0, s.stops_);

@@ -791,6 +791,34 @@ TEST_F(ControllerProtocolTest, AResetsStateBeforeItsSuccessfulAnswerStartsTheEpi
   }
 }
 
+TEST_F(ControllerProtocolTest, AFallAfterTheResetWasServedThatTheSimWaitsOnAsksForAnotherReset)
+{
+  // bad_messages.test's flood: the reset was served, then a hand on cart_effort stepped the sim
+  // on until its pole fell, before the controller saw the reset's start. The lockstep sim repeats
+  // that fallen state, unanswered; the controller asks for a reset again at its second repeat.
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(1), kUpright);
+  ASSERT_TRUE(controller.onState(tick(2), kFallen).request_reset);
+  for (int i = 0; i < 5; ++i)  // the sim's repeats while the reset call is under way: nothing
+    EXPECT_FALSE(controller.onState(tick(2), kFallen).request_reset) << "before its answer " << i;
+  controller.onResetOutcome(true);
+  const Reaction moved_on = controller.onState(tick(9), kFallen);
+  EXPECT_EQ(Reaction::Kind::New, moved_on.kind);
+  EXPECT_FALSE(moved_on.request_reset) << "a fall may still be in flight";
+  EXPECT_FALSE(moved_on.answer);
+  const Reaction first = controller.onState(tick(9), kFallen);
+  EXPECT_FALSE(first.request_reset) << "the first repeat may have been sent before the reset";
+  const Reaction second = controller.onState(tick(9), kFallen);
+  EXPECT_EQ(Reaction::Kind::Repeat, second.kind);
+  EXPECT_TRUE(second.request_reset);
+  EXPECT_FALSE(second.answer);
+  EXPECT_EQ(ControllerProtocol::Phase::AwaitingReset, controller.phase());
+  EXPECT_FALSE(controller.onState(tick(9), kFallen).request_reset) << "once per reset served";
+  controller.onResetOutcome(true);
+  EXPECT_TRUE(controller.onState(tick(10), kSmall).episode_began);
+  EXPECT_EQ(1u, session_.episodesEnded());
+}
+
 TEST_F(ControllerProtocolTest, WorkingResetsAndOutcomesWithoutAResetServiceChangeNothing)
 {
   ControllerProtocol controller(session_, params_);
@@ -1104,6 +1132,68 @@ public:
     start();
   }
 
+  // A stray publisher's flood taken for the sim's states (bad_messages.test's flood, which a
+  // controller once took while the sim waited to repeat): for `messages` messages the sim's own
+  // states are lost and the stray's delivered in their place, the kinds in turn: stamps older
+  // than any (each once), an older stamp twice (a restarted sim's look), the sim's latest stamp
+  // with other readings, a stamp just after it (not a tick) with a cart far outside the track,
+  // and one just after it with plausible readings. The controller's answers reach the sim, which
+  // steps on those that carry its pending stamp; and a hand on cart_effort (unstamped, which the
+  // sim steps on whatever is pending) pushes at 10 N after every sixth. With `fall_by_hand`, the
+  // hand goes on pushing after the last stray state until the pole has fallen. Then the stray
+  // stops.
+  void strayFlood(std::uint64_t messages, bool fall_by_hand)
+  {
+    hide_sim_ = true;
+    const Stamp base = history_.empty() ? kTick : history_.back().stamp;
+    for (std::uint64_t n = 0; n < messages; ++n)
+    {
+      const Stamp latest = history_.empty() ? kTick : history_.back().stamp;
+      const Stamp just_after = latest + 1000 * (n % 15000 + 1);
+      CartPoleState plausible;
+      plausible << 0.01, 0.0, 0.02, -0.01;
+      CartPoleState far = plausible;
+      far[0] = n % 2 == 0 ? 1e300 : -1e300;
+      switch (n % 5)
+      {
+        case 0:
+          onState({base > 20 * kTick + 1000 * n ? base - 20 * kTick - 1000 * n : 1 + n, plausible});
+          break;
+        case 1:
+        {
+          const Stamp older = base > kTick + 1000 * (n % 15000) ? base - kTick - 1000 * (n % 15000) : 1;
+          onState({older, plausible});
+          onState({older, plausible});
+          break;
+        }
+        case 2:
+          onState({latest, plausible});
+          break;
+        case 3:
+          onState({just_after, far});
+          break;
+        default:
+          onState({just_after, plausible});
+          break;
+      }
+      while (!to_sim_.empty())
+        deliverOne();
+      if (n % 6 == 5)
+        pushByHand();
+    }
+    for (int i = 0; fall_by_hand && i < 1000 && !session_.task().isTerminal(simulation_.state()); ++i)
+      pushByHand();
+    to_controller_.clear();
+    hide_sim_ = false;
+  }
+
+  void pushByHand()
+  {
+    sim_.onUnstampedCommand(now_);
+    simulation_.step(10.0);
+    publish(sim_.pending());
+  }
+
   // One message delivered (states first); false when nothing is in flight.
   bool deliverOne()
   {
@@ -1194,7 +1284,7 @@ private:
   {
     const StateMessage message{stamp, simulation_.state()};
     ++states_published_;
-    if (!strikes(faults_.drop_state, states_published_))
+    if (!hide_sim_ && !strikes(faults_.drop_state, states_published_))
       to_controller_.push_back(message);
     if (strikes(faults_.stray_state, states_published_))
       to_controller_.push_back({0, CartPoleState::Constant(0.01)});
@@ -1217,9 +1307,11 @@ private:
       finished_ = true;
     if (reaction.request_reset)
     {
-      // The reset service: served at once, while commands may still be in flight.
+      // The reset service: served at once, while commands may still be in flight; its answer
+      // reaches the controller right after the state it publishes.
       simulation_.resetRandom();
       publish(sim_.onReset(now_));
+      controller_.onResetOutcome(true);
     }
     if (reaction.answer)
       send({reaction.stamp, reaction.effort});
@@ -1294,6 +1386,7 @@ private:
   std::uint64_t steps_on_another_states_answer_ = 0;
   std::vector<Reaction> reactions_;
   bool finished_ = false;
+  bool hide_sim_ = false;  // strayFlood: the sim's states are lost
 };
 
 Faults everyFault()
@@ -1322,6 +1415,28 @@ TEST(LockstepProtocol, ScriptedLinkWithoutFaultsTrainsAsTheLoopback)
   EXPECT_TRUE(link.finished());
   EXPECT_TRUE(bitIdentical(loopback.session().table().values(), link.session().table().values()));
   EXPECT_EQ(0u, link.sim().counts().repeats);
+}
+
+TEST(LockstepProtocol, AStrayFloodTakenForTheSimLeavesTrainingGoingOnceItStops)
+{
+  // Whatever the stray's states did to the episode under way (restarts, falls, resets), the
+  // sim's own states, repeated while unanswered, bring training back; and when the last stray
+  // state was a fall whose reset was served and the hand then felled the pole unseen (the sim
+  // waits on a fall that is not the reset's start), a second reset does.
+  for (const bool fall_by_hand : {false, true})
+    for (const std::uint64_t at : {3u, 10u, 25u})
+      for (const std::uint64_t length : {1u, 4u, 5u, 37u, 499u, 3001u, 3004u})
+      {
+        SCOPED_TRACE("after " + std::to_string(at) + " episodes, " + std::to_string(length) + " stray states" +
+                     (fall_by_hand ? ", then a fall by hand" : ""));
+        ScriptedLink link(shortConfig(60), 1, Faults());
+        link.start();
+        link.run(at);
+        link.strayFlood(length, fall_by_hand);
+        const std::uint64_t before = link.session().episodesEnded();
+        EXPECT_NO_THROW(link.run(5));
+        EXPECT_TRUE(link.finished() || link.session().episodesEnded() >= before + 5);
+      }
 }
 
 TEST(LockstepProtocol, LostDuplicatedReplayedAndStrayMessagesLeaveTheTableBitForBitAsWithout)
