@@ -179,6 +179,7 @@ void ControllerProtocol::onResetOutcome(bool succeeded)
     phase_ = Phase::AwaitingReset;  // the next state that is not fallen is the reset's start
   reset_served_ = succeeded && phase_ == Phase::AwaitingReset;
   fallen_repeats_ = 0;
+  fallen_states_ = 0;
 }
 
 bool ControllerProtocol::takesAsNew(Stamp stamp) const
@@ -269,6 +270,7 @@ void ControllerProtocol::requestReset(Reaction& reaction)
   phase_ = Phase::AwaitingReset;
   reset_served_ = false;
   fallen_repeats_ = 0;
+  fallen_states_ = 0;
 }
 
 Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& state)
@@ -303,6 +305,12 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
       // is served lie outside such a region but for the rare one falling slowly near its edge.
       if (params_.reset_starts_in_region ? !terminal && inStartRegion(state) : !terminal || inStartRegion(state))
         begin(reaction, state);
+      // A realtime robot felled after its reset was served (the start never seen) sends new
+      // fallen states, not repeats: after a second's worth at 50 Hz (far more than can still be
+      // in flight from before the reset), ask again.
+      else if (reset_served_ && terminal && !inStartRegion(state) &&
+               ++fallen_states_ >= kFallenStatesBeforeAskingAgain)
+        requestReset(reaction);
       else if (params_.reset_starts_in_region)
         answer(reaction, 0.0);
       break;

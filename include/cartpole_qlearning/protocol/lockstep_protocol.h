@@ -60,7 +60,8 @@
 //   - A first state that is terminal (joining a sim that waits on a fallen pole) asks for a
 //     reset without learning. So does a fallen state repeated twice after the reset asked for
 //     came back done: the sim waits on a fall that is not the reset's start (something moved it
-//     after the reset), and nothing else would answer it.
+//     after the reset), and nothing else would answer it; and, from a realtime robot felled so,
+//     50 new fallen states in a row.
 //   - Training ends after the episode that reaches the limits (solved or max_episodes); every
 //     state after it is ignored.
 #pragma once
@@ -288,6 +289,8 @@ private:
   bool reset_failing_ = false;  // the last reset failed, none has succeeded since
   bool reset_served_ = false;   // AwaitingReset: the reset asked for came back done
   int fallen_repeats_ = 0;      // repeats of a fallen state since then
+  int fallen_states_ = 0;       // new fallen states since then
+  static constexpr int kFallenStatesBeforeAskingAgain = 50;
   Counts counts_;
 };
 

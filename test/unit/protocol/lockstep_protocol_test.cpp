@@ -819,6 +819,31 @@ TEST_F(ControllerProtocolTest, AFallAfterTheResetWasServedThatTheSimWaitsOnAsksF
   EXPECT_EQ(1u, session_.episodesEnded());
 }
 
+TEST_F(ControllerProtocolTest, ARealtimeRobotFelledAfterItsResetWasServedIsResetAgainAfterFiftyFallenStates)
+{
+  // Realtime: the felled robot sends new states, each fallen. Before the reset's answer none of
+  // them asks again (the sim falls on until it is reset); after it, the 50th does.
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(1), kUpright);
+  ASSERT_TRUE(controller.onState(tick(2), kFallen).request_reset);
+  std::uint64_t n = 3;
+  for (int i = 0; i < 100; ++i, ++n)
+    EXPECT_FALSE(controller.onState(tick(n), kFallen).request_reset) << "before the reset's answer " << i;
+  controller.onResetOutcome(true);
+  for (int i = 1; i < 50; ++i, ++n)
+  {
+    const Reaction r = controller.onState(tick(n), kFallen);
+    EXPECT_FALSE(r.request_reset) << i;
+    EXPECT_FALSE(r.answer) << i;
+  }
+  EXPECT_TRUE(controller.onState(tick(n++), kFallen).request_reset);
+  for (int i = 0; i < 100; ++i, ++n)
+    EXPECT_FALSE(controller.onState(tick(n), kFallen).request_reset) << "once per reset served " << i;
+  controller.onResetOutcome(true);
+  EXPECT_TRUE(controller.onState(tick(n++), kSmall).episode_began);
+  EXPECT_EQ(1u, session_.episodesEnded());
+}
+
 TEST_F(ControllerProtocolTest, WorkingResetsAndOutcomesWithoutAResetServiceChangeNothing)
 {
   ControllerProtocol controller(session_, params_);
