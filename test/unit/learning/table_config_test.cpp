@@ -75,7 +75,9 @@ TEST(TrainingConfigText, TheSameConfigurationIsTheSameTextHoweverItWasWritten)
   const std::string robust = trainingConfigText(shipped("robust.yaml"));
   EXPECT_NE(trainingConfigText(readText("")), robust);
   EXPECT_NE(std::string::npos, robust.find("max_episode_steps: 200")) << robust;
-  EXPECT_NE(std::string::npos, robust.find("bins: [3, 3, 8, 12]")) << robust;
+  EXPECT_NE(std::string::npos, robust.find("features: tiles")) << robust;
+  EXPECT_NE(std::string::npos, robust.find("tilings: 8")) << robust;
+  EXPECT_NE(std::string::npos, robust.find("tiles: [3, 3, 8, 12]")) << robust;
 }
 
 TEST(TrainingConfigText, SaysWhetherASourceHoldsAConfiguration)
@@ -130,15 +132,32 @@ TEST(TableConfig, ATableThatDoesNotCarryItsConfigurationRunsWithItsFeaturesOverT
 
 TEST(TableConfig, AContradictionNamesTheConfigsValueAndTheTablesWithBothSources)
 {
-  const TrainingConfig trained = shipped("robust.yaml");
-  const QTable table = stampedTable(trained);
-  const TrainingConfig other = shipped("cartpole.yaml");
-  const std::string said = tableContradiction(other, "cartpole.yaml", table, "/t/robust_table.yaml");
+  // robust.yaml's table (tiles) under the default config (bins): the features differ, and with
+  // them everything that shapes them does not compare.
+  const QTable robust_table = stampedTable(shipped("robust.yaml"));
+  const TrainingConfig defaults = shipped("cartpole.yaml");
+  EXPECT_EQ("learning/features is bins in cartpole.yaml but tiles in the table /t/robust_table.yaml",
+            tableContradiction(defaults, "cartpole.yaml", robust_table, "/t/robust_table.yaml"));
+  TrainingConfig tiles4 = shipped("tiles.yaml");
+  const std::string tilings_said = tableContradiction(tiles4, "tiles.yaml", robust_table, "/t/robust_table.yaml");
   // Every key that differs, the config's value first (the refusal named neither).
+  EXPECT_EQ(0u, tilings_said.find("learning/tilings is 4 in tiles.yaml but 8 in the table /t/robust_table.yaml; "
+                                  "learning/tiles is [1, 1, 8, 12] in tiles.yaml but [3, 3, 8, 12] in the table "
+                                  "/t/robust_table.yaml; "))
+      << tilings_said;
+  for (const std::string key : {"learning/lower_bounds", "learning/upper_bounds"})
+    EXPECT_NE(std::string::npos, tilings_said.find(key + " is ")) << key << ": " << tilings_said;
+
+  // A binned table (robust.yaml's keys before tiles) under the default config: each key named.
+  const TrainingConfig trained = readText(
+      "{learning: {bins: [3, 3, 8, 12], lower_bounds: [-1, -1, -0.2094, -0.8727], upper_bounds: [1, 1, 0.2094, "
+      "0.8727]}}");
+  const QTable table = stampedTable(trained);
+  const std::string said = tableContradiction(defaults, "cartpole.yaml", table, "/t/binned.yaml");
   for (const std::string key : {"learning/bins", "learning/lower_bounds", "learning/upper_bounds"})
     EXPECT_NE(std::string::npos, said.find(key + " is ")) << key << ": " << said;
   EXPECT_EQ(0u, said.find("learning/bins is [1, 1, 6, 12] in cartpole.yaml but [3, 3, 8, 12] in the table "
-                          "/t/robust_table.yaml; "))
+                          "/t/binned.yaml; "))
       << said;
 
   // One at a time, each named with both values.
