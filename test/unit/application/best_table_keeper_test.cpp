@@ -68,7 +68,7 @@ protected:
 TEST_F(BestTableKeeperTest, TheSuiteIsFoundOrStopsOnlyARunThatNeedsIt)
 {
   BestTableKeeper keeper(config_, true, {});
-  EXPECT_NE(std::string::npos, all(keeper.loadSuite()).find("runs on the table every 1 episodes; the best table"));
+  EXPECT_NE(std::string::npos, all(keeper.loadSuite()).find("runs on the table after every episode; the best table"));
   EXPECT_TRUE(keeper.hasSuite());
 
   BestTableKeeper evaluating(config_, false, {});
