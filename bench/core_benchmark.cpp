@@ -284,9 +284,9 @@ BENCHMARK(BM_SuiteVerdictUntilDecided)
     ->UseRealTime();
 
 // The whole verdict of a passing table: bench/robust_table.yaml, trained by `train_headless --config
-// config/robust.yaml --seed 2` with robust.yaml as it was on 2026-12-02 (bins [3, 3, 8, 12], kept so
-// that the figures of docs/benchmarks.md compare), which passes the shipped suite: every case balances (nearly) every
-// episode to the step limit, the most steps a verdict takes. Its own configuration, as
+// config/robust.yaml --seed 2` with robust.yaml as it was on 2026-12-02 (bins [3, 3, 8, 12], kept
+// so that the figures of docs/benchmarks.md compare), which passes the shipped suite: every case
+// balances (nearly) every episode to the step limit, the most steps a verdict takes. Its own configuration, as
 // `train_headless --evaluate TABLE --suite FILE` runs it. Ranges as above.
 void BM_SuiteVerdictPassing(benchmark::State& state)
 {

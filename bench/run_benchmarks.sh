@@ -22,8 +22,9 @@
 #        fails the suite): whole, every case to its last episode, on one thread and one per core
 #        (what a finished run prints), and until decided (stopped at its first failing case, as
 #        training judges a table); and the whole verdict of a passing table (bench/robust_table.yaml,
-#        robust.yaml's seed 2, bins as of 2026-12-02); each on the 500-step suite and the shipped 3000-step one: wall ms
-#        and greedy steps/s beside (g)'s training steps/s (not pinned: one thread per core)
+#        robust.yaml's seed 2, bins as of 2026-12-02); each on the 500-step suite and the shipped
+#        3000-step one: wall ms and greedy steps/s beside (g)'s training steps/s (not pinned: one
+#        thread per core)
 #   (g3) train_headless --seed 0 as a process, from exec to exit (verdict and run folder included)
 #   (h)  the Python anchor ../shared/anchors/gym_tabular_q.py (Gymnasium + numpy, the tutorial's
 #        method in one process), to solved: median wall time over BENCH_ANCHOR_SEEDS, which

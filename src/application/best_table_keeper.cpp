@@ -77,14 +77,14 @@ LogLines BestTableKeeper::loadSuite()
   }
   if (needed)
   {
-    const std::string when = config_.limits.suite_every == 1 ?
-                                 std::string("after every episode") :
-                                 formatText("every %llu episodes", count(config_.limits.suite_every));
-    log.push_back({LogLine::Level::Info,
-                   formatText("the robustness suite %s runs on the table %s%s; the best table is kept",
-                              suite_path_.c_str(), when.c_str(),
-                              config_.limits.until == TrainUntil::SuitePasses ? ", and training ends when it passes" :
-                                                                                "")});
+    const std::string when = config_.limits.suite_every == 1
+                                 ? std::string("after every episode")
+                                 : formatText("every %llu episodes", count(config_.limits.suite_every));
+    log.push_back(
+        {LogLine::Level::Info,
+         formatText("the robustness suite %s runs on the table %s%s; the best table is kept", suite_path_.c_str(),
+                    when.c_str(),
+                    config_.limits.until == TrainUntil::SuitePasses ? ", and training ends when it passes" : "")});
   }
   return log;
 }

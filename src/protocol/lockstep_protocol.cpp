@@ -226,8 +226,8 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
     // it after the reset (a hand on cart_effort, a stray command) and the reset's start was never
     // seen. Nothing would answer it; ask again. The second repeat, not the first: a repeat of the
     // fall sent before the reset may still be in flight.
-    if (phase_ == Phase::AwaitingReset && reset_served_ && session_.task().isTerminal(state) &&
-        !inStartRegion(state) && ++fallen_repeats_ >= 2)
+    if (phase_ == Phase::AwaitingReset && reset_served_ && session_.task().isTerminal(state) && !inStartRegion(state) &&
+        ++fallen_repeats_ >= 2)
     {
       requestReset(reaction);
       return reaction;
@@ -308,8 +308,7 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
       // A realtime robot felled after its reset was served (the start never seen) sends new
       // fallen states, not repeats: after a second's worth at 50 Hz (far more than can still be
       // in flight from before the reset), ask again.
-      else if (reset_served_ && terminal && !inStartRegion(state) &&
-               ++fallen_states_ >= kFallenStatesBeforeAskingAgain)
+      else if (reset_served_ && terminal && !inStartRegion(state) && ++fallen_states_ >= kFallenStatesBeforeAskingAgain)
         requestReset(reaction);
       else if (params_.reset_starts_in_region)
         answer(reaction, 0.0);

@@ -138,7 +138,7 @@ TEST(TableConfig, AContradictionNamesTheConfigsValueAndTheTablesWithBothSources)
   const TrainingConfig defaults = shipped("cartpole.yaml");
   EXPECT_EQ("learning/features is bins in cartpole.yaml but tiles in the table /t/robust_table.yaml",
             tableContradiction(defaults, "cartpole.yaml", robust_table, "/t/robust_table.yaml"));
-  TrainingConfig tiles4 = shipped("tiles.yaml");
+  const TrainingConfig tiles4 = shipped("tiles.yaml");
   const std::string tilings_said = tableContradiction(tiles4, "tiles.yaml", robust_table, "/t/robust_table.yaml");
   // Every key that differs, the config's value first (the refusal named neither).
   EXPECT_EQ(0u, tilings_said.find("learning/tilings is 4 in tiles.yaml but 8 in the table /t/robust_table.yaml; "

@@ -1184,8 +1184,7 @@ public:
         case 0:
           onState({base > 20 * kTick + 1000 * n ? base - 20 * kTick - 1000 * n : 1 + n, plausible});
           break;
-        case 1:
-        {
+        case 1: {
           const Stamp older = base > kTick + 1000 * (n % 15000) ? base - kTick - 1000 * (n % 15000) : 1;
           onState({older, plausible});
           onState({older, plausible});
