@@ -138,9 +138,16 @@ SuiteResult BestTableKeeper::settle(TrainingSession& session, std::optional<Suit
     session.replaceTable(best_->table);
     last = best_->result;
   }
+  // Not evaluated during training: the table's verdict, whole when the suite is the run's goal;
+  // for information (trained until solved), each case stops once its verdict is known: a table
+  // trained to solved fails most cases within their first episodes, where running all of them took
+  // most of the process's time (issue 29). The rows say where a case stopped, and
+  // `train_headless --evaluate TABLE --suite FILE` runs every episode.
+  const bool for_information = config_.limits.until != TrainUntil::SuitePasses;
   if (!last)
-    last = evaluateSuite(session.table(), config_, *suite_);
-  if (config_.limits.until == TrainUntil::SuitePasses)
+    last = evaluateSuite(session.table(), config_, *suite_,
+                         for_information ? SuiteRun::eachCaseUntilDecided() : SuiteRun::complete());
+  if (!for_information)
     log.push_back({LogLine::Level::Info,
                    formatText("robustness of the saved table (%s, greedy, %llu episodes per case):\n",
                               suite_path_.c_str(), count(suite_->episodes)) +
@@ -150,9 +157,13 @@ SuiteResult BestTableKeeper::settle(TrainingSession& session, std::optional<Suit
   {
     // Not this run's goal: what the table would be worth on a robot, with where to go for that,
     // rather than a FAILED beside the SOLVED that follows.
-    const std::string verdict = last->passed() ? "every case passes: robust by this suite as well"
-                                               : formatText("%zu of %zu cases pass: not yet a table for a real robot",
-                                                            last->casesPassed(), last->cases_in_suite);
+    const std::string verdict =
+        (last->passed() ? std::string("every case passes: robust by this suite as well")
+                        : formatText("%zu of %zu cases pass: not yet a table for a real robot", last->casesPassed(),
+                                     last->cases_in_suite)) +
+        (last->complete() ? ""
+                          : " (each case stopped once decided; train_headless --evaluate TABLE --suite FILE runs "
+                            "every episode)");
     log.push_back(
         {LogLine::Level::Info,
          formatText("robustness of the saved table, for information (%s, greedy, %llu episodes per case):\n",

@@ -392,9 +392,13 @@ std::string SuiteResult::rows() const
   for (const CaseResult& c : cases)
   {
     const std::string balanced = std::to_string(c.balanced) + "/" + std::to_string(c.run);
+    // A case cut short says after how many of its episodes its verdict was known.
+    const std::string verdict =
+        std::string(c.passed() ? "pass" : "FAIL") +
+        (c.cutShort() ? " (decided after " + std::to_string(c.run) + " of " + std::to_string(c.episodes) + ")" : "");
     std::snprintf(line, sizeof line, "%-*s  %8s  %6llu  %11.1f  %s\n", static_cast<int>(width), c.name.c_str(),
                   balanced.c_str(), static_cast<unsigned long long>(c.pass), shownReturn(c.mean_return, 1),
-                  c.passed() ? "pass" : "FAIL");
+                  verdict.c_str());
     out << line;
   }
   if (!reward_note.empty())

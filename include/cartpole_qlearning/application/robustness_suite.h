@@ -100,6 +100,16 @@ struct SuiteRun
   {
     return SuiteRun();
   }
+  // Every case, each until its own verdict is known (its pass-th balanced episode or its
+  // (episodes - pass + 1)-th fall): the verdict of every case, for a fraction of the episodes when
+  // the table is far from passing (the for-information verdict at the end of a run trained until
+  // solved).
+  static SuiteRun eachCaseUntilDecided()
+  {
+    SuiteRun run;
+    run.stop_cases_when_decided = true;
+    return run;
+  }
   // During training: only whether the table passes, as soon as that is known.
   static SuiteRun untilDecided(std::vector<std::size_t> order)
   {
