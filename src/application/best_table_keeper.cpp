@@ -107,11 +107,24 @@ std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSessio
     failedCaseFirst(order_, quick, *suite_);
     if (!quick.reachedTargets())
     {
-      log.push_back({LogLine::Level::Info,
-                     formatText("robustness at episode %llu (%llu steps): %s; no better than the best so far "
-                                "(episode %llu, worst case %llu balanced)",
-                                count(s.episode), count(s.total_steps), quick.summary().c_str(), count(best_->episode),
-                                count(best_->result.worstBalanced()))});
+      // Judged after every episode, a run has thousands of these: one line at the progress
+      // cadence (and at the end) says how many there were, and every table that could beat the
+      // best has a line of its own below.
+      ++not_better_unsaid_;
+      const std::uint64_t every = config_.limits.progress_every;
+      if (training_ends || (every > 0 && s.episode % every == 0))
+      {
+        const std::string others =
+            not_better_unsaid_ > 1
+                ? formatText("; %llu tables judged since the last such line, none better", count(not_better_unsaid_))
+                : std::string();
+        log.push_back({LogLine::Level::Info,
+                       formatText("robustness at episode %llu (%llu steps): %s; no better than the best so far "
+                                  "(episode %llu, worst case %llu balanced)%s",
+                                  count(s.episode), count(s.total_steps), quick.summary().c_str(),
+                                  count(best_->episode), count(best_->result.worstBalanced()), others.c_str())});
+        not_better_unsaid_ = 0;
+      }
       return quick;
     }
   }

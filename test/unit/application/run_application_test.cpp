@@ -9,6 +9,7 @@
 #include "cartpole_qlearning/application/run_application.h"
 
 #include "test_support.h"
+#include "text_match.h"
 
 #include <gtest/gtest.h>
 
@@ -963,6 +964,7 @@ TEST_F(RunApplicationTest, UntilTheSuitePassesItIsEvaluatedAtItsCadenceAndEndsTr
       "episodes: 20\ncases: [{name: nominal, pass: 20}, {name: pushes, pass: 19, "
       "perturbations: {push_probability: 0.2, push_force: 2.0}}]");
   config.limits.suite_every = 10;
+  config.limits.progress_every = 10;  // every verdict said (a table no better than the best, too)
   config.limits.until = TrainUntil::SuitePasses;
   LogLines started;
   const std::vector<EpisodeEnd> ends = train(config, &started);
@@ -998,6 +1000,7 @@ TEST_F(RunApplicationTest, AtMaxEpisodesTheBestTableSeenIsSavedAndTheDefaultTabl
       "episodes: 20\ncases: [{name: pushed_hard, pass: 20, perturbations: "
       "{delay_steps: 1, push_probability: 0.3, push_force: 8.0}}]");
   config.limits.suite_every = 25;
+  config.limits.progress_every = 25;  // every verdict said
   config.limits.until = TrainUntil::SuitePasses;
   config.limits.max_episodes = 400;
   const std::vector<EpisodeEnd> ends = train(config);
@@ -1025,6 +1028,47 @@ TEST_F(RunApplicationTest, AtMaxEpisodesTheBestTableSeenIsSavedAndTheDefaultTabl
   EXPECT_EQ(1u, lines(ends, "suite NOT passed, max_episodes reached").size());
   EXPECT_FALSE(fs::exists(dir_ / "q_table.yaml"));
   EXPECT_EQ("max_episodes", parseRunRecord(text(dir_ / folderName() / "run.yaml")).finished);
+}
+
+TEST_F(RunApplicationTest, JudgedEveryEpisodeTheTablesNoBetterThanTheBestAreSaidAtTheProgressCadence)
+{
+  // robust.yaml judges after every episode: thousands of verdicts a run. A table that can beat
+  // the best has a line of its own; those that cannot are said once every progress_every
+  // episodes and at the end, with how many there were, so every verdict is accounted for.
+  TrainingConfig config;
+  config.limits.suite = writeSuite(
+      "episodes: 20\ncases: [{name: pushed_hard, pass: 20, perturbations: "
+      "{delay_steps: 1, push_probability: 0.3, push_force: 8.0}}]");
+  config.limits.suite_every = 1;
+  config.limits.progress_every = 50;
+  config.limits.until = TrainUntil::SuitePasses;
+  config.limits.max_episodes = 210;
+  const std::vector<EpisodeEnd> ends = train(config);
+  ASSERT_EQ(210u, ends.size());
+  std::uint64_t verdicts = 0;
+  std::size_t cut_short_lines = 0;
+  for (std::size_t i = 0; i < ends.size(); ++i)
+  {
+    const std::uint64_t episode = i + 1;
+    for (const std::string& line : lines({ends[i]}, "robustness at episode"))
+    {
+      EXPECT_EQ(0u, line.rfind("robustness at episode " + std::to_string(episode) + " (", 0)) << line;
+      if (line.find("; no better than the best so far") == std::string::npos)
+      {
+        ++verdicts;  // a whole verdict: a table that could beat the best
+        continue;
+      }
+      ++cut_short_lines;
+      EXPECT_TRUE(episode % 50 == 0 || episode == 210) << line;
+      test::text_match::Groups since;
+      verdicts +=
+          test::text_match::contains(line, "; ([0-9]+) tables judged since the last such line, none better$", &since)
+              ? std::stoull(since[1])
+              : 1;
+    }
+  }
+  EXPECT_EQ(210u, verdicts);       // one a episode, each said or counted
+  EXPECT_EQ(5u, cut_short_lines);  // at 50, 100, 150, 200 and the end
 }
 
 TEST_F(RunApplicationTest, ASuiteThatCannotBeReadStopsARunThatNeedsItAndIsOnlySaidOtherwise)
@@ -1055,6 +1099,7 @@ TEST_F(RunApplicationTest, TheBestTableSeenSurvivesAResumeAndIsStillTheOneToBeat
       "episodes: 20\ncases: [{name: pushed_hard, pass: 20, perturbations: "
       "{delay_steps: 1, push_probability: 0.3, push_force: 8.0}}]");
   config.limits.suite_every = 25;
+  config.limits.progress_every = 25;  // every verdict said
   config.limits.until = TrainUntil::SuitePasses;
   config.limits.max_episodes = 400;
   settings_.checkpoint_every = 25;
