@@ -25,7 +25,9 @@
 #        robust.yaml's seed 2, bins as of 2026-12-02); each on the 500-step suite and the shipped
 #        3000-step one: wall ms and greedy steps/s beside (g)'s training steps/s (not pinned: one
 #        thread per core)
-#   (g3) train_headless --seed 0 as a process, from exec to exit (verdict and run folder included)
+#   (g3) train_headless --seed 0 as a process, from exec to exit (verdict and run folder included;
+#        since 2026-12-03 that verdict, information on a run trained to solved, runs each case only
+#        until it is decided)
 #   (h)  the Python anchor ../shared/anchors/gym_tabular_q.py (Gymnasium + numpy, the tutorial's
 #        method in one process), to solved: median wall time over BENCH_ANCHOR_SEEDS, which
 #        (e)'s roslaunch-to-SOLVED time and (i)'s roslaunch-to-SUITE-PASSED time are compared
@@ -407,8 +409,9 @@ for verdict in "BM_SuiteVerdictWhole/1/500 (g)'s table, whole, 500-step suite, o
 done
 
 # --- (g3) train_headless --seed 0, the whole process ------------------------------------------------
-# From exec to exit, the saved table's verdict (the shipped suite) and the run folder (under the
-# run's ROS_HOME) included; not pinned, as a user runs it (the verdict takes one thread per core).
+# From exec to exit, the saved table's verdict (the shipped suite, each case until decided) and the
+# run folder (under the run's ROS_HOME) included; not pinned, as a user runs it (the verdict takes
+# one thread per core).
 # Issue 29's target: <= 25 ms.
 echo "(g3) train_headless --seed 0, the whole process, 5 runs" >&2
 PROCESS_MS=()
