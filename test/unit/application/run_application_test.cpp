@@ -180,6 +180,22 @@ protected:
     return path.string();
   }
 
+  // Training until a suite no table passes here (a command a step late and hard pushes): it goes
+  // to max_episodes, keeping the table with the most balanced episodes in its worst case, the
+  // first of equals. Every verdict is said unless progress_every says otherwise.
+  TrainingConfig untilAnUnpassableSuite(std::uint64_t suite_every, std::uint64_t max_episodes)
+  {
+    TrainingConfig config;
+    config.limits.suite = writeSuite(
+        "episodes: 20\ncases: [{name: pushed_hard, pass: 20, perturbations: "
+        "{delay_steps: 1, push_probability: 0.3, push_force: 8.0}}]");
+    config.limits.suite_every = suite_every;
+    config.limits.progress_every = suite_every;
+    config.limits.until = TrainUntil::SuitePasses;
+    config.limits.max_episodes = max_episodes;
+    return config;
+  }
+
   fs::path dir_;
   RunSettings settings_;
   TrainingConfig config_;
@@ -993,16 +1009,7 @@ TEST_F(RunApplicationTest, UntilTheSuitePassesItIsEvaluatedAtItsCadenceAndEndsTr
 
 TEST_F(RunApplicationTest, AtMaxEpisodesTheBestTableSeenIsSavedAndTheDefaultTableLeftAlone)
 {
-  // A suite no table passes here: training goes to max_episodes and keeps the table with the
-  // most balanced episodes in its worst case, the first of equals.
-  TrainingConfig config;
-  config.limits.suite = writeSuite(
-      "episodes: 20\ncases: [{name: pushed_hard, pass: 20, perturbations: "
-      "{delay_steps: 1, push_probability: 0.3, push_force: 8.0}}]");
-  config.limits.suite_every = 25;
-  config.limits.progress_every = 25;  // every verdict said
-  config.limits.until = TrainUntil::SuitePasses;
-  config.limits.max_episodes = 400;
+  const TrainingConfig config = untilAnUnpassableSuite(25, 400);
   const std::vector<EpisodeEnd> ends = train(config);
   ASSERT_EQ(400u, ends.size()) << lines(ends, "robustness").back();
   const std::vector<std::string> judged = lines(ends, "robustness at episode");
@@ -1035,14 +1042,8 @@ TEST_F(RunApplicationTest, JudgedEveryEpisodeTheTablesNoBetterThanTheBestAreSaid
   // robust.yaml judges after every episode: thousands of verdicts a run. A table that can beat
   // the best has a line of its own; those that cannot are said once every progress_every
   // episodes and at the end, with how many there were, so every verdict is accounted for.
-  TrainingConfig config;
-  config.limits.suite = writeSuite(
-      "episodes: 20\ncases: [{name: pushed_hard, pass: 20, perturbations: "
-      "{delay_steps: 1, push_probability: 0.3, push_force: 8.0}}]");
-  config.limits.suite_every = 1;
+  TrainingConfig config = untilAnUnpassableSuite(1, 210);
   config.limits.progress_every = 50;
-  config.limits.until = TrainUntil::SuitePasses;
-  config.limits.max_episodes = 210;
   const std::vector<EpisodeEnd> ends = train(config);
   ASSERT_EQ(210u, ends.size());
   std::uint64_t verdicts = 0;
@@ -1093,15 +1094,8 @@ TEST_F(RunApplicationTest, ASuiteThatCannotBeReadStopsARunThatNeedsItAndIsOnlySa
 
 TEST_F(RunApplicationTest, TheBestTableSeenSurvivesAResumeAndIsStillTheOneToBeat)
 {
-  // A suite no table passes here (as above): the best is what the run saves at max_episodes.
-  TrainingConfig config;
-  config.limits.suite = writeSuite(
-      "episodes: 20\ncases: [{name: pushed_hard, pass: 20, perturbations: "
-      "{delay_steps: 1, push_probability: 0.3, push_force: 8.0}}]");
-  config.limits.suite_every = 25;
-  config.limits.progress_every = 25;  // every verdict said
-  config.limits.until = TrainUntil::SuitePasses;
-  config.limits.max_episodes = 400;
+  // The best is what the run saves at max_episodes.
+  const TrainingConfig config = untilAnUnpassableSuite(25, 400);
   settings_.checkpoint_every = 25;
   const RobustnessSuite suite = loadRobustnessSuite(config.limits.suite, config);
   // The worst case's balanced episodes that a "robustness at episode" line gives.
