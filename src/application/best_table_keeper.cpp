@@ -100,30 +100,37 @@ std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSessio
   // table that can is evaluated whole and compared on whole verdicts, as every table was: the
   // table kept is the one whole evaluations of every table would keep. (The suite runs greedily
   // on the table, learning nothing.)
+  // Between the evaluations that look for the best (training/best_every), only whether the table
+  // passes: each case stops at the fall that fails it, far sooner than at the one that says it
+  // cannot beat a best near the pass marks; a table that passes is judged whole below, as before.
   const bool passing_decides = config_.limits.until == TrainUntil::SuitePasses && best_ && best_->result.passed();
+  const std::uint64_t best_every = config_.limits.best_every;
+  const bool ranks = best_every == 0 || s.episode % best_every == 0 || training_ends;
   if (best_ && !passing_decides)
   {
-    SuiteResult quick = evaluateSuite(session.table(), config_, *suite_, againstTheBest(best_->result, order_));
+    SuiteResult quick = evaluateSuite(session.table(), config_, *suite_,
+                                      ranks ? againstTheBest(best_->result, order_) : SuiteRun::untilDecided(order_));
     failedCaseFirst(order_, quick, *suite_);
     if (!quick.reachedTargets())
     {
       // Judged after every episode, a run has thousands of these: one line at the progress
       // cadence (and at the end) says how many there were, and every table that could beat the
       // best has a line of its own below.
-      ++not_better_unsaid_;
+      ++not_kept_unsaid_;
       const std::uint64_t every = config_.limits.progress_every;
       if (training_ends || (every > 0 && s.episode % every == 0))
       {
         const std::string others =
-            not_better_unsaid_ > 1
-                ? formatText("; %llu tables judged since the last such line, none better", count(not_better_unsaid_))
+            not_kept_unsaid_ > 1
+                ? formatText("; %llu tables judged since the last such line, none kept", count(not_kept_unsaid_))
                 : std::string();
         log.push_back({LogLine::Level::Info,
-                       formatText("robustness at episode %llu (%llu steps): %s; no better than the best so far "
-                                  "(episode %llu, worst case %llu balanced)%s",
+                       formatText("robustness at episode %llu (%llu steps): %s; %s (episode %llu, worst case %llu "
+                                  "balanced)%s",
                                   count(s.episode), count(s.total_steps), quick.summary().c_str(),
+                                  ranks ? "no better than the best so far" : "does not pass; the best so far",
                                   count(best_->episode), count(best_->result.worstBalanced()), others.c_str())});
-        not_better_unsaid_ = 0;
+        not_kept_unsaid_ = 0;
       }
       return quick;
     }

@@ -446,6 +446,7 @@ TrainingLimits readLimits(const ParameterSource& source)
   if (limits.suite.empty())
     reader.fail("suite", "''", "a suite file, or none");
   reader.read("suite_every", limits.suite_every, 0);
+  reader.read("best_every", limits.best_every, 0);
   std::string until = limits.until == TrainUntil::Solved ? "solved" : "suite_passes";
   reader.readChoice("until", until, {"solved", "suite_passes"});
   limits.until = until == "solved" ? TrainUntil::Solved : TrainUntil::SuitePasses;
@@ -631,6 +632,7 @@ std::string trainingConfigText(const TrainingConfig& config)
   out << YAML::Key << "progress_every" << YAML::Value << limits.progress_every;
   out << YAML::Key << "suite" << YAML::Value << YAML::DoubleQuoted << limits.suite;
   out << YAML::Key << "suite_every" << YAML::Value << limits.suite_every;
+  out << YAML::Key << "best_every" << YAML::Value << limits.best_every;
   out << YAML::Key << "until" << YAML::Value << (limits.until == TrainUntil::Solved ? "solved" : "suite_passes");
   out << YAML::EndMap;
 

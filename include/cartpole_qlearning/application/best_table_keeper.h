@@ -39,7 +39,8 @@ public:
   // The suite's verdict on the session's table when it is due at the session's last episode (at
   // suite_every's cadence, and when training ends), said; the table is kept when it is the best
   // so far. Nothing when not due. Once there is a best, the verdict of a table that cannot beat it
-  // is cut short (SuiteResult::complete() false) and said only at training/progress_every's
+  // (or, between training/best_every's evaluations, that does not pass) is cut short
+  // (SuiteResult::complete() false) and said only at training/progress_every's
   // cadence (progress_every 0: none) and when training ends, with how many such tables
   // there were since the last such line; against a failing best such a table fails, and
   // its passed() is false as its whole verdict's would be. (Against a passing best, a cut-short
@@ -76,9 +77,9 @@ private:
   std::optional<BestTable> best_;
   // The order the next evaluation runs the cases in: the last to fall short first.
   std::vector<std::size_t> order_;
-  // Tables found no better than the best since the last line that said so (said at the progress
-  // cadence, not one line each).
-  std::uint64_t not_better_unsaid_ = 0;
+  // Tables not kept (no better than the best, or not passing) since the last line that said so
+  // (said at the progress cadence, not one line each).
+  std::uint64_t not_kept_unsaid_ = 0;
 };
 
 }  // namespace cartpole_qlearning

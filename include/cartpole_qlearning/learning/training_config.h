@@ -247,6 +247,10 @@ struct TrainingLimits
   // to the folders RunSettings::suite_folders lists; "none": no suite.
   std::string suite = "robust_suite.yaml";
   std::uint64_t suite_every = 0;  // [episodes] also evaluate it during training, keeping the best table (0: never)
+  // [episodes] the evaluations during training that look for the best table (one that could beat
+  // it is judged whole): every one (0), or those at multiples of this; the others only ask whether
+  // the table passes, which is all until suite_passes needs, for a fraction of the greedy steps.
+  std::uint64_t best_every = 0;
   TrainUntil until = TrainUntil::Solved;
 
   // Training goes on after solved, to max_episodes (stop_when_solved false, until solved).

@@ -16,7 +16,9 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <tuple>
 
 #include <unistd.h>
 
@@ -1063,13 +1065,65 @@ TEST_F(RunApplicationTest, JudgedEveryEpisodeTheTablesNoBetterThanTheBestAreSaid
       EXPECT_TRUE(episode % 50 == 0 || episode == 210) << line;
       test::text_match::Groups since;
       verdicts +=
-          test::text_match::contains(line, "; ([0-9]+) tables judged since the last such line, none better$", &since)
+          test::text_match::contains(line, "; ([0-9]+) tables judged since the last such line, none kept$", &since)
               ? std::stoull(since[1])
               : 1;
     }
   }
   EXPECT_EQ(210u, verdicts);       // one a episode, each said or counted
   EXPECT_EQ(5u, cut_short_lines);  // at 50, 100, 150, 200 and the end
+}
+
+TEST_F(RunApplicationTest, LookingForTheBestLessOftenSavesTheSamePassingTableAndTheBestOfThoseRanked)
+{
+  // A suite no table passes (this run first: its folder is folderName()): the table saved is the best of those ranked,
+  // the first evaluation's (there is no best before it), every 25th and the last; no other has a whole verdict.
+  TrainingConfig unpassable = untilAnUnpassableSuite(1, 120);
+  unpassable.limits.best_every = 25;
+  unpassable.limits.progress_every = 0;
+  const std::vector<EpisodeEnd> ends = train(unpassable);
+  ASSERT_EQ(120u, ends.size());
+  const std::set<std::uint64_t> ranked = {1, 25, 50, 75, 100, 120};
+  std::uint64_t best = 0;
+  std::uint64_t best_at = 0;
+  for (std::size_t i = 0; i < ends.size(); ++i)
+    for (const std::string& line : lines({ends[i]}, "robustness at episode"))
+    {
+      if (line.find("; no better than") != std::string::npos || line.find("; does not pass") != std::string::npos)
+        continue;
+      const std::uint64_t episode = i + 1;
+      EXPECT_EQ(1u, ranked.count(episode)) << line;
+      const std::size_t at = line.find("pushed_hard ") + 12;
+      const std::uint64_t balanced = std::stoull(line.substr(at, line.find('/', at) - at));
+      if (best_at == 0 || balanced > best)
+        std::tie(best, best_at) = std::make_tuple(balanced, episode);
+    }
+  ASSERT_GT(best_at, 0u);
+  EXPECT_EQ(best_at, loadQTableFile((dir_ / folderName() / "q_table.yaml").string()).episodes);
+  EXPECT_NE(std::string::npos, ends.back().robustness.find("pushed_hard " + std::to_string(best) + "/20: FAILED"));
+
+  // Judged after every episode until a suite the default learner passes some way past solved:
+  // looking for the best table only every 7th episode (the others asking only whether the table
+  // passes) ends at the same episode with the same table.
+  TrainingConfig config;
+  config.limits.suite = writeSuite(
+      "episodes: 20\ncases: [{name: nominal, pass: 20}, {name: pushes, pass: 19, "
+      "perturbations: {push_probability: 0.2, push_force: 2.0}}]");
+  config.limits.suite_every = 1;
+  config.limits.progress_every = 1;  // every verdict said
+  config.limits.until = TrainUntil::SuitePasses;
+  const std::vector<EpisodeEnd> every = train(config);
+  ASSERT_NE(std::string::npos, every.back().robustness.find(": PASSED"));
+  const QTable ranked_every = loadQTableFile((dir_ / "q_table.yaml").string());
+  config.limits.best_every = 7;
+  const std::vector<EpisodeEnd> seventh = train(config);
+  EXPECT_EQ(every.size(), seventh.size());
+  EXPECT_EQ(every.back().robustness, seventh.back().robustness);
+  const QTable ranked_seventh = loadQTableFile((dir_ / "q_table.yaml").string());
+  EXPECT_EQ(ranked_every.episodes, ranked_seventh.episodes);
+  EXPECT_EQ(ranked_every.values(), ranked_seventh.values());
+  // Between, a table that does not pass is said as such, not as no better than the best.
+  EXPECT_FALSE(lines(seventh, "; does not pass; the best so far (episode ").empty());
 }
 
 TEST_F(RunApplicationTest, ASuiteThatCannotBeReadStopsARunThatNeedsItAndIsOnlySaidOtherwise)

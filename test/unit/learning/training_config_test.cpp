@@ -56,6 +56,8 @@ TEST(Config, ShippedFileLoadsWithTheDocumentedDefaults)
   EXPECT_EQ(defaults.agent.alpha.min, config.agent.alpha.min);
   EXPECT_EQ(defaults.agent.alpha.log_divisor, config.agent.alpha.log_divisor);
   EXPECT_EQ(defaults.limits.max_episodes, config.limits.max_episodes);
+  EXPECT_EQ(defaults.limits.suite_every, config.limits.suite_every);
+  EXPECT_EQ(defaults.limits.best_every, config.limits.best_every);
   EXPECT_EQ(12u, config.agent.discretiser.bins[3]);
 }
 
@@ -65,7 +67,7 @@ TEST(Config, ValuesOverrideDefaults)
       "physics: {tau: 0.01, integrator: rk4}\n"
       "task: {reward: seed, max_episode_steps: 200}\n"
       "learning:\n  gamma: 0.9\n  bins: [1, 1, 3, 4]\n  epsilon: {schedule: exponential, decay_rate: 0.9}\n"
-      "training: {max_episodes: 7, stop_when_solved: false}\n");
+      "training: {max_episodes: 7, stop_when_solved: false, suite_every: 1, best_every: 10}\n");
   EXPECT_EQ(0.01, c.physics.tau);
   EXPECT_EQ(Integrator::Rk4, c.physics.integrator);
   EXPECT_EQ(RewardScheme::Seed, c.task.reward);
@@ -76,6 +78,9 @@ TEST(Config, ValuesOverrideDefaults)
   EXPECT_EQ(0.9, c.agent.epsilon.decay_rate);
   EXPECT_EQ(7u, c.limits.max_episodes);
   EXPECT_FALSE(c.limits.stop_when_solved);
+  EXPECT_EQ(10u, c.limits.best_every);
+  // Written with the table as read (the configuration a table carries).
+  EXPECT_EQ(10u, parse(trainingConfigText(c)).limits.best_every);
 }
 
 TEST(Config, BadValuesNameTheKeyTheValueAndTheRange)
@@ -101,6 +106,7 @@ TEST(Config, BadValuesNameTheKeyTheValueAndTheRange)
   EXPECT_NE(std::string::npos, errorOf("learning: {epsilon: {min: 3}}").find("learning/epsilon/min = 3"));
   EXPECT_NE(std::string::npos, errorOf("learning: {actions: [-20, 20]}").find("physics/force_mag"));
   EXPECT_NE(std::string::npos, errorOf("training: {max_episodes: 0}").find("training/max_episodes = 0"));
+  EXPECT_NE(std::string::npos, errorOf("training: {best_every: -1}").find("training/best_every = -1"));
   EXPECT_NE(std::string::npos, errorOf("training: {until: forever}").find("training/until = 'forever'"));
   EXPECT_NE(std::string::npos, errorOf("training: {until: suite_passes}").find("needs training/suite_every > 0"));
   EXPECT_NE(std::string::npos,
