@@ -97,15 +97,17 @@ std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSessio
     return std::nullopt;
   // Against the best so far first, each case only until it is decided whether this table can beat
   // it: most cannot, and that result (a verdict cut short, said plainly) is this evaluation's. A
-  // table that can is evaluated whole and compared on whole verdicts, as every table was: the
-  // table kept is the one whole evaluations of every table would keep. (The suite runs greedily
-  // on the table, learning nothing.)
+  // table that can is evaluated whole and compared on whole verdicts, as every table was: with
+  // best_every 0 the table kept is the one whole evaluations of every table would keep. (The
+  // suite runs greedily on the table, learning nothing.)
   // Between the evaluations that look for the best (training/best_every), only whether the table
   // passes: each case stops at the fall that fails it, far sooner than at the one that says it
   // cannot beat a best near the pass marks; a table that passes is judged whole below, as before.
+  // Against a passing best, beating it asks more than passing: always ranked then.
   const bool passing_decides = config_.limits.until == TrainUntil::SuitePasses && best_ && best_->result.passed();
   const std::uint64_t best_every = config_.limits.best_every;
-  const bool ranks = best_every == 0 || s.episode % best_every == 0 || training_ends;
+  const bool ranks =
+      best_every == 0 || s.episode % best_every == 0 || training_ends || (best_ && best_->result.passed());
   if (best_ && !passing_decides)
   {
     SuiteResult quick = evaluateSuite(session.table(), config_, *suite_,
@@ -113,34 +115,43 @@ std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSessio
     failedCaseFirst(order_, quick, *suite_);
     if (!quick.reachedTargets())
     {
-      // Judged after every episode, a run has thousands of these: one line at the progress
-      // cadence (and at the end) says how many there were, and every table that could beat the
-      // best has a line of its own below.
-      ++not_kept_unsaid_;
+      // Judged after every episode, a run has thousands of these: one line in each stretch of
+      // progress_every episodes (and at the end) says how many there were, and every table that
+      // could beat the best has a line of its own below.
       const std::uint64_t every = config_.limits.progress_every;
-      if (training_ends || (every > 0 && s.episode % every == 0))
+      if (training_ends || (every > 0 && s.episode / every > progress_said_))
       {
-        const std::string others =
-            not_kept_unsaid_ > 1
-                ? formatText("; %llu tables judged since the last such line, none kept", count(not_kept_unsaid_))
-                : std::string();
-        log.push_back({LogLine::Level::Info,
-                       formatText("robustness at episode %llu (%llu steps): %s; %s (episode %llu, worst case %llu "
-                                  "balanced)%s",
-                                  count(s.episode), count(s.total_steps), quick.summary().c_str(),
-                                  ranks ? "no better than the best so far" : "does not pass; the best so far",
-                                  count(best_->episode), count(best_->result.worstBalanced()), others.c_str())});
-        not_kept_unsaid_ = 0;
+        log.push_back(
+            {LogLine::Level::Info,
+             formatText("robustness at episode %llu (%llu steps): %s; %s (episode %llu, worst case %llu "
+                        "balanced)%s",
+                        count(s.episode), count(s.total_steps), quick.summary().c_str(),
+                        ranks ? "no better than the best so far" : "does not pass; the best so far",
+                        count(best_->episode), count(best_->result.worstBalanced()), othersNotKept().c_str())});
+        if (every > 0)
+          progress_said_ = s.episode / every;
       }
+      else
+        ++not_kept_unsaid_;
       return quick;
     }
   }
   SuiteResult result = evaluateSuite(session.table(), config_, *suite_);
   if (!best_ || better(result, best_->result))
     best_ = BestTable{session.table(), result, s.episode};
-  log.push_back({LogLine::Level::Info, formatText("robustness at episode %llu (%llu steps): %s", count(s.episode),
-                                                  count(s.total_steps), result.summary().c_str())});
+  log.push_back(
+      {LogLine::Level::Info, formatText("robustness at episode %llu (%llu steps): %s%s", count(s.episode),
+                                        count(s.total_steps), result.summary().c_str(), othersNotKept().c_str())});
   return result;
+}
+
+std::string BestTableKeeper::othersNotKept()
+{
+  const std::uint64_t others = not_kept_unsaid_;
+  not_kept_unsaid_ = 0;
+  return others == 0 ? std::string()
+                     : formatText("; %llu other table%s judged since the last line, none kept", count(others),
+                                  others == 1 ? "" : "s");
 }
 
 SuiteResult BestTableKeeper::settle(TrainingSession& session, std::optional<SuiteResult> last, LogLines& log)
@@ -186,8 +197,8 @@ SuiteResult BestTableKeeper::settle(TrainingSession& session, std::optional<Suit
                             "every episode)");
     log.push_back(
         {LogLine::Level::Info,
-         formatText("robustness of the saved table, for information (%s, greedy, %llu episodes per case):\n",
-                    suite_path_.c_str(), count(suite_->episodes)) +
+         formatText("robustness of the saved table, for information (%s, greedy, %s%llu episodes per case):\n",
+                    suite_path_.c_str(), last->complete() ? "" : "up to ", count(suite_->episodes)) +
              last->rows() + verdict +
              ". This run's goal was solved (the tutorial's), not this suite; config/robust.yaml trains until this "
              "suite passes (docs/robust_tables.md)",

@@ -447,6 +447,11 @@ TrainingLimits readLimits(const ParameterSource& source)
     reader.fail("suite", "''", "a suite file, or none");
   reader.read("suite_every", limits.suite_every, 0);
   reader.read("best_every", limits.best_every, 0);
+  // Looked for at evaluations only: its episodes must be some of the suite's.
+  if (limits.best_every > 0 && (limits.suite_every == 0 || limits.best_every % limits.suite_every != 0))
+    reader.fail("best_every", std::to_string(limits.best_every),
+                "0, or a multiple of training/suite_every (" + std::to_string(limits.suite_every) +
+                    "): the best is looked for at evaluations of the suite");
   std::string until = limits.until == TrainUntil::Solved ? "solved" : "suite_passes";
   reader.readChoice("until", until, {"solved", "suite_passes"});
   limits.until = until == "solved" ? TrainUntil::Solved : TrainUntil::SuitePasses;

@@ -23,7 +23,8 @@ namespace cartpole_qlearning
 class BestTableKeeper
 {
 public:
-  // config: training/suite, suite_every and until; the physics the suite's cases vary.
+  // config: training/suite, suite_every, best_every, until and progress_every (the cadence of the
+  // lines for tables not kept); the physics the suite's cases vary.
   // learning: false (evaluating) keeps no suite. suite_folders: where a relative suite is looked
   // for, in order.
   BestTableKeeper(const TrainingConfig& config, bool learning, std::vector<std::string> suite_folders);
@@ -40,9 +41,9 @@ public:
   // suite_every's cadence, and when training ends), said; the table is kept when it is the best
   // so far. Nothing when not due. Once there is a best, the verdict of a table that cannot beat it
   // (or, between training/best_every's evaluations, that does not pass) is cut short
-  // (SuiteResult::complete() false) and said only at training/progress_every's
-  // cadence (progress_every 0: none) and when training ends, with how many such tables
-  // there were since the last such line; against a failing best such a table fails, and
+  // (SuiteResult::complete() false) and said at most once in each stretch of
+  // training/progress_every episodes (progress_every 0: only when training ends), the next line
+  // saying how many such tables there were since the last one; against a failing best such a table fails, and
   // its passed() is false as its whole verdict's would be. (Against a passing best, a cut-short
   // verdict says nothing of passing: under training/until suite_passes the keeper then judges
   // every table whole, since passing ends training.)
@@ -77,9 +78,15 @@ private:
   std::optional<BestTable> best_;
   // The order the next evaluation runs the cases in: the last to fall short first.
   std::vector<std::size_t> order_;
-  // Tables not kept (no better than the best, or not passing) since the last line that said so
-  // (said at the progress cadence, not one line each).
+  // "; N other tables judged since the last line, none kept" for the next line said ("" when
+  // none), and the count starts again.
+  std::string othersNotKept();
+
+  // Tables not kept (no better than the best, or not passing) and not said since the last line
+  // (at most one such line in each stretch of progress_every episodes).
   std::uint64_t not_kept_unsaid_ = 0;
+  // episode / progress_every at the last line of a table not kept.
+  std::uint64_t progress_said_ = 0;
 };
 
 }  // namespace cartpole_qlearning

@@ -1039,39 +1039,72 @@ TEST_F(RunApplicationTest, AtMaxEpisodesTheBestTableSeenIsSavedAndTheDefaultTabl
   EXPECT_EQ("max_episodes", parseRunRecord(text(dir_ / folderName() / "run.yaml")).finished);
 }
 
-TEST_F(RunApplicationTest, JudgedEveryEpisodeTheTablesNoBetterThanTheBestAreSaidAtTheProgressCadence)
+TEST_F(RunApplicationTest, JudgedEveryEpisodeTheTablesNotKeptAreSaidOnceEachProgressStretchAndCounted)
 {
   // robust.yaml judges after every episode: thousands of verdicts a run. A table that can beat
-  // the best has a line of its own; those that cannot are said once every progress_every
-  // episodes and at the end, with how many there were, so every verdict is accounted for.
+  // the best has a line of its own; of those that cannot (or, between best_every's evaluations,
+  // do not pass) one line in each stretch of progress_every episodes and one at the end, and
+  // every line says how many others there were since the last: every verdict is accounted for.
+  struct Said
+  {
+    std::uint64_t verdicts = 0;
+    std::set<std::uint64_t> stretches;  // episode / 50 of every line
+    std::size_t not_kept_lines = 0;
+  };
+  const auto account = [](const std::vector<EpisodeEnd>& ends) {
+    Said said;
+    for (std::size_t i = 0; i < ends.size(); ++i)
+      for (const std::string& line : lines({ends[i]}, "robustness at episode"))
+      {
+        const std::uint64_t episode = i + 1;
+        EXPECT_EQ(0u, line.rfind("robustness at episode " + std::to_string(episode) + " (", 0)) << line;
+        const bool not_kept = line.find("; no better than the best so far") != std::string::npos ||
+                              line.find("; does not pass; the best so far") != std::string::npos;
+        if (not_kept)
+        {
+          EXPECT_TRUE(said.stretches.insert(episode / 50).second || episode == ends.size())
+              << "a second line in one stretch: " << line;
+          ++said.not_kept_lines;
+        }
+        test::text_match::Groups others;
+        said.verdicts += 1 + (test::text_match::contains(
+                                  line, "; ([0-9]+) other tables? judged since the last line, none kept$", &others)
+                                  ? std::stoull(others[1])
+                                  : 0);
+      }
+    return said;
+  };
+
   TrainingConfig config = untilAnUnpassableSuite(1, 210);
   config.limits.progress_every = 50;
-  const std::vector<EpisodeEnd> ends = train(config);
-  ASSERT_EQ(210u, ends.size());
-  std::uint64_t verdicts = 0;
-  std::size_t cut_short_lines = 0;
-  for (std::size_t i = 0; i < ends.size(); ++i)
-  {
-    const std::uint64_t episode = i + 1;
-    for (const std::string& line : lines({ends[i]}, "robustness at episode"))
-    {
-      EXPECT_EQ(0u, line.rfind("robustness at episode " + std::to_string(episode) + " (", 0)) << line;
-      if (line.find("; no better than the best so far") == std::string::npos)
-      {
-        ++verdicts;  // a whole verdict: a table that could beat the best
-        continue;
-      }
-      ++cut_short_lines;
-      EXPECT_TRUE(episode % 50 == 0 || episode == 210) << line;
-      test::text_match::Groups since;
-      verdicts +=
-          test::text_match::contains(line, "; ([0-9]+) tables judged since the last such line, none kept$", &since)
-              ? std::stoull(since[1])
-              : 1;
-    }
-  }
-  EXPECT_EQ(210u, verdicts);       // one a episode, each said or counted
-  EXPECT_EQ(5u, cut_short_lines);  // at 50, 100, 150, 200 and the end
+  const Said every_episode = account(train(config));
+  EXPECT_EQ(210u, every_episode.verdicts);  // one an episode, each said or counted
+  EXPECT_LE(every_episode.not_kept_lines, 5u);
+  EXPECT_GE(every_episode.not_kept_lines, 2u);
+
+  // Judged every 3 episodes: a line in every stretch of 50 still (not only where 3 and 50 meet).
+  config.limits.suite_every = 3;
+  config.limits.max_episodes = 210;
+  const std::vector<EpisodeEnd> third = train(config);
+  const Said every_third = account(third);
+  EXPECT_EQ(70u, every_third.verdicts);
+  for (std::uint64_t stretch = 1; stretch <= 4; ++stretch)
+    EXPECT_FALSE(lines(std::vector<EpisodeEnd>(third.begin() + stretch * 50 - 1, third.begin() + stretch * 50 + 49),
+                       "robustness at episode")
+                     .empty())
+        << "no line in episodes " << stretch * 50 << "-" << stretch * 50 + 49;
+
+  // A run that passes: the tables since the last line are counted on the passing one's.
+  TrainingConfig passing;
+  passing.limits.suite = writeSuite(
+      "episodes: 20\ncases: [{name: nominal, pass: 20}, {name: pushes, pass: 19, "
+      "perturbations: {push_probability: 0.2, push_force: 2.0}}]");
+  passing.limits.suite_every = 1;
+  passing.limits.progress_every = 50;
+  passing.limits.until = TrainUntil::SuitePasses;
+  const std::vector<EpisodeEnd> ends = train(passing);
+  ASSERT_NE(std::string::npos, ends.back().robustness.find(": PASSED"));
+  EXPECT_EQ(ends.size(), account(ends).verdicts);
 }
 
 TEST_F(RunApplicationTest, LookingForTheBestLessOftenSavesTheSamePassingTableAndTheBestOfThoseRanked)

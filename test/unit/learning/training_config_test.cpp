@@ -107,6 +107,12 @@ TEST(Config, BadValuesNameTheKeyTheValueAndTheRange)
   EXPECT_NE(std::string::npos, errorOf("learning: {actions: [-20, 20]}").find("physics/force_mag"));
   EXPECT_NE(std::string::npos, errorOf("training: {max_episodes: 0}").find("training/max_episodes = 0"));
   EXPECT_NE(std::string::npos, errorOf("training: {best_every: -1}").find("training/best_every = -1"));
+  // The best is looked for at evaluations: best_every names some of suite_every's episodes.
+  EXPECT_NE(std::string::npos, errorOf("training: {suite_every: 2, best_every: 5}")
+                                   .find("training/best_every = 5 is not allowed (0, or a multiple of "
+                                         "training/suite_every (2)"));
+  EXPECT_NE(std::string::npos, errorOf("training: {best_every: 10}").find("training/best_every = 10"));
+  EXPECT_EQ("", errorOf("training: {suite_every: 5, best_every: 20}"));
   EXPECT_NE(std::string::npos, errorOf("training: {until: forever}").find("training/until = 'forever'"));
   EXPECT_NE(std::string::npos, errorOf("training: {until: suite_passes}").find("needs training/suite_every > 0"));
   EXPECT_NE(std::string::npos,
