@@ -5,6 +5,7 @@
 #include <ros/console.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <exception>
 #include <map>
 #include <mutex>
@@ -40,7 +41,13 @@ void logLine(const std::string& logger, ros::console::Level level, const std::st
     place = found;
   }
   if (place->logger_enabled_)
+  {
     ros::console::print(nullptr, place->logger_, place->level_, __FILE__, __LINE__, __func__, "%s", text.c_str());
+    // Under roslaunch into a file or a pipe stdout is block-buffered, and a line cut at the
+    // buffer's end was finished after roslaunch's "killing on exit" lines (a SOLVED line split in
+    // two, found by tools/first_hour.sh): each line leaves whole, when it is said.
+    std::fflush(stdout);
+  }
 }
 
 std::string withPrefix(const std::string& prefix, const LogLine& line)

@@ -1086,13 +1086,19 @@ TEST_F(RunApplicationTest, JudgedEveryEpisodeTheTablesNotKeptAreSaidOnceEachProg
   config.limits.suite_every = 3;
   config.limits.max_episodes = 210;
   const std::vector<EpisodeEnd> third = train(config);
+  ASSERT_EQ(210u, third.size());
   const Said every_third = account(third);
   EXPECT_EQ(70u, every_third.verdicts);
-  for (std::uint64_t stretch = 1; stretch <= 4; ++stretch)
-    EXPECT_FALSE(lines(std::vector<EpisodeEnd>(third.begin() + stretch * 50 - 1, third.begin() + stretch * 50 + 49),
+  for (std::size_t stretch = 1; stretch <= 4; ++stretch)  // episodes 50-99, ..., 200-210
+  {
+    const std::size_t first = stretch * 50 - 1;
+    const std::size_t end = std::min(third.size(), stretch * 50 + 49);
+    EXPECT_FALSE(lines(std::vector<EpisodeEnd>(third.begin() + static_cast<std::ptrdiff_t>(first),
+                                               third.begin() + static_cast<std::ptrdiff_t>(end)),
                        "robustness at episode")
                      .empty())
-        << "no line in episodes " << stretch * 50 << "-" << stretch * 50 + 49;
+        << "no line in episodes " << first + 1 << "-" << end;
+  }
 
   // A run that passes: the tables since the last line are counted on the passing one's.
   TrainingConfig passing;
