@@ -6,7 +6,8 @@
 // line that says how it went. How long the table keeps the pole up is printed, not asserted: a
 // table robust.yaml trains until it passes the one-minute suite (all_at_once 95 of 100) can
 // still fall in five minutes of all_at_once (docs/robust_tables.md). The seed is the .test's
-// `seed` argument (default 0): rostest cartpole_qlearning control_robot.test seed:=3
+// `seed` argument (default 0): rostest cartpole_qlearning control_robot.test seed:=3; the robot is
+// the suite case the sim poses as (`suite`, `suite_case`; default all_at_once).
 #include "cartpole_qlearning/ControlStats.h"
 
 #include "ros_test_support.h"
@@ -47,6 +48,8 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
   std::filesystem::create_directories(home);
   int seed = 0;
   ros::param::get("~seed", seed);
+  std::string suite_case = "all_at_once";
+  ros::param::get("~suite_case", suite_case);
   const auto trained = runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + CARTPOLE_CONFIG_DIR +
                                   "/robust.yaml --seed " + std::to_string(seed) +
                                   " --quiet --no-run-folder --save robust.yaml");
@@ -105,8 +108,8 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
       "control ended: balanced [0-9.]+ s of [0-9.]+ s, the longest stretch [0-9.]+ s, [0-9]+ falls?, 0 of "
       "[0-9]+ commands beyond the motor's 10 N"))
       << output;
-  std::printf("five minutes of control on all_at_once, seed %d's table: %.1f s balanced, the longest stretch %.1f s, "
+  std::printf("five minutes of control on %s, seed %d's table: %.1f s balanced, the longest stretch %.1f s, "
               "%llu falls\n",
-              seed, at_five_minutes.balanced_seconds, at_five_minutes.longest_seconds,
+              suite_case.c_str(), seed, at_five_minutes.balanced_seconds, at_five_minutes.longest_seconds,
               static_cast<unsigned long long>(at_five_minutes.falls));
 }
