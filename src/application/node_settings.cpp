@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/application/node_settings.h"
 
 #include "cartpole_qlearning/io/file_access.h"
+#include "cartpole_qlearning/learning/delay_predictor.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/application/table_store.h"
@@ -367,6 +368,11 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   priv.readSeconds("report_every", run.report_every, 0.0, 3600.0, true);
   if (!run.control && !source.keysUnder("report_every").empty())
     priv.fail("report_every", SectionReader::numberText(run.report_every), "only with mode control");
+  // A robot known to answer late: decide for the state the table's model predicts for when the command acts.
+  priv.read("predict_delay_steps", run.predict_delay_steps, 0, kMaxPredictedDelaySteps);
+  if (run.learning && run.predict_delay_steps > 0)
+    priv.fail("predict_delay_steps", std::to_string(run.predict_delay_steps),
+              "only with mode evaluate or control: training learns from the states it observes");
   priv.read("checkpoint_every", run.checkpoint_every, 0);
   priv.read("save_on_shutdown", run.save_on_shutdown);
   priv.read("shutdown_when_finished", settings.shutdown_when_finished);
@@ -545,6 +551,9 @@ std::string controllerStartText(const ControllerSettings& settings, const QTable
                      served;
   if (settings.robots.size() > 1)
     text += settings.sync ? " in lockstep rounds" : ", each as its states come";
+  if (settings.run.predict_delay_steps > 0)
+    text += "; deciding for the state predicted " + std::to_string(settings.run.predict_delay_steps) +
+            (settings.run.predict_delay_steps == 1 ? " step" : " steps") + " ahead (~predict_delay_steps)";
   return text + "; " +
          (settings.protocol.reset_service ? "resets by ~" + settings.reset_service
                                           : "no reset service: episodes start when the state is in ~start_region");

@@ -2,6 +2,7 @@
 
 #include "cartpole_qlearning/simulation/physics_engines.h"
 #include "cartpole_qlearning/learning/cartpole_task.h"
+#include "cartpole_qlearning/learning/delay_predictor.h"
 #include "cartpole_qlearning/learning/q_learning_agent.h"
 
 #include <yaml-cpp/yaml.h>
@@ -151,7 +152,8 @@ RobustnessSuite loadRobustnessSuite(const std::string& path, const TrainingConfi
 }
 
 CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
-                        std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided, std::uint64_t target)
+                        std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided, std::uint64_t target,
+                        unsigned predict_delay_steps)
 {
   // Greedy, and nothing else: the steps a TrainingSession that does not learn takes (the same
   // rows, the same first-best action, the same task, returns summed in the same order), without
@@ -178,23 +180,29 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
   const std::uint64_t falls_to_fail = episodes >= decided_at ? episodes - decided_at + 1 : 0;
   double returns = 0.0;
   ActiveRows rows;
+  // The model the table learnt, for a prediction of the robot's delay (none: decide for what is seen).
+  DelayPredictor predictor(config.physics, predict_delay_steps);
+  const bool predicting = predict_delay_steps > 0;
   for (std::uint64_t e = 0; e < episodes; ++e)
   {
     simulation.resetRandom();
-    features.activeRows(simulation.observation(), rows);
+    predictor.begin();
+    features.activeRows(predicting ? predictor.predict(simulation.observation()) : simulation.observation(), rows);
     std::size_t action = QLearningAgent::greedyAction(table, rows);
     unsigned steps = 0;
     double episode_return = 0.0;
     StepOutcome outcome;
     for (;;)
     {
+      predictor.sent(efforts[action]);
       simulation.step(efforts[action]);
       outcome = task.evaluate(simulation.observation(), ++steps);
       episode_return += outcome.score;  // the return the solved window counts (TaskParams::scoreReward())
       if (outcome.done())
         break;
       // The action just taken is part of what a previous_action table sees of the state.
-      features.activeRows(simulation.observation(), rows, action + 1);
+      features.activeRows(predicting ? predictor.predict(simulation.observation()) : simulation.observation(), rows,
+                          action + 1);
       action = QLearningAgent::greedyAction(table, rows);
     }
     result.steps += steps;
@@ -248,7 +256,7 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
       {
         const SuiteCase& c = suite.cases[order[p]];
         results[p] = evaluateCase(table, judged, c, suite.episodes, suite.seed, how.stop_cases_when_decided,
-                                  how.target ? how.target(c) : c.pass);
+                                  how.target ? how.target(c) : c.pass, how.predict_delay_steps);
       }
       catch (...)
       {

@@ -63,6 +63,10 @@ struct RunApplication::Parts
     // Every table this run saves (the services, checkpoints, the final and shutdown saves, the
     // best table) then says what it takes to run it.
     session.stampTables(config.physics.tau, trainingConfigText(config));
+    // The node's and train_headless's settings refuse a prediction while learning: this is a backstop.
+    const std::string refused = session.predictDelay(config.physics, settings.predict_delay_steps);
+    if (!refused.empty())
+      throw std::invalid_argument(refused);
   }
 
   // Puts a loaded table in use. Training goes on with the table's counts: episode numbers,

@@ -47,6 +47,7 @@ const RuleOption kTrace{"--trace", [](const HeadlessOptions& o) { return o.trace
 const RuleOption kEvaluate{"--evaluate", [](const HeadlessOptions& o) { return o.evaluating(); }};
 const RuleOption kEpisodes{"--episodes", [](const HeadlessOptions& o) { return o.episodes_given; }};
 const RuleOption kMaxSteps{"--max-steps", [](const HeadlessOptions& o) { return o.max_steps_given; }};
+const RuleOption kPredictDelay{"--predict-delay", [](const HeadlessOptions& o) { return o.predict_delay_given; }};
 const RuleOption kSuite{"--suite", [](const HeadlessOptions& o) { return !o.suite_path.empty(); }};
 const RuleOption kReplay{"--replay", [](const HeadlessOptions& o) { return !o.replay_path.empty(); }};
 const RuleOption kPolicy{"--policy", [](const HeadlessOptions& o) { return !o.policy_path.empty(); }};
@@ -123,6 +124,11 @@ const std::vector<OptionRule>& headlessOptionRules()
        {kRobots, kMaxEpisodes, kStatsCsv, kLoad, kResume, kCheckpointEvery, kNoRunFolder, kGreedyCheck},
        "a replay learns from its file alone"},
       {Kind::Requires, kEvaluate, {kSuite}, "runs a table: give it with --evaluate TABLE"},
+      {Kind::Requires,
+       kEvaluate,
+       {kPredictDelay},
+       "is how a greedy table meets a robot that answers late: give it with --evaluate TABLE (training learns "
+       "from the states it observes)"},
       {Kind::Excludes,
        kSuite,
        {kEpisodes, kMaxSteps, kRobots, kReturns},
@@ -220,6 +226,12 @@ HeadlessCommandLine parseHeadlessOptions(const std::vector<std::string>& args)
         return refuse(arg, args[i],
                       "must be a whole number in [1, " + std::to_string(std::numeric_limits<int>::max()) + "]");
     }
+    else if (arg == "--predict-delay" && has_value)
+    {
+      o.predict_delay_given = true;
+      if (!parseCount(args[++i], o.predict_delay) || o.predict_delay > kMaxPredictedDelaySteps)
+        return refuse(arg, args[i], "must be a whole number in [0, " + std::to_string(kMaxPredictedDelaySteps) + "]");
+    }
     else if (arg == "--greedy-check" && has_value)
     {
       if (!parseCount(args[++i], o.greedy_check) || o.greedy_check == 0 || o.greedy_check > 1000)
@@ -261,6 +273,7 @@ RunSettings headlessRunSettings(const HeadlessOptions& options, std::uint64_t se
   settings.save_on_shutdown = !options.no_run_folder;
   settings.run_folder = !options.no_run_folder;
   settings.trace = options.trace;
+  settings.predict_delay_steps = static_cast<unsigned>(options.predict_delay);
   settings.own_absolute_paths = true;
   settings.command_line = true;
   // A relative training/suite: beside the config first, then the package's config/.

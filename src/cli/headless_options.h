@@ -42,6 +42,9 @@ struct HeadlessOptions
   bool episodes_given = false;
   std::uint64_t max_steps = kEvaluationMaxSteps;  // --evaluate: an episode's length (never the config's)
   bool max_steps_given = false;
+  // --evaluate (with or without --suite): decide for the state predicted this many steps ahead.
+  std::uint64_t predict_delay = 0;
+  bool predict_delay_given = false;
   std::string suite_path;
 
   std::string replay_path;

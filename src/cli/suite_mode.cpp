@@ -35,17 +35,23 @@ int suiteMode(const HeadlessOptions& options, const HeadlessSetup& setup)
         tableContradiction(setup.config, setup.config_origin, table, tablePath(setup.table_dir, table_path));
     if (!contradiction.empty())
       throw FileError(contradiction);
-    result = evaluateSuite(table, setup.config, suite);
+    SuiteRun how = SuiteRun::complete();
+    how.predict_delay_steps = static_cast<unsigned>(options.predict_delay);
+    result = evaluateSuite(table, setup.config, suite, how);
   }
   catch (const std::runtime_error& e)  // FileError, ConfigError: the table cannot be read or does not fit
   {
     std::cerr << "train_headless: --evaluate " << table_path << ": " << e.what() << "\n";
     return 2;
   }
+  const std::string predicting =
+      options.predict_delay == 0 ? ""
+                                 : ", each decision for the state predicted " + std::to_string(options.predict_delay) +
+                                       (options.predict_delay == 1 ? " step" : " steps") + " ahead";
   if (!options.quiet)
-    std::printf("suite %s: %zu cases, %llu greedy episodes each, seed %llu\n%s\n", suite_path.c_str(),
+    std::printf("suite %s: %zu cases, %llu greedy episodes each, seed %llu%s\n%s\n", suite_path.c_str(),
                 suite.cases.size(), static_cast<unsigned long long>(suite.episodes),
-                static_cast<unsigned long long>(suite.seed), result.table().c_str());
+                static_cast<unsigned long long>(suite.seed), predicting.c_str(), result.table().c_str());
   std::size_t passed = 0;
   for (const CaseResult& c : result.cases)
     passed += c.passed();

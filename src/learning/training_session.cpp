@@ -40,6 +40,23 @@ TrainingSession::TrainingSession(const TaskParams& task, const AgentParams& agen
   episodes_.assign(robots, Episode(task.solved_window));
 }
 
+std::string TrainingSession::predictDelay(const CartPoleParams& model, unsigned steps)
+{
+  if (steps == 0)
+  {
+    predictors_.clear();
+    return "";
+  }
+  if (learning_)
+    return "a prediction of the robot's delay is for a greedy table (evaluate, control): training learns from the "
+           "states it observes";
+  if (steps > kMaxPredictedDelaySteps)
+    return "a prediction of " + std::to_string(steps) + " steps is not allowed (must be in [0, " +
+           std::to_string(kMaxPredictedDelaySteps) + "])";
+  predictors_.assign(episodes_.size(), DelayPredictor(model, steps));
+  return "";
+}
+
 std::size_t TrainingSession::chooseAction(const ActiveRows& state, double epsilon)
 {
   return learning_ ? agent_.selectAction(state, epsilon) : agent_.greedyAction(state);
@@ -57,9 +74,14 @@ double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size
   e.steps = 0;
   e.steps_before_table = 0;
   e.episode_return = 0.0;
-  agent_.activeRows(start_state, e.rows[e.current]);
+  if (!predictors_.empty())
+    predictors_[robot].begin();
+  agent_.activeRows(decidedFor(start_state, robot), e.rows[e.current]);
   e.action = chooseAction(e.state(), e.epsilon);
-  return agent_.table().actions()[e.action];
+  const double effort = agent_.table().actions()[e.action];
+  if (!predictors_.empty())
+    predictors_[robot].sent(effort);
+  return effort;
 }
 
 Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
@@ -70,7 +92,8 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   decision.outcome = task_.evaluate(state, e.steps);
   e.episode_return += decision.outcome.score;
   // The action just taken: with previous_action, part of what the learner sees of this state.
-  agent_.activeRows(state, e.next(), e.action + 1);
+  // (A predicting session does not learn: its rows are only what the next action is chosen on.)
+  agent_.activeRows(decidedFor(state, robot), e.next(), e.action + 1);
   if (learning_)
   {
     const QUpdate update =
@@ -101,6 +124,8 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
     e.action = chooseAction(e.state(), e.epsilon);
     decision.action = e.action;
     decision.effort = agent_.table().actions()[e.action];
+    if (!predictors_.empty())
+      predictors_[robot].sent(decision.effort);
     return decision;
   }
 

@@ -84,6 +84,10 @@ TEST(HeadlessOptions, EveryOptionGoesIntoItsField)
   EXPECT_EQ("s.yaml", e.suite_path);
   EXPECT_EQ(kEvaluationMaxSteps, e.max_steps);
   EXPECT_EQ(3000u, parse("--evaluate t.yaml --max-steps 3000").options.max_steps);
+  EXPECT_EQ(0u, e.predict_delay);
+  EXPECT_EQ(1u, parse("--evaluate t.yaml --suite s.yaml --predict-delay 1").options.predict_delay);
+  EXPECT_EQ(1u, headlessRunSettings(parse("--evaluate t.yaml --predict-delay 1").options, 0, "/tables", "c.yaml", "")
+                    .predict_delay_steps);
 
   const HeadlessOptions p = parse("--policy t.yaml --grid 11 --axes x,theta --at x_dot=1 --previous 0").options;
   EXPECT_EQ("t.yaml", p.policy_path);
@@ -163,6 +167,12 @@ TEST(HeadlessOptions, EachRuleRefusesWhatDoesNotGoTogether)
   EXPECT_EQ("--episodes: counts --evaluate's episodes (training: --max-episodes)", refusal("--episodes 5"));
   EXPECT_EQ("--max-steps: is how long --evaluate's episodes are (training's: the config's task/max_episode_steps)",
             refusal("--max-steps 3000"));
+  EXPECT_EQ(
+      "--predict-delay: is how a greedy table meets a robot that answers late: give it with --evaluate TABLE "
+      "(training learns from the states it observes)",
+      refusal("--predict-delay 1"));
+  EXPECT_EQ("--predict-delay 51 is not allowed (must be a whole number in [0, 50])",
+            refusal("--evaluate t.yaml --predict-delay 51"));
   const std::string evaluation = " with --evaluate: an evaluation learns nothing and writes nothing";
   for (const std::string option : {"--load l", "--resume r", "--save s", "--max-episodes 3", "--checkpoint-every 0",
                                    "--no-run-folder", "--stats-csv c", "--trace", "--replay r", "--greedy-check 10"})
@@ -193,7 +203,7 @@ TEST(HeadlessOptions, TheRulesAreCheckedInTheTablesOrder)
   // Within a rule, its list's order: --load before --save.
   EXPECT_EQ("--load with --evaluate: an evaluation learns nothing and writes nothing",
             refusal("--evaluate t.yaml --save s --load l"));
-  EXPECT_EQ(10u, headlessOptionRules().size());
+  EXPECT_EQ(11u, headlessOptionRules().size());
   for (const OptionRule& rule : headlessOptionRules())
   {
     EXPECT_FALSE(rule.others.empty()) << rule.option.name;

@@ -7,7 +7,8 @@
 // table robust.yaml trains until it passes the one-minute suite (all_at_once 95 of 100) can
 // still fall in five minutes of all_at_once (docs/robust_tables.md). The seed is the .test's
 // `seed` argument (default 0): rostest cartpole_qlearning control_robot.test seed:=3; the robot is
-// the suite case the sim poses as (`suite`, `suite_case`; default all_at_once).
+// the suite case the sim poses as (`suite`, `suite_case`; default all_at_once); `predict_delay`
+// is robot.launch's (default 0).
 #include "cartpole_qlearning/ControlStats.h"
 
 #include "ros_test_support.h"
@@ -50,9 +51,11 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
   ros::param::get("~seed", seed);
   std::string suite_case = "all_at_once";
   ros::param::get("~suite_case", suite_case);
-  const auto trained = runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + CARTPOLE_CONFIG_DIR +
-                                  "/robust.yaml --seed " + std::to_string(seed) +
-                                  " --quiet --no-run-folder --save robust.yaml");
+  int predict_delay = 0;
+  ros::param::get("~predict_delay", predict_delay);
+  const auto trained =
+      runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + CARTPOLE_CONFIG_DIR +
+                 "/robust.yaml --seed " + std::to_string(seed) + " --quiet --no-run-folder --save robust.yaml");
   ASSERT_EQ(0, trained.status) << trained.output;
 
   ros::NodeHandle nh;
@@ -78,7 +81,8 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
   // The sim holds no command in lockstep: no freshness guard. A report each minute of robot time.
   TrainLaunch launch(home, "control",
                      "mode:=control load:=robust.yaml freshness_timeout:=0 reset_service:=cartpole_sim/reset "
-                     "report_every:=60",
+                     "report_every:=60 predict_delay:=" +
+                         std::to_string(predict_delay),
                      "robot.launch");
   ASSERT_TRUE(spinUntil([&] { return last.seconds >= 300.0; }, 300.0))
       << reports << " reports, the last at " << last.seconds << " s\n"
@@ -108,8 +112,9 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
       "control ended: balanced [0-9.]+ s of [0-9.]+ s, the longest stretch [0-9.]+ s, [0-9]+ falls?, 0 of "
       "[0-9]+ commands beyond the motor's 10 N"))
       << output;
-  std::printf("five minutes of control on %s, seed %d's table: %.1f s balanced, the longest stretch %.1f s, "
-              "%llu falls\n",
-              suite_case.c_str(), seed, at_five_minutes.balanced_seconds, at_five_minutes.longest_seconds,
-              static_cast<unsigned long long>(at_five_minutes.falls));
+  std::printf(
+      "five minutes of control on %s, seed %d's table, predict_delay %d: %.1f s balanced, the longest "
+      "stretch %.1f s, %llu falls\n",
+      suite_case.c_str(), seed, predict_delay, at_five_minutes.balanced_seconds, at_five_minutes.longest_seconds,
+      static_cast<unsigned long long>(at_five_minutes.falls));
 }

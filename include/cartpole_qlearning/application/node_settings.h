@@ -35,6 +35,10 @@ struct RunSettings
   // learning; a fall commands 0 until a start, and ControlMeter says how it goes.
   bool control = false;
   double report_every = 10.0;  // [s] control: a report this often (robot time)
+  // Evaluate and control: decide for the state the table's model predicts this many steps ahead,
+  // for a robot known to carry commands out that many steps late (DelayPredictor); 0: for the
+  // state observed.
+  unsigned predict_delay_steps = 0;
   // [s] control: the most robot time one decision counts (ControlMeter's max_gap): the freshness
   // bound, five decision periods or five steps, the longest.
   double control_max_gap = 0.1;

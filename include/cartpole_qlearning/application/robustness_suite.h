@@ -94,6 +94,9 @@ struct SuiteRun
   std::vector<std::size_t> order;
   // Cases run side by side on this many threads (0: one per core).
   unsigned threads = 0;
+  // Each decision for the state the table's model predicts this many steps ahead (DelayPredictor:
+  // a controller that knows its robot answers late); 0: for the state observed.
+  unsigned predict_delay_steps = 0;
 
   // The complete verdict: every case to its last episode.
   static SuiteRun complete()
@@ -159,10 +162,10 @@ struct SuiteResult
 // evaluateSuite runs each case with the suite's step limit in place of the task's.
 // Throws ConfigError when the table does not fit the configuration.
 // stop_when_decided: stop once the case has `target` balanced episodes or can no longer reach
-// it (0: the case's pass).
+// it (0: the case's pass). predict_delay_steps: as SuiteRun's (the model: config's physics).
 CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
                         std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided = false,
-                        std::uint64_t target = 0);
+                        std::uint64_t target = 0, unsigned predict_delay_steps = 0);
 SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite,
                           const SuiteRun& how = SuiteRun::complete());
 

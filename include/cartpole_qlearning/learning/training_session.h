@@ -12,6 +12,7 @@
 
 #include "cartpole_qlearning/learning/cartpole_task.h"
 #include "cartpole_qlearning/learning/learning_settings.h"
+#include "cartpole_qlearning/learning/delay_predictor.h"
 #include "cartpole_qlearning/learning/q_learning_agent.h"
 #include "cartpole_qlearning/learning/trace.h"
 
@@ -171,6 +172,17 @@ public:
   // are not in the table's count and are left out of the session's total too, so that the total
   // stays the table's.
   std::string resume(QTable table, const std::vector<double>& recent_returns);
+  // A greedy session only (evaluate, control): each decision is made for the state `model`
+  // predicts for when the command will act on a robot that answers `steps` late (DelayPredictor),
+  // from the next episode that begins; 0: for the state observed (the default). Returns what is
+  // wrong (a learning session, too many steps) and changes nothing then. The task still judges
+  // the observed state.
+  std::string predictDelay(const CartPoleParams& model, unsigned steps);
+  unsigned predictedDelaySteps() const
+  {
+    return predictors_.empty() ? 0 : predictors_.front().steps();
+  }
+
   // The solved window's returns, oldest first: what a checkpoint records for resume().
   std::vector<double> recentReturns() const
   {
@@ -210,10 +222,16 @@ private:
   };
 
   std::size_t chooseAction(const ActiveRows& state, double epsilon);
+  // The state a decision is made for: the observed one, or its prediction (predictDelay).
+  CartPoleState decidedFor(const CartPoleState& observed, std::size_t robot) const
+  {
+    return predictors_.empty() ? observed : predictors_[robot].predict(observed);
+  }
 
   CartPoleTask task_;
   QLearningAgent agent_;
-  double stamp_tau_ = 0.0;  // stampTables' (0: none)
+  std::vector<DelayPredictor> predictors_;  // one per robot; empty: decide for what is observed
+  double stamp_tau_ = 0.0;                  // stampTables' (0: none)
   std::string stamp_trained_with_;
   LearningSettings learning_settings_;
   bool learning_;

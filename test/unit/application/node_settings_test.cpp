@@ -196,6 +196,22 @@ TEST(ControllerSettings, ControlDrivesWithATableAndNoStepLimitNorVerdict)
               "report_every = 5 is not allowed (only with mode control)");
 }
 
+TEST(ControllerSettings, APredictionOfTheRobotsDelayIsForAGreedyTable)
+{
+  const std::string shared = "{task: {max_episode_steps: 200}}";
+  EXPECT_EQ(0u, readController("{mode: control, load_on_start: t.yaml}", shared).run.predict_delay_steps);
+  EXPECT_EQ(
+      1u,
+      readController("{mode: control, load_on_start: t.yaml, predict_delay_steps: 1}", shared).run.predict_delay_steps);
+  EXPECT_EQ(2u, readController("{mode: evaluate, predict_delay_steps: 2}", shared).run.predict_delay_steps);
+  EXPECT_EQ(0u, readController("{mode: train, predict_delay_steps: 0}", shared).run.predict_delay_steps);
+  EXPECT_SAYS(controllerError("{mode: train, predict_delay_steps: 1}", shared),
+              "predict_delay_steps = 1 is not allowed (only with mode evaluate or control: training learns from the "
+              "states it observes)");
+  EXPECT_SAYS(controllerError("{mode: evaluate, predict_delay_steps: 51}", shared), "predict_delay_steps = 51");
+  EXPECT_SAYS(controllerError("{mode: evaluate, predict_delay_steps: -1}", shared), "predict_delay_steps = -1");
+}
+
 TEST(ControllerSettings, RefusesAnUnknownMode)
 {
   EXPECT_SAYS(controllerError("mode: fly"), "mode = 'fly' is not allowed (allowed: train, evaluate, control)");

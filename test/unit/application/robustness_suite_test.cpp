@@ -362,10 +362,11 @@ namespace
 // The verdict's steps as they were taken before the greedy path (issue 29): through a session that
 // does not learn. The reference evaluateCase must agree with, count for count and bit for bit.
 CaseResult throughASession(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
-                           std::uint64_t episodes, std::uint64_t seed)
+                           std::uint64_t episodes, std::uint64_t seed, unsigned predict_delay_steps = 0)
 {
   TrainingSession session(config.task, config.agent, seed, false);
   EXPECT_EQ(session.replaceTable(table), "");
+  EXPECT_EQ(session.predictDelay(config.physics, predict_delay_steps), "");
   CartPoleSimulation simulation = makeSimulation(suite_case.physics, suite_case.engine, suite_case.start_state_bound,
                                                  seed, suite_case.perturbations);
   CaseResult result;
@@ -438,4 +439,64 @@ TEST(RobustnessSuite, TheGreedyPathTakesTheStepsOfASessionThatDoesNotLearn)
       EXPECT_EQ(greedy.mean_return, expected.mean_return) << c.name;
     }
   }
+}
+
+TEST(RobustnessSuite, PredictingTheDelayTheGreedyPathAndASessionTakeTheSameSteps)
+{
+  // The controller's session and the suite's greedy loop predict the same states, whatever the
+  // delay predicted and the delay the case has (none, one step, noise and all at once).
+  TrainingConfig tiles;
+  tiles.agent.features = FeatureKind::Tiles;
+  const std::vector<std::pair<TrainingConfig, QTable>> tables{{TrainingConfig(), trainedTable(0)},
+                                                              {tiles, randomTable(tiles, 2)}};
+  for (const auto& [config, table] : tables)
+  {
+    const RobustnessSuite suite = loadRobustnessSuite(kSuite, config);
+    for (unsigned predicted = 1; predicted <= 2; ++predicted)
+    {
+      for (const SuiteCase& c : suite.cases)
+      {
+        TrainingConfig judged = config;
+        judged.task.max_episode_steps = 200;
+        const CaseResult expected = throughASession(table, judged, c, 20, suite.seed, predicted);
+        const CaseResult greedy = evaluateCase(table, judged, c, 20, suite.seed, false, 0, predicted);
+        EXPECT_EQ(greedy.steps, expected.steps) << c.name << ", " << predicted;
+        EXPECT_EQ(greedy.balanced, expected.balanced) << c.name << ", " << predicted;
+        EXPECT_EQ(greedy.mean_return, expected.mean_return) << c.name << ", " << predicted;
+      }
+    }
+  }
+}
+
+TEST(RobustnessSuite, OnARobotOneStepLateATableActingOnThePredictionBalancesMore)
+{
+  // The trained table of the default config on the suite's one_step_late case, in 500-step
+  // episodes: what the prediction is for. The same table on the nominal model, predicting a delay
+  // that is not there, decides a step ahead of the robot and balances less than it does there.
+  const TrainingConfig config;
+  const RobustnessSuite suite = loadRobustnessSuite(kSuite, config);
+  TrainingConfig judged = config;
+  judged.task.max_episode_steps = 500;
+  const QTable table = trainedTable(0);
+  const SuiteCase* late = nullptr;
+  const SuiteCase* nominal = nullptr;
+  for (const SuiteCase& c : suite.cases)
+  {
+    if (c.name == "one_step_late")
+      late = &c;
+    if (c.name == "nominal")
+      nominal = &c;
+  }
+  ASSERT_NE(late, nullptr);
+  ASSERT_NE(nominal, nullptr);
+  const CaseResult seen = evaluateCase(table, judged, *late, 100, suite.seed);
+  const CaseResult predicted = evaluateCase(table, judged, *late, 100, suite.seed, false, 0, 1);
+  EXPECT_GT(predicted.balanced, seen.balanced);
+  const CaseResult nominal_seen = evaluateCase(table, judged, *nominal, 100, suite.seed);
+  const CaseResult nominal_predicted = evaluateCase(table, judged, *nominal, 100, suite.seed, false, 0, 1);
+  EXPECT_LT(nominal_predicted.balanced, nominal_seen.balanced);
+  std::printf("one_step_late: %llu balanced predicting, %llu not; nominal: %llu predicting, %llu not\n",
+              static_cast<unsigned long long>(predicted.balanced), static_cast<unsigned long long>(seen.balanced),
+              static_cast<unsigned long long>(nominal_predicted.balanced),
+              static_cast<unsigned long long>(nominal_seen.balanced));
 }

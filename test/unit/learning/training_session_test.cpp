@@ -313,3 +313,45 @@ TEST(TrainingSession, TheLearnerTrainsOnTheRewardAndTheReturnsAreTheSolvedReward
   EXPECT_EQ(3.0, session.lastEpisode().episode_return);
   EXPECT_TRUE(session.lastEpisode().solved);
 }
+
+TEST(TrainingSession, APredictionOfTheDelayIsForAGreedySessionOnly)
+{
+  const TrainingConfig config;
+  TrainingSession learning(config.task, config.agent, 0, true);
+  EXPECT_NE(learning.predictDelay(config.physics, 1).find("training learns from the states it observes"),
+            std::string::npos);
+  EXPECT_EQ(learning.predictedDelaySteps(), 0u);
+  EXPECT_EQ(learning.predictDelay(config.physics, 0), "");
+
+  TrainingSession greedy(config.task, config.agent, 0, false);
+  EXPECT_NE(greedy.predictDelay(config.physics, kMaxPredictedDelaySteps + 1).find("is not allowed"), std::string::npos);
+  EXPECT_EQ(greedy.predictedDelaySteps(), 0u);
+  ASSERT_EQ(greedy.predictDelay(config.physics, 1), "");
+  EXPECT_EQ(greedy.predictedDelaySteps(), 1u);
+
+  // The first decision is made for the start advanced one step under no command, the next for the
+  // state advanced under the command just sent: the same action as a session shown those states.
+  TrainingSession shown(config.task, config.agent, 0, false);
+  QTable table(config.agent.featureParams(), config.agent.actions);
+  std::vector<double> values(table.values().size());
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = static_cast<double>((i * 7919) % 13) - 6.0;
+  table.setValues(values);
+  ASSERT_EQ(greedy.replaceTable(table), "");
+  ASSERT_EQ(shown.replaceTable(table), "");
+  const CartPoleDynamics model(config.physics);
+  CartPoleState state;
+  state << 0.02, -0.1, 0.04, 0.3;
+  double effort = greedy.beginEpisode(state);
+  EXPECT_EQ(effort, shown.beginEpisode(model.step(state, 0.0)));
+  for (int step = 0; step < 20; ++step)
+  {
+    state = model.step(state, effort);
+    const Decision decision = greedy.observe(state);
+    const Decision expected = shown.observe(model.step(state, effort));
+    if (decision.episode_over || expected.episode_over)
+      break;
+    EXPECT_EQ(decision.effort, expected.effort) << "step " << step;
+    effort = decision.effort;
+  }
+}
