@@ -1363,3 +1363,22 @@ TEST_F(RunApplicationTest, AnEvaluationSaysWhatItsTableLeavesToTheDefaults)
   const Run run = startRun();
   EXPECT_EQ(LogLine::Level::Warn, log(run.started, "the table says no configuration").level);
 }
+
+TEST_F(RunApplicationTest, AnEvaluationOrControlRunDecidesForThePredictedStateItsSettingsAskFor)
+{
+  // The node's ~predict_delay_steps and train_headless's --predict-delay reach the session through
+  // the run's settings; a training run cannot take one (the settings refuse it first: a backstop).
+  settings_.learning = false;
+  settings_.predict_delay_steps = 2;
+  TrainingSession greedy(config_.task, config_.agent, settings_.seed, false);
+  const RunApplication evaluation(settings_, config_, greedy, clocks_);
+  EXPECT_EQ(2u, greedy.predictedDelaySteps());
+
+  settings_.learning = true;
+  TrainingSession learning(config_.task, config_.agent, settings_.seed, true);
+  EXPECT_THROW(RunApplication(settings_, config_, learning, clocks_), std::invalid_argument);
+  settings_.predict_delay_steps = 0;
+  TrainingSession plain(config_.task, config_.agent, settings_.seed, true);
+  const RunApplication training(settings_, config_, plain, clocks_);
+  EXPECT_EQ(0u, plain.predictedDelaySteps());
+}
