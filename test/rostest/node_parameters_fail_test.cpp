@@ -257,6 +257,14 @@ TEST_F(NodeParametersTest, ControllerNodeletRefusesAnUnknownMode)
                 "[/~]mode\\b.*\\bfly\\b");
 }
 
+TEST_F(NodeParametersTest, ControllerRefusesToPredictTheRobotsDelayWhileTraining)
+{
+  expectRefused(kController, "/ko_controller_predict_delay",
+                {{"qlearning_controller/mode", XmlRpcValue("train")},
+                 {"qlearning_controller/predict_delay_steps", XmlRpcValue(1)}},
+                "[/~]predict_delay_steps = 1 is not allowed \\(only with mode evaluate or control");
+}
+
 // Not rules of the reader: the node opens these files as it starts.
 
 TEST_F(NodeParametersTest, ControllerRefusesAMissingTableToLoadOnStart)
