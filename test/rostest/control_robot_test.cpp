@@ -112,6 +112,13 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
       "control ended: balanced [0-9.]+ s of [0-9.]+ s, the longest stretch [0-9.]+ s, [0-9]+ falls?, 0 of "
       "[0-9]+ commands beyond the motor's 10 N"))
       << output;
+  // robot.launch predict_delay:=N reached the controller, which says so as it starts.
+  if (predict_delay > 0)
+    EXPECT_TRUE(cartpole_qlearning::test::text_match::contains(
+        output, "deciding for the state predicted " + std::to_string(predict_delay) + " steps? ahead"))
+        << output;
+  else
+    EXPECT_EQ(std::string::npos, output.find("deciding for the state predicted")) << output;
   std::printf(
       "five minutes of control on %s, seed %d's table, predict_delay %d: %.1f s balanced, the longest "
       "stretch %.1f s, %llu falls\n",
