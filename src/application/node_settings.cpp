@@ -395,6 +395,14 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   }
   useModelJoints(robot_engine, settings.robot);
   readRobotInterface(priv, settings.training.physics.tau, settings.robot);
+  // The model predicts one decision at a time, each physics/tau long: on a robot decided on at
+  // another period a step of its delay is not a step of the model.
+  if (run.predict_delay_steps > 0 && std::abs(settings.robot.decision_period - settings.training.physics.tau) > 1e-9)
+    priv.fail("predict_delay_steps", std::to_string(run.predict_delay_steps),
+              "the table's model predicts in decisions of physics/tau = " +
+                  SectionReader::numberText(settings.training.physics.tau) +
+                  " s: it needs ~decision_period = tau, not " +
+                  SectionReader::numberText(settings.robot.decision_period));
   protocol.commands_unstamped = settings.robot.command_type != CommandType::JointState;
   // The freshness guard's bound: a few decision periods, and no less than 0.1 s (a real-time
   // machine's hiccup is not a robot gone). 0 turns it off: a lockstep sim holds no command.

@@ -8,7 +8,8 @@
 // still fall in five minutes of all_at_once (docs/robust_tables.md). The seed is the .test's
 // `seed` argument (default 0): rostest cartpole_qlearning control_robot.test seed:=3; the robot is
 // the suite case the sim poses as (`suite`, `suite_case`; default all_at_once); `predict_delay`
-// is robot.launch's (default 0).
+// is robot.launch's (default 1: the posed robot answers a step late; give 0 for a case without a
+// delay, which a prediction drops).
 #include "cartpole_qlearning/ControlStats.h"
 
 #include "ros_test_support.h"

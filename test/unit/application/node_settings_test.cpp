@@ -210,6 +210,15 @@ TEST(ControllerSettings, APredictionOfTheRobotsDelayIsForAGreedyTable)
               "states it observes)");
   EXPECT_SAYS(controllerError("{mode: evaluate, predict_delay_steps: 51}", shared), "predict_delay_steps = 51");
   EXPECT_SAYS(controllerError("{mode: evaluate, predict_delay_steps: -1}", shared), "predict_delay_steps = -1");
+  // A step of the delay is a decision of physics/tau (0.02 s), as the model predicts it.
+  EXPECT_EQ(1u, readController("{mode: evaluate, predict_delay_steps: 1, decision_period: 0.02}", shared)
+                    .run.predict_delay_steps);
+  EXPECT_SAYS(
+      controllerError("{mode: evaluate, predict_delay_steps: 1, decision_period: 0.01}", shared),
+      "predict_delay_steps = 1 is not allowed (the table's model predicts in decisions of physics/tau = 0.02 s: "
+      "it needs ~decision_period = tau, not 0.01)");
+  EXPECT_SAYS(controllerError("{mode: evaluate, predict_delay_steps: 1, decision_period: 0}", shared),
+              "needs ~decision_period = tau, not 0)");
 }
 
 TEST(ControllerSettings, RefusesAnUnknownMode)

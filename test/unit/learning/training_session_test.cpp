@@ -339,19 +339,29 @@ TEST(TrainingSession, APredictionOfTheDelayIsForAGreedySessionOnly)
   table.setValues(values);
   ASSERT_EQ(greedy.replaceTable(table), "");
   ASSERT_EQ(shown.replaceTable(table), "");
+  // And not the action a session that does not predict takes on every state: the prediction counts.
+  TrainingSession observing(config.task, config.agent, 0, false);
+  ASSERT_EQ(observing.replaceTable(table), "");
   const CartPoleDynamics model(config.physics);
   CartPoleState state;
   state << 0.02, -0.1, 0.04, 0.3;
   double effort = greedy.beginEpisode(state);
   EXPECT_EQ(effort, shown.beginEpisode(model.step(state, 0.0)));
+  int differs = effort != observing.beginEpisode(state);
+  int decisions = 0;
   for (int step = 0; step < 20; ++step)
   {
     state = model.step(state, effort);
     const Decision decision = greedy.observe(state);
     const Decision expected = shown.observe(model.step(state, effort));
-    if (decision.episode_over || expected.episode_over)
+    const Decision observed = observing.observe(state);
+    if (decision.episode_over || expected.episode_over || observed.episode_over)
       break;
     EXPECT_EQ(decision.effort, expected.effort) << "step " << step;
+    differs += decision.effort != observed.effort;
+    ++decisions;
     effort = decision.effort;
   }
+  EXPECT_GE(decisions, 5);
+  EXPECT_GT(differs, 0);
 }
