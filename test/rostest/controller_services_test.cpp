@@ -226,7 +226,10 @@ TEST(ControllerServices, BadJointStatesAreDroppedAndASilentSimIsReported)
   // and says so again when states come back.
   ASSERT_TRUE(spinUntil([&] { return silent_reported; }, 20.0)) << "no report of the silent sim";
   // ... and stops the cart, which may hold its last command (ros_control's forward controllers).
-  EXPECT_TRUE(spinUntil([&] { return stops == 1; }, 5.0)) << "no zero effort after the states stopped";
+  // (At least one: the freshness guard's and the silence's stops may both come, a second zero
+  // being harmless; the sanitized CI run of 2026-12-03 once saw this wait fail with '== 1'.)
+  EXPECT_TRUE(spinUntil([&] { return stops >= 1; }, 5.0))
+      << "no zero effort after the states stopped: " << stops << " stops, " << commands << " commands";
   states.publish(make({"cart_joint", "pole_joint"}, {0.0, 0.01}, {0.0, 0.0}));
   EXPECT_TRUE(spinUntil([&] { return back_reported; }, 10.0));
   EXPECT_TRUE(spinUntil([&] { return commands == 2; }, 10.0));
