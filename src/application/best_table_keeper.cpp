@@ -65,6 +65,7 @@ LogLines BestTableKeeper::loadSuite()
                         (where.empty() ? std::string("no folder") : where) + ")");
     suite_ = std::make_unique<RobustnessSuite>(loadRobustnessSuite(suite_path_, config_));
     order_.clear();
+    falls_ = FallenEpisodes();
     for (std::size_t i = 0; i < suite_->cases.size(); ++i)
       order_.push_back(i);
   }
@@ -110,8 +111,9 @@ std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSessio
       best_every == 0 || s.episode % best_every == 0 || training_ends || (best_ && best_->result.passed());
   if (best_ && !passing_decides)
   {
-    SuiteResult quick = evaluateSuite(session.table(), config_, *suite_,
-                                      ranks ? againstTheBest(best_->result, order_) : SuiteRun::untilDecided(order_));
+    SuiteRun how = ranks ? againstTheBest(best_->result, order_) : SuiteRun::untilDecided(order_);
+    how.falls = &falls_;
+    SuiteResult quick = evaluateSuite(session.table(), config_, *suite_, how);
     failedCaseFirst(order_, quick, *suite_);
     if (!quick.reachedTargets())
     {

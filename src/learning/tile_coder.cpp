@@ -56,6 +56,15 @@ TileCoder::TileCoder(const TileCoderParams& params) : params_(params)
     for (unsigned i = 0; i < params_.tilings; ++i)
       offsets_[i][k] = (i * odd) % params_.tilings;
   }
+  const unsigned n = params_.tilings;
+  tiling_starts_.resize(n);
+  for (unsigned i = 0; i < n; ++i)
+    tiling_starts_[i] = static_cast<std::uint32_t>(i * tiles_per_tiling_);
+  carries_.assign(static_cast<std::size_t>(used_count_) * n * n, 0);
+  for (unsigned k = 0; k < used_count_; ++k)
+    for (unsigned part = 0; part < n; ++part)
+      for (unsigned i = 0; i < n; ++i)
+        carries_[(k * n + part) * n + i] = part + offsets_[i][k] >= n ? static_cast<std::uint32_t>(stride_[k]) : 0;
 }
 
 unsigned TileCoder::offset(unsigned tiling, std::size_t dimension) const
@@ -74,23 +83,27 @@ void TileCoder::activeTiles(const CartPoleState& state, std::uint32_t* tiles) co
   // Where the value falls on a grid n times finer than a tile: tiling i's tile is
   // (fine + offset_i) / n, so one division per dimension serves every tiling and a tile edge is
   // exactly a fine-cell edge. With fine = n * whole + part that is whole, plus one when
-  // part + offset_i reaches n.
-  std::array<unsigned, kStateDimensions> whole{};
-  std::array<unsigned, kStateDimensions> part{};
+  // part + offset_i reaches n: the carry, looked up per tiling (carries_).
+  std::uint32_t base = 0;
   for (unsigned k = 0; k < used_count_; ++k)
   {
     const std::size_t d = used_[k];
     const unsigned fine = uniformBin(state[d], params_.lower[d], params_.upper[d], params_.tiles[d] * n);
-    whole[k] = fine / n;
-    part[k] = fine - whole[k] * n;
+    const unsigned whole = fine / n;
+    base += static_cast<std::uint32_t>(stride_[k] * whole);
+    const std::uint32_t* carry = &carries_[(k * n + (fine - whole * n)) * n];
+    if (k == 0)
+      for (unsigned i = 0; i < n; ++i)
+        tiles[i] = tiling_starts_[i] + carry[i];
+    else
+      for (unsigned i = 0; i < n; ++i)
+        tiles[i] += carry[i];
   }
+  if (used_count_ == 0)
+    for (unsigned i = 0; i < n; ++i)
+      tiles[i] = tiling_starts_[i];
   for (unsigned i = 0; i < n; ++i)
-  {
-    std::size_t tile = i * tiles_per_tiling_;
-    for (unsigned k = 0; k < used_count_; ++k)
-      tile += stride_[k] * (whole[k] + (part[k] + offsets_[i][k] >= n ? 1 : 0));
-    tiles[i] = static_cast<std::uint32_t>(tile);
-  }
+    tiles[i] += base;
 }
 
 }  // namespace cartpole_qlearning

@@ -78,6 +78,8 @@ private:
   std::optional<BestTable> best_;
   // The order the next evaluation runs the cases in: the last to fall short first.
   std::vector<std::size_t> order_;
+  // The episodes each case last saw fall, tried first by the next evaluation (SuiteRun::falls).
+  FallenEpisodes falls_;
   // "; N other tables judged since the last line, none kept" for the next line said ("" when
   // none), and the count starts again.
   std::string othersNotKept();

@@ -59,6 +59,8 @@ struct CaseResult
   // (0: pass).
   std::uint64_t target = 0;
   std::uint64_t steps = 0;  // steps run over the episodes run (greedy steps: the verdict's cost)
+  // The episodes that fell, by their index in the case's draw (0 .. episodes - 1), in the order run.
+  std::vector<std::uint32_t> fallen{};
   bool passed() const
   {
     return balanced >= pass;
@@ -77,6 +79,28 @@ struct CaseResult
   }
 };
 
+// Whether a case's episodes can be run in any order: each episode's start and physics are drawn
+// at its reset and its steps draw nothing (no sensor noise, no pushes; the equations' engine), so
+// episode e is the same whatever the table did in the episodes before it. (A noisy case's
+// episode e meets the noise drawn after every step of the episodes before it: run in order only.)
+bool episodesRunInAnyOrder(const SuiteCase& suite_case);
+
+// What training remembers between evaluations, by suite case index: the episodes each case last
+// saw fall. A table that fell on an episode is likely to fall there again after one more training
+// episode; a case whose episodes run in any order (episodesRunInAnyOrder) tries those first
+// (SuiteRun::falls).
+struct FallenEpisodes
+{
+  // Evaluations a case is not probed for after a probe whose first episode balanced.
+  static constexpr unsigned kRest = 8;
+  struct Case
+  {
+    std::vector<std::uint32_t> fallen{};
+    unsigned rest = 0;
+  };
+  std::vector<Case> by_case;
+};
+
 // How a suite is run. The verdict (passed or not) is the same whatever these say: the episodes of
 // a case are drawn from its own stream, in order, so stopping early only leaves out episodes that
 // could not change it, and a case's result does not depend on which thread ran it.
@@ -92,6 +116,14 @@ struct SuiteRun
   std::function<std::uint64_t(const SuiteCase&)> target;
   // The cases' indices in the order to run them (each once); empty: as the suite lists them.
   std::vector<std::size_t> order;
+  // With stop_at_first_failure, a probe before the cases run in `order`: the cases whose episodes
+  // run in any order, those failed by the fewest falls first, each trying its remembered falls
+  // and then its other episodes in order. When a case falls as often as fails it the suite has
+  // failed (its result is that case, cut short); at the first episode that balances the probing
+  // ends and the cases run in `order` as without it. The verdict is the one without: the falls
+  // are the case's own episodes, and nothing else about the run changes. evaluateSuite leaves
+  // this evaluation's falls in it; null: no probe.
+  FallenEpisodes* falls = nullptr;
   // Cases run side by side on this many threads (0: one per core).
   unsigned threads = 0;
   // Each decision for the state the table's model predicts this many steps ahead (DelayPredictor:
@@ -131,6 +163,8 @@ struct SuiteResult
   // What a return means when the reward is not CartPole-v1's +1 a step ("sutton_barto's reward, 0 a
   // step, -1 on the fall"), printed under the rows; "" for gymnasium.
   std::string reward_note;
+  // Decided by SuiteRun::falls's probe: `cases` is the one case whose remembered falls fell again.
+  bool probed = false;
   bool passed() const;
   // A case run can no longer pass, whatever its episodes not run would give. (A suite stopped
   // against targets other than pass may be neither passed() nor failed(): not decided.)
@@ -169,9 +203,17 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
 SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite,
                           const SuiteRun& how = SuiteRun::complete());
 
+// Runs the given episodes of a case (by index in its draw; the case's episodes must run in any
+// order: episodesRunInAnyOrder) in that order, stopping at the first that balances or once
+// `falls_to_stop` have fallen. The result counts the episodes run (run, balanced, fallen, steps,
+// mean_return) out of `episodes`, the case's episodes.
+CaseResult evaluateEpisodes(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
+                            std::uint64_t episodes, std::uint64_t seed, const std::vector<std::uint32_t>& which,
+                            std::uint64_t falls_to_stop, std::uint64_t target = 0, unsigned predict_delay_steps = 0);
+
 // The order for the next evaluation during training: the case that fell short of its target last
-// comes first (the likeliest to again), the others keep their order. order: the indices of the
-// suite's cases.
+// comes first (the likeliest to again), the others keep their order (a result decided by the
+// probe leaves it as it is). order: the indices of the suite's cases.
 void failedCaseFirst(std::vector<std::size_t>& order, const SuiteResult& result, const RobustnessSuite& suite);
 
 // A mean return as printed with this many decimals: rounded there, a zero without its sign.

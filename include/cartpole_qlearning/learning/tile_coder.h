@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace cartpole_qlearning
 {
@@ -82,6 +83,13 @@ private:
   std::array<std::size_t, kStateDimensions> used_{};
   std::array<std::size_t, kStateDimensions> stride_{};
   std::array<std::array<unsigned, kStateDimensions>, kMaxTilings> offsets_{};
+  // What activeTiles adds per tiling, looked up rather than computed: each tiling's first tile
+  // number, and for used dimension k and a value's place `part` within its tile (in tilings-ths),
+  // carries_[(k * tilings + part) * tilings + i] is the stride of k when tiling i's displacement
+  // carries that value into the next tile, else 0. Every step of training and of the suite codes
+  // a state (8 tilings x 4 dimensions by default): two loops of additions over the tilings.
+  std::vector<std::uint32_t> tiling_starts_;
+  std::vector<std::uint32_t> carries_;
 };
 
 }  // namespace cartpole_qlearning

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <utility>
 #include <vector>
@@ -345,6 +346,137 @@ TEST(RobustnessSuite, TheCaseThatFailedLastIsTriedFirstNextTime)
   result.cases = {passed};
   failedCaseFirst(order, result, suite);
   EXPECT_EQ((std::vector<std::size_t>{5, 0, 1, 2, 3, 4, 6, 7}), order) << "nothing failed: nothing moves";
+}
+
+TEST(RobustnessSuite, OnlyCasesThatDrawNothingWhileTheyRunTakeTheirEpisodesInAnyOrder)
+{
+  const RobustnessSuite suite = loadRobustnessSuite(kSuite, TrainingConfig());
+  std::vector<std::string> any_order;
+  for (const SuiteCase& c : suite.cases)
+    if (episodesRunInAnyOrder(c))
+      any_order.push_back(c.name);
+  EXPECT_EQ((std::vector<std::string>{"nominal", "one_step_late", "masses_and_length", "weaker_motor", "wide_starts"}),
+            any_order);
+  const SuiteCase& noisy = suite.cases[2];
+  ASSERT_EQ("sensor_noise", noisy.name);
+  EXPECT_THROW(evaluateEpisodes(QTable(), TrainingConfig(), noisy, 10, 1000, {3}, 1), std::invalid_argument);
+}
+
+// Episode e of such a case, run alone and out of order, is episode e of the case run in order:
+// the same fall or balance, the same steps, the same return.
+TEST(RobustnessSuite, AnEpisodeRunOutOfOrderIsTheOneRunInOrder)
+{
+  const std::vector<QTable> tables = tablesAlongTraining();
+  const RobustnessSuite suite = shortSuite(12, 1000);
+  int falls = 0;
+  int balances = 0;
+  for (const QTable& table : tables)
+  {
+    for (const SuiteCase& c : suite.cases)
+    {
+      if (!episodesRunInAnyOrder(c))
+        continue;
+      TrainingConfig judged;
+      judged.task.max_episode_steps = suite.max_episode_steps;
+      const CaseResult in_order = evaluateCase(table, judged, c, suite.episodes, suite.seed);
+      std::uint64_t steps = 0;
+      double returns = 0.0;
+      for (std::uint32_t e = static_cast<std::uint32_t>(suite.episodes); e-- > 0;)  // last first
+      {
+        const CaseResult alone = evaluateEpisodes(table, judged, c, suite.episodes, suite.seed, {e}, 1);
+        ASSERT_EQ(1u, alone.run);
+        const bool fell_in_order =
+            std::find(in_order.fallen.begin(), in_order.fallen.end(), e) != in_order.fallen.end();
+        ASSERT_EQ(fell_in_order, alone.balanced == 0) << c.name << ", episode " << e;
+        EXPECT_EQ(fell_in_order ? std::vector<std::uint32_t>{e} : std::vector<std::uint32_t>{}, alone.fallen);
+        steps += alone.steps;
+        returns += alone.mean_return;
+        falls += fell_in_order ? 1 : 0;
+        balances += fell_in_order ? 0 : 1;
+      }
+      EXPECT_EQ(in_order.steps, steps) << c.name;
+      EXPECT_NEAR(in_order.mean_return * static_cast<double>(suite.episodes), returns, 1e-6) << c.name;
+    }
+  }
+  EXPECT_GT(falls, 50);
+  EXPECT_GT(balances, 50);
+}
+
+// Training's evaluations remember the falls (SuiteRun::falls) and try them first: over tables
+// from no learning to solved, evaluated one after another as training does, against the pass
+// marks and against targets other than them, the probe changes no verdict.
+TEST(RobustnessSuite, TriedFirstTheRememberedFallsGiveTheVerdictOfTheSuiteWithoutThem)
+{
+  const std::vector<QTable> tables = tablesAlongTraining();
+  int probed = 0;
+  int not_probed_failures = 0;
+  for (std::uint64_t seed : {1000u, 3u})
+  {
+    const RobustnessSuite suite = shortSuite(12, seed);
+    for (const std::uint64_t target : {std::uint64_t{0}, std::uint64_t{4}, std::uint64_t{12}})
+    {
+      FallenEpisodes falls;
+      std::vector<std::size_t> order{7, 0, 1, 2, 3, 4, 5, 6};
+      for (int round = 0; round < 2; ++round)
+      {
+        for (const QTable& table : tables)
+        {
+          SuiteRun plain = SuiteRun::untilDecided(order);
+          if (target > 0)
+            plain.target = [target](const SuiteCase&) { return target; };
+          SuiteRun probing = plain;
+          probing.falls = &falls;
+          const SuiteResult without = evaluateSuite(table, TrainingConfig(), suite, plain);
+          const SuiteResult with = evaluateSuite(table, TrainingConfig(), suite, probing);
+          ASSERT_EQ(without.passed(), with.passed()) << without.summary() << " | " << with.summary();
+          ASSERT_EQ(without.failed(), with.failed()) << without.summary() << " | " << with.summary();
+          ASSERT_EQ(without.reachedTargets(), with.reachedTargets()) << without.summary() << " | " << with.summary();
+          if (with.probed)
+          {
+            ++probed;
+            ASSERT_EQ(1u, with.cases.size());
+            EXPECT_TRUE(episodesRunInAnyOrder(
+                suite.cases[std::find_if(suite.cases.begin(), suite.cases.end(),
+                                         [&](const SuiteCase& c) { return c.name == with.cases[0].name; }) -
+                            suite.cases.begin()]));
+            EXPECT_FALSE(with.cases[0].reachedTarget());
+            EXPECT_NE(std::string::npos, with.summary().find("cases not run")) << with.summary();
+          }
+          else if (!with.reachedTargets())
+            ++not_probed_failures;
+        }
+      }
+    }
+  }
+  EXPECT_GT(probed, 20) << "the probe must decide some evaluations, else this test shows nothing";
+  EXPECT_GT(not_probed_failures, 0);
+}
+
+// The same table evaluated again: its remembered falls alone fail it, each tried falling.
+TEST(RobustnessSuite, ATableThatFellIsFailedAgainByTheEpisodesItFellOn)
+{
+  const RobustnessSuite suite = shortSuite(12, 1000);
+  int failed_again = 0;
+  for (const QTable& table : tablesAlongTraining())
+  {
+    FallenEpisodes falls;
+    SuiteRun how = SuiteRun::untilDecided({7, 0, 1, 2, 3, 4, 5, 6});
+    how.falls = &falls;
+    const SuiteResult first = evaluateSuite(table, TrainingConfig(), suite, how);
+    if (first.passed())
+      continue;
+    const SuiteResult second = evaluateSuite(table, TrainingConfig(), suite, how);
+    if (!second.probed)
+      continue;  // it failed only cases that draw while they run
+    const CaseResult& c = second.cases[0];
+    EXPECT_EQ(c.fallen.size(), c.run) << "every episode tried fell: " << second.summary();
+    EXPECT_EQ(c.episodes - c.pass + 1, c.run) << second.summary();
+    const SuiteResult third = evaluateSuite(table, TrainingConfig(), suite, how);
+    EXPECT_EQ(second.summary(), third.summary());
+    EXPECT_EQ(second.cases[0].fallen, third.cases[0].fallen);
+    ++failed_again;
+  }
+  EXPECT_GT(failed_again, 3);
 }
 
 TEST(RobustnessSuite, AnOrderThatDoesNotNameEachCaseOnceIsRefused)

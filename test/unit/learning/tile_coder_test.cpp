@@ -1,4 +1,5 @@
 #include "cartpole_qlearning/learning/q_learning_agent.h"
+#include "cartpole_qlearning/common/random.h"
 #include "cartpole_qlearning/learning/tile_coder.h"
 
 #include <gtest/gtest.h>
@@ -235,4 +236,52 @@ TEST(TileCodedAgent, AnUpdateSpreadsAlphaOverTheTilings)
   const cartpole_qlearning::QUpdate fall = agent.update(s, 0, 1.0, next, true, 0.5);
   EXPECT_DOUBLE_EQ(1.0, fall.target);
   EXPECT_DOUBLE_EQ(3.6 + 0.5 * (1.0 - 3.6), fall.new_value);
+}
+
+// activeTiles looks its carries up in a table built once; here each tiling's tile is worked out
+// from the definition (the value's cell on a grid tilings times finer than a tile, plus the
+// tiling's offset, divided by tilings), for random states inside and outside the bounds.
+TEST(TileCoder, TheTilesAreThoseOfTheDefinitionForEveryTiling)
+{
+  std::vector<TileCoderParams> shapes(4);
+  shapes[0].tilings = 8;  // config/robust.yaml's
+  shapes[0].tiles = {{3, 3, 8, 12}};
+  shapes[0].lower = {{-1.0, -1.0, -0.2094, -0.8727}};
+  shapes[0].upper = {{1.0, 1.0, 0.2094, 0.8727}};
+  shapes[1].tilings = 64;
+  shapes[1].tiles = {{2, 1, 5, 7}};
+  shapes[2].tilings = 3;
+  shapes[2].tiles = {{1, 4, 1, 1}};
+  shapes[3].tilings = 1;
+  shapes[3].tiles = {{2, 2, 2, 2}};
+  RandomStream rng(7, kEnvironmentStream);
+  for (const TileCoderParams& p : shapes)
+  {
+    const TileCoder coder(p);
+    const unsigned n = p.tilings;
+    for (int draw = 0; draw < 2000; ++draw)
+    {
+      CartPoleState state;
+      for (std::size_t d = 0; d < kStateDimensions; ++d)
+      {
+        const double span = p.upper[d] - p.lower[d];
+        state[d] = rng.uniform(p.lower[d] - 0.2 * span, p.upper[d] + 0.2 * span);
+      }
+      const Tiles tiles = active(coder, state);
+      for (unsigned i = 0; i < n; ++i)
+      {
+        std::size_t expected = i * coder.tilesPerTiling();
+        std::size_t stride = 1;
+        for (std::size_t d = kStateDimensions; d-- > 0;)
+        {
+          if (p.tiles[d] == 1)
+            continue;
+          const unsigned fine = uniformBin(state[d], p.lower[d], p.upper[d], p.tiles[d] * n);
+          expected += stride * ((fine + coder.offset(i, d)) / n);
+          stride *= p.tiles[d] + 1;
+        }
+        ASSERT_EQ(expected, tiles[i]) << "tilings " << n << ", tiling " << i << ", draw " << draw;
+      }
+    }
+  }
 }
