@@ -109,10 +109,13 @@ std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSessio
   const std::uint64_t best_every = config_.limits.best_every;
   const bool ranks =
       best_every == 0 || s.episode % best_every == 0 || training_ends || (best_ && best_->result.passed());
+  // Where the cut-short evaluation left each case: a table judged whole below goes on from there.
+  SuiteProgress progress;
   if (best_ && !passing_decides)
   {
     SuiteRun how = ranks ? againstTheBest(best_->result, order_) : SuiteRun::untilDecided(order_);
     how.falls = &falls_;
+    how.progress = &progress;
     SuiteResult quick = evaluateSuite(session.table(), config_, *suite_, how);
     failedCaseFirst(order_, quick, *suite_);
     if (!quick.reachedTargets())
@@ -138,7 +141,9 @@ std::optional<SuiteResult> BestTableKeeper::evaluateWhenDue(const TrainingSessio
       return quick;
     }
   }
-  SuiteResult result = evaluateSuite(session.table(), config_, *suite_);
+  SuiteRun whole = SuiteRun::complete();
+  whole.progress = &progress;
+  SuiteResult result = evaluateSuite(session.table(), config_, *suite_, whole);
   if (!best_ || better(result, best_->result))
     best_ = BestTable{session.table(), result, s.episode};
   log.push_back(

@@ -253,23 +253,41 @@ bool episodesRunInAnyOrder(const SuiteCase& suite_case)
 
 CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
                         std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided, std::uint64_t target,
-                        unsigned predict_delay_steps)
+                        unsigned predict_delay_steps, SuiteProgress::Case* progress)
 {
   GreedyEpisodes greedy(table, config, predict_delay_steps);
-  CartPoleSimulation simulation = makeSimulation(suite_case.physics, suite_case.engine, suite_case.start_state_bound,
-                                                 seed, suite_case.perturbations);
+  std::unique_ptr<CartPoleSimulation> simulation;
   CaseResult result = startResult(suite_case, episodes, target);
+  double returns = 0.0;
+  if (progress != nullptr && progress->simulation && progress->result.episodes == episodes &&
+      progress->result.name == suite_case.name)
+  {
+    // Going on where an evaluation of this table stopped: its counts, with this run's target.
+    simulation = std::move(progress->simulation);
+    result = std::move(progress->result);
+    result.target = target;
+    result.pass = suite_case.pass;
+    returns = progress->returns;
+  }
+  else
+    simulation = std::make_unique<CartPoleSimulation>(makeSimulation(
+        suite_case.physics, suite_case.engine, suite_case.start_state_bound, seed, suite_case.perturbations));
   // Decided once target episodes balanced, or once more fell than that allows.
   const std::uint64_t decided_at = result.decidedAgainst();
   const std::uint64_t falls_to_fail = fallsToFail(result);
-  double returns = 0.0;
-  for (std::uint64_t e = 0; e < episodes; ++e)
-  {
-    greedy.run(simulation, static_cast<std::uint32_t>(e), result, returns);
-    if (stop_when_decided && (result.balanced >= decided_at || result.run - result.balanced >= falls_to_fail))
-      break;
-  }
+  const auto decided = [&]() {
+    return stop_when_decided && (result.balanced >= decided_at || result.run - result.balanced >= falls_to_fail);
+  };
+  // Decided is asked after each episode (a case runs at least one).
+  for (std::uint64_t e = result.run; e < episodes && !(e > 0 && decided()); ++e)
+    greedy.run(*simulation, static_cast<std::uint32_t>(e), result, returns);
   result.mean_return = result.run > 0 ? returns / static_cast<double>(result.run) : 0.0;
+  if (progress != nullptr)
+  {
+    progress->simulation = std::move(simulation);
+    progress->result = result;
+    progress->returns = returns;
+  }
   return result;
 }
 
@@ -379,6 +397,9 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
     }
   }
 
+  if (how.progress != nullptr)
+    how.progress->by_case.resize(suite.cases.size());
+
   // Positions are taken in order, so when the case at position p fails every position before p
   // has been taken and runs to its end: the cases kept (up to the first failure) are the same
   // whatever the number of threads. A complete verdict keeps every case, so it takes the costliest
@@ -405,8 +426,9 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
       try
       {
         const SuiteCase& c = suite.cases[order[p]];
-        results[p] = evaluateCase(table, judged, c, suite.episodes, suite.seed, how.stop_cases_when_decided,
-                                  targetOf(c), how.predict_delay_steps);
+        results[p] =
+            evaluateCase(table, judged, c, suite.episodes, suite.seed, how.stop_cases_when_decided, targetOf(c),
+                         how.predict_delay_steps, how.progress != nullptr ? &how.progress->by_case[order[p]] : nullptr);
       }
       catch (...)
       {

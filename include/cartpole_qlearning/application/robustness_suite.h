@@ -7,10 +7,12 @@
 
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/learning/q_table.h"
+#include "cartpole_qlearning/simulation/cartpole_simulation.h"
 
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -101,6 +103,21 @@ struct FallenEpisodes
   std::vector<Case> by_case;
 };
 
+// Where each case of an evaluation stopped, by suite case index: the simulation ready for its next
+// episode (its draws where the episodes run left them), and the counts so far. An evaluation of the
+// same table that asks more of a case goes on from there instead of running its first episodes
+// again (SuiteRun::progress).
+struct SuiteProgress
+{
+  struct Case
+  {
+    std::unique_ptr<CartPoleSimulation> simulation;  // null: the case starts from its first episode
+    CaseResult result;
+    double returns = 0.0;  // summed in the order run, as a case run whole sums them
+  };
+  std::vector<Case> by_case;
+};
+
 // How a suite is run. The verdict (passed or not) is the same whatever these say: the episodes of
 // a case are drawn from its own stream, in order, so stopping early only leaves out episodes that
 // could not change it, and a case's result does not depend on which thread ran it.
@@ -124,6 +141,12 @@ struct SuiteRun
   // are the case's own episodes, and nothing else about the run changes. evaluateSuite leaves
   // this evaluation's falls in it; null: no probe.
   FallenEpisodes* falls = nullptr;
+  // Where the cases of an earlier evaluation of the same table stopped: each case run in order goes
+  // on from there (its episodes and draws are those it would meet from the start, so the result
+  // is the same), and leaves where it stops now. Training judges whole a table whose cut-short
+  // evaluation reached its targets: the episodes that one ran are not run twice. The caller
+  // keeps it to one table. Null: every case from its first episode.
+  SuiteProgress* progress = nullptr;
   // Cases run side by side on this many threads (0: one per core).
   unsigned threads = 0;
   // Each decision for the state the table's model predicts this many steps ahead (DelayPredictor:
@@ -197,9 +220,11 @@ struct SuiteResult
 // Throws ConfigError when the table does not fit the configuration.
 // stop_when_decided: stop once the case has `target` balanced episodes or can no longer reach
 // it (0: the case's pass). predict_delay_steps: as SuiteRun's (the model: config's physics).
+// progress: as SuiteRun's, for this case (null: from the first episode, nothing kept).
 CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
                         std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided = false,
-                        std::uint64_t target = 0, unsigned predict_delay_steps = 0);
+                        std::uint64_t target = 0, unsigned predict_delay_steps = 0,
+                        SuiteProgress::Case* progress = nullptr);
 SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, const RobustnessSuite& suite,
                           const SuiteRun& how = SuiteRun::complete());
 

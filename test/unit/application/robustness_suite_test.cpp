@@ -479,6 +479,49 @@ TEST(RobustnessSuite, ATableThatFellIsFailedAgainByTheEpisodesItFellOn)
   EXPECT_GT(failed_again, 3);
 }
 
+// Training judges whole a table whose cut-short evaluation reached its targets; the whole verdict
+// goes on from where each case stopped (SuiteRun::progress) and is the one run from the start:
+// every count, every mean return to the bit, whatever the thread count.
+TEST(RobustnessSuite, AWholeVerdictGoingOnFromACutShortOneIsTheOneRunFromTheStart)
+{
+  const std::vector<QTable> tables = tablesAlongTraining();
+  const RobustnessSuite suite = shortSuite(12, 1000);
+  int went_on = 0;
+  for (const QTable& table : tables)
+  {
+    const SuiteResult fresh = evaluateSuite(table, TrainingConfig(), suite);
+    for (const std::uint64_t target : {std::uint64_t{1}, std::uint64_t{6}, std::uint64_t{12}})
+    {
+      for (const unsigned threads : {1u, 2u})
+      {
+        SuiteProgress progress;
+        SuiteRun quick = SuiteRun::untilDecided({7, 0, 1, 2, 3, 4, 5, 6});
+        quick.target = [target](const SuiteCase&) { return target; };
+        quick.progress = &progress;
+        quick.threads = threads;
+        const SuiteResult cut = evaluateSuite(table, TrainingConfig(), suite, quick);
+        ASSERT_EQ(suite.cases.size(), progress.by_case.size());
+        for (const SuiteProgress::Case& c : progress.by_case)
+          went_on += c.simulation && c.result.run > 0 && c.result.run < c.result.episodes ? 1 : 0;
+        SuiteRun whole = SuiteRun::complete();
+        whole.progress = &progress;
+        whole.threads = threads;
+        const SuiteResult result = evaluateSuite(table, TrainingConfig(), suite, whole);
+        ASSERT_EQ(fresh.summary(), result.summary()) << "after " << cut.summary();
+        ASSERT_EQ(fresh.cases.size(), result.cases.size());
+        for (std::size_t i = 0; i < fresh.cases.size(); ++i)
+        {
+          EXPECT_TRUE(sameCase(fresh.cases[i], result.cases[i])) << fresh.cases[i].name << " after " << cut.summary();
+          EXPECT_EQ(fresh.cases[i].steps, result.cases[i].steps) << fresh.cases[i].name;
+          EXPECT_EQ(fresh.cases[i].fallen, result.cases[i].fallen) << fresh.cases[i].name;
+          EXPECT_EQ(fresh.cases[i].target, result.cases[i].target) << fresh.cases[i].name;
+        }
+      }
+    }
+  }
+  EXPECT_GT(went_on, 20) << "some cases must go on from the middle, else this test shows nothing";
+}
+
 TEST(RobustnessSuite, AnOrderThatDoesNotNameEachCaseOnceIsRefused)
 {
   const RobustnessSuite suite = shortSuite(2, 1000);
