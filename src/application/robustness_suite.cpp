@@ -251,9 +251,12 @@ bool episodesRunInAnyOrder(const SuiteCase& suite_case)
          !(p.push_probability > 0.0 && p.push_force != 0.0);
 }
 
-CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
-                        std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided, std::uint64_t target,
-                        unsigned predict_delay_steps, SuiteProgress::Case* progress)
+namespace
+{
+// evaluateCase, abandoned between episodes once `abandoned` says its result will not be used.
+CaseResult runCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
+                   std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided, std::uint64_t target,
+                   unsigned predict_delay_steps, SuiteProgress::Case* progress, const std::function<bool()>& abandoned)
 {
   GreedyEpisodes greedy(table, config, predict_delay_steps);
   std::unique_ptr<CartPoleSimulation> simulation;
@@ -279,7 +282,7 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
     return stop_when_decided && (result.balanced >= decided_at || result.run - result.balanced >= falls_to_fail);
   };
   // Decided is asked after each episode (a case runs at least one).
-  for (std::uint64_t e = result.run; e < episodes && !(e > 0 && decided()); ++e)
+  for (std::uint64_t e = result.run; e < episodes && !(e > 0 && decided()) && !(abandoned && abandoned()); ++e)
     greedy.run(*simulation, static_cast<std::uint32_t>(e), result, returns);
   result.mean_return = result.run > 0 ? returns / static_cast<double>(result.run) : 0.0;
   if (progress != nullptr)
@@ -289,6 +292,15 @@ CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const
     progress->returns = returns;
   }
   return result;
+}
+}  // namespace
+
+CaseResult evaluateCase(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
+                        std::uint64_t episodes, std::uint64_t seed, bool stop_when_decided, std::uint64_t target,
+                        unsigned predict_delay_steps, SuiteProgress::Case* progress)
+{
+  return runCase(table, config, suite_case, episodes, seed, stop_when_decided, target, predict_delay_steps, progress,
+                 {});
 }
 
 CaseResult evaluateEpisodes(const QTable& table, const TrainingConfig& config, const SuiteCase& suite_case,
@@ -426,9 +438,14 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
       try
       {
         const SuiteCase& c = suite.cases[order[p]];
+        // A case after one that has failed is not part of the result: it stops at its next episode
+        // (run to its end, it kept the suite's answer waiting: a case that passes runs 3000-step
+        // episodes for a hundred of them).
+        const auto abandoned = [&first_failure, p]() { return p > first_failure.load(); };
         results[p] =
-            evaluateCase(table, judged, c, suite.episodes, suite.seed, how.stop_cases_when_decided, targetOf(c),
-                         how.predict_delay_steps, how.progress != nullptr ? &how.progress->by_case[order[p]] : nullptr);
+            runCase(table, judged, c, suite.episodes, suite.seed, how.stop_cases_when_decided, targetOf(c),
+                    how.predict_delay_steps, how.progress != nullptr ? &how.progress->by_case[order[p]] : nullptr,
+                    how.stop_at_first_failure ? std::function<bool()>(abandoned) : std::function<bool()>());
       }
       catch (...)
       {
