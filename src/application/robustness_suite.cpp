@@ -7,6 +7,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#ifdef __linux__
+#include <sched.h>
+#endif
+
 #include <algorithm>
 #include <atomic>
 #include <exception>
@@ -24,6 +28,20 @@ namespace cartpole_qlearning
 {
 namespace
 {
+// The cores this process may run on: under taskset or a container's cpuset fewer than the
+// machine has (std::thread::hardware_concurrency counts the machine's), and a second thread on
+// one core only takes turns with the first.
+unsigned usableCores()
+{
+#ifdef __linux__
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) == 0)
+    return static_cast<unsigned>(std::max(1, CPU_COUNT(&allowed)));
+#endif
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
 std::uint64_t wholeNumber(const YAML::Node& node, const std::string& where, std::uint64_t min, std::uint64_t max)
 {
   long long value = 0;
@@ -464,7 +482,7 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
       }
     }
   };
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned cores = usableCores();
   std::size_t threads = std::min<std::size_t>(how.threads > 0 ? how.threads : cores, order.size());
   // MuJoCo's XML loading is not documented as thread-safe: cases on a model run one after another.
   if (std::any_of(suite.cases.begin(), suite.cases.end(),

@@ -147,7 +147,7 @@ struct SuiteRun
   // evaluation reached its targets: the episodes that one ran are not run twice. The caller
   // keeps it to one table. Null: every case from its first episode.
   SuiteProgress* progress = nullptr;
-  // Cases run side by side on this many threads (0: one per core).
+  // Cases run side by side on this many threads (0: one per core this process may use).
   unsigned threads = 0;
   // Each decision for the state the table's model predicts this many steps ahead (DelayPredictor:
   // a controller that knows its robot answers late); 0: for the state observed.
