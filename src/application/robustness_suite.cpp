@@ -280,7 +280,7 @@ CaseResult runCase(const QTable& table, const TrainingConfig& config, const Suit
   std::unique_ptr<CartPoleSimulation> simulation;
   CaseResult result = startResult(suite_case, episodes, target);
   double returns = 0.0;
-  if (progress != nullptr && progress->simulation && progress->result.episodes == episodes &&
+  if (progress != nullptr && !stop_when_decided && progress->simulation && progress->result.episodes == episodes &&
       progress->result.name == suite_case.name)
   {
     // Going on where an evaluation of this table stopped: its counts, with this run's target.
@@ -299,7 +299,8 @@ CaseResult runCase(const QTable& table, const TrainingConfig& config, const Suit
   const auto decided = [&]() {
     return stop_when_decided && (result.balanced >= decided_at || result.run - result.balanced >= falls_to_fail);
   };
-  // Decided is asked after each episode (a case runs at least one).
+  // Decided is asked after each episode run here (a case started afresh runs at least one); an
+  // abandoned case stops before its next.
   for (std::uint64_t e = result.run; e < episodes && !(e > 0 && decided()) && !(abandoned && abandoned()); ++e)
     greedy.run(*simulation, static_cast<std::uint32_t>(e), result, returns);
   result.mean_return = result.run > 0 ? returns / static_cast<double>(result.run) : 0.0;
@@ -382,30 +383,37 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
   if (falls != nullptr)
   {
     falls->by_case.resize(suite.cases.size());
-    // The cases failed by the fewest falls first.
-    std::vector<std::pair<std::uint64_t, std::size_t>> probes;
-    for (const std::size_t index : order)
+    // The case failed by the fewest falls (the first in `order` of those), unless it rests.
+    std::uint64_t needed = 0;
+    std::size_t index = suite.cases.size();
+    for (const std::size_t i : order)
     {
-      const SuiteCase& c = suite.cases[index];
-      FallenEpisodes::Case& memory = falls->by_case[index];
-      const std::uint64_t needed = fallsToFail(startResult(c, suite.episodes, targetOf(c)));
-      if (needed == 0 || !episodesRunInAnyOrder(c))
+      const SuiteCase& c = suite.cases[i];
+      FallenEpisodes::Case& memory = falls->by_case[i];
+      const std::uint64_t falls_to_fail = fallsToFail(startResult(c, suite.episodes, targetOf(c)));
+      if (falls_to_fail == 0 || !episodesRunInAnyOrder(c))
         continue;
       if (memory.rest > 0)
         --memory.rest;
-      else
-        probes.emplace_back(needed, index);
+      else if (index == suite.cases.size() || falls_to_fail < needed)
+      {
+        needed = falls_to_fail;
+        index = i;
+      }
     }
-    std::stable_sort(probes.begin(), probes.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& [needed, index] : probes)
+    if (index < suite.cases.size())
     {
       const SuiteCase& c = suite.cases[index];
       FallenEpisodes::Case& memory = falls->by_case[index];
       // Its remembered falls, then its other episodes in order, until one balances.
-      std::vector<std::uint32_t> which = memory.fallen;
+      std::vector<std::uint32_t> which;
       std::vector<bool> listed(suite.episodes, false);
-      for (const std::uint32_t e : which)
-        listed[e] = true;
+      for (const std::uint32_t e : memory.fallen)
+        if (e < suite.episodes && !listed[e])
+        {
+          listed[e] = true;
+          which.push_back(e);
+        }
       for (std::uint32_t e = 0; e < suite.episodes; ++e)
         if (!listed[e])
           which.push_back(e);
@@ -418,12 +426,10 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
         result.probed = true;
         return result;
       }
-      // It balanced one: no more probing (the table is not the one that fell), and a case whose
-      // first episode tried balanced rests a while (a table that passes it pays a balanced
-      // episode for nothing at every evaluation).
+      // It balanced one: the cases run in order. A case whose first episode tried balanced rests a
+      // while (a table that passes it would pay a balanced episode for nothing at every evaluation).
       if (probed.fallen.empty())
         memory.rest = FallenEpisodes::kRest;
-      break;
     }
   }
 
@@ -510,8 +516,8 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
 
 void failedCaseFirst(std::vector<std::size_t>& order, const SuiteResult& result, const RobustnessSuite& suite)
 {
-  // A probe's case is tried before the order anyway; moved to the front it would run whole,
-  // before the case that failed in order, once its remembered falls balance.
+  // A probe's case is left where it is: the probe tries it again next time (its falls are
+  // remembered), and moved to the front it would run in order, whole, once they balance.
   if (result.probed)
     return;
   for (const CaseResult& c : result.cases)

@@ -163,12 +163,12 @@ std::size_t QLearningAgent::bestAction(const QTable& table, const ActiveRows& st
     // Two actions (every shipped configuration): the sums in the same order as below, held in
     // registers (the general loop copied the first row through memcpy and kept q in memory: a
     // quarter of a suite step, perf).
-    const double* row = values + state.rows[0] * 2;
+    const double* row = values + state.rows[0] * std::size_t{2};
     double q0 = row[0];
     double q1 = row[1];
     for (unsigned i = 1; i < state.count; ++i)
     {
-      row = values + state.rows[i] * 2;
+      row = values + state.rows[i] * std::size_t{2};
       q0 += row[0];
       q1 += row[1];
     }

@@ -133,19 +133,25 @@ struct SuiteRun
   std::function<std::uint64_t(const SuiteCase&)> target;
   // The cases' indices in the order to run them (each once); empty: as the suite lists them.
   std::vector<std::size_t> order;
-  // With stop_at_first_failure, a probe before the cases run in `order`: the cases whose episodes
-  // run in any order, those failed by the fewest falls first, each trying its remembered falls
-  // and then its other episodes in order. When a case falls as often as fails it the suite has
-  // failed (its result is that case, cut short); at the first episode that balances the probing
-  // ends and the cases run in `order` as without it. The verdict is the one without: the falls
-  // are the case's own episodes, and nothing else about the run changes. evaluateSuite leaves
-  // this evaluation's falls in it; null: no probe.
+  // With stop_at_first_failure, a probe before the cases run in `order`: of the cases whose
+  // episodes run in any order, the one failed by the fewest falls (unless it rests after a probe
+  // whose first episode balanced) tries its remembered falls and then its other episodes in
+  // order. When it falls as often as keeps it from its target the suite has not reached its
+  // targets (its result is that case, cut short); at the first episode that balances the cases
+  // run in `order` as without it. passed()
+  // and reachedTargets() are those without: the falls are the case's own episodes, and nothing
+  // else about the run changes. (Which cases are listed, and with targets other than the pass
+  // marks whether failed() can say so yet, may differ: a probe can stop at a case that is short of
+  // its target but not of its pass mark.) evaluateSuite leaves this evaluation's falls in it;
+  // null: no probe.
   FallenEpisodes* falls = nullptr;
-  // Where the cases of an earlier evaluation of the same table stopped: each case run in order goes
-  // on from there (its episodes and draws are those it would meet from the start, so the result
-  // is the same), and leaves where it stops now. Training judges whole a table whose cut-short
-  // evaluation reached its targets: the episodes that one ran are not run twice. The caller
-  // keeps it to one table. Null: every case from its first episode.
+  // Where the cases of an earlier evaluation of the same table stopped, and where each case run in
+  // order stops now. A complete run (stop_cases_when_decided false) goes on from there: its
+  // episodes and draws are those it would meet from the start, and every episode runs, so the
+  // result is the same. (A run that stops when decided starts afresh: the earlier run may have
+  // gone past where it would stop.) Training judges whole a table whose cut-short evaluation
+  // reached its targets: the episodes that one ran are not run twice. The caller keeps it to one
+  // table, configuration and suite. Null: every case from its first episode.
   SuiteProgress* progress = nullptr;
   // Cases run side by side on this many threads (0: one per core this process may use).
   unsigned threads = 0;
@@ -186,7 +192,7 @@ struct SuiteResult
   // What a return means when the reward is not CartPole-v1's +1 a step ("sutton_barto's reward, 0 a
   // step, -1 on the fall"), printed under the rows; "" for gymnasium.
   std::string reward_note;
-  // Decided by SuiteRun::falls's probe: `cases` is the one case whose remembered falls fell again.
+  // Decided by SuiteRun::falls's probe: `cases` is the one case the probe found short of its target.
   bool probed = false;
   bool passed() const;
   // A case run can no longer pass, whatever its episodes not run would give. (A suite stopped
