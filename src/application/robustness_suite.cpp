@@ -377,8 +377,8 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
   // failed by one fall, where the case that failed last (first in `order`) may need several
   // long episodes to fall as often as fails it (all_at_once: 6 of 100, each balanced episode
   // before them 3000 steps). Seed 0's robust.yaml run: 350 of 389 tables sampled that failed
-  // the suite failed nominal too, and a table refuted by a probe cost about 1,100 steps where
-  // all_at_once took 33,000.
+  // the suite failed nominal too; 1,646 of its evaluations were then decided by the probe at
+  // about 400 greedy steps each, where all_at_once took 33,000 (docs/benchmarks.md).
   FallenEpisodes* const falls = how.stop_at_first_failure ? how.falls : nullptr;
   if (falls != nullptr)
   {
