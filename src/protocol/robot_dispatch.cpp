@@ -58,6 +58,7 @@ RobotDispatch::Orders RobotDispatch::onInvalid(std::size_t r, Stamp stamp, WallC
                                                const std::string& publisher)
 {
   Orders orders;
+  robots_.at(r).last_message = now;
   robots_.at(r).guard.onMessage(stamp, false, publisher, now, orders.log);
   orders.drop = true;
   return orders;
@@ -68,6 +69,7 @@ RobotDispatch::Orders RobotDispatch::onState(std::size_t r, Stamp stamp, const J
 {
   Robot& robot = robots_.at(r);
   Orders orders;
+  robot.last_message = now;
   if (!robot.guard.onMessage(stamp, true, publisher, now, orders.log))
   {
     orders.drop = true;
@@ -124,9 +126,14 @@ RobotDispatch::Orders RobotDispatch::onTick(WallClock::time_point now)
     robot.silent_reported = true;
     if (orders.stop.empty() || orders.stop.back() != r)
       orders.stop.push_back(r);
+    const bool publishing = robot.last_message && now - *robot.last_message < silent_after;
     orders.log.push_back(
         {LogLine::Level::Warn,
-         params_.simulated
+         publishing
+             ? formatText("no usable joint_states on %s for %.1f s: they keep coming, but none could be used (see "
+                          "the warnings about them above). Waiting for usable ones",
+                          robot.name.c_str(), params_.silent_after_s)
+         : params_.simulated
              ? formatText("no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting for it",
                           robot.name.c_str(), params_.silent_after_s)
              : formatText("no joint_states on %s for %.1f s: no driver publishes them. Is the robot's driver running, "

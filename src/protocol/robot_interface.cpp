@@ -61,7 +61,7 @@ CartPoleState StateMapping::map(Stamp stamp, const JointReadings& r)
 }
 
 DecisionClock::DecisionClock(double period_s)
-  : period_(period_s > 0.0 ? static_cast<Stamp>(std::llround(period_s * 1e9)) : 0), tolerance_(period_ / 20)
+  : period_(period_s > 0.0 ? static_cast<Stamp>(std::llround(period_s * 1e9)) : 0), tolerance_(period_ / 5)
 {
 }
 
@@ -70,18 +70,31 @@ DecisionClock::Verdict DecisionClock::onState(Stamp stamp)
   Verdict verdict;
   if (period_ == 0 || stamp == 0)
     return verdict;
+  if (last_ && stamp == *last_)
+    return verdict;  // a repeat: the protocol answers it
   if (last_ && stamp > *last_)
   {
-    const Stamp gap = stamp - *last_;
-    if (gap + tolerance_ < period_)
+    // Decisions keep to a grid of due times a period apart, not to the last state's stamp: a
+    // real-time driver's jitter would otherwise make every state that comes a little early miss
+    // its decision, and the next one come two periods after the last.
+    if (stamp + tolerance_ < due_)
     {
       verdict.decide = false;
       return verdict;
     }
-    verdict.slow = gap > period_ + period_ / 2;
+    // The rate, not one gap, is slow or not: a moving mean of the decided states' gaps.
+    const double gap = static_cast<double>(stamp - *last_);
+    mean_gap_ = mean_gap_ > 0.0 ? 0.9 * mean_gap_ + 0.1 * gap : gap;
+    verdict.slow = mean_gap_ > 1.5 * static_cast<double>(period_);
+    // Half a period or more behind the grid (a slower driver, a gap, a clock that drifts): the
+    // grid starts again here.
+    due_ = (stamp < due_ + period_ / 2 ? due_ : stamp) + period_;
   }
-  if (!last_ || stamp != *last_)
-    last_ = stamp;
+  else
+  {
+    due_ = stamp + period_;  // the first state, or time set back (the protocol judges it)
+  }
+  last_ = stamp;
   return verdict;
 }
 

@@ -111,6 +111,9 @@ private:
     Stamp held_stamp = 0;  // a new state waiting for its round
     CartPoleState held_state;
     bool silent_reported = false;
+    // The last message of any kind, valid or not: a driver that publishes only what cannot be
+    // used (NaN, its joints missing) is not silent, and the warning says so.
+    std::optional<WallClock::time_point> last_message;
   };
   struct Waiting
   {

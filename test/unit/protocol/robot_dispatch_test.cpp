@@ -231,6 +231,22 @@ TEST_F(RobotDispatchTest, ARobotsSilenceNamesItsStateTopicAndItsDriverNotASim)
   EXPECT_EQ(std::string::npos, text(orders.log).find("cartpole_sim"));
 }
 
+TEST_F(RobotDispatchTest, ADriverThatPublishesOnlyUnusableStatesIsNotSaidToPublishNothing)
+{
+  params_.simulated = false;
+  RobotDispatch& dispatch = make(1);
+  // NaN states at 50 Hz (the node drops them as invalid): the driver is there, its states are not.
+  for (int ms = 0; ms < 1000; ms += 20)
+    dispatch.onInvalid(0, tick(1) + static_cast<Stamp>(ms) * kMs, kT0 + milliseconds(ms), "/driver");
+  const RobotDispatch::Orders orders = dispatch.onTick(kT0 + milliseconds(1000));
+  EXPECT_EQ(std::vector<std::size_t>{0}, orders.stop);
+  EXPECT_EQ(
+      "no usable joint_states on /robot_0/joint_states for 1.0 s: they keep coming, but none could be used (see the "
+      "warnings about them above). Waiting for usable ones\n",
+      text(orders.log));
+  EXPECT_TRUE(dispatch.onTick(kT0 + milliseconds(1500)).log.empty()) << "said once";
+}
+
 TEST_F(RobotDispatchTest, AFailedResetKeepsASpinningPoleFromStartingEpisodesUntilItIsInTheStartRegion)
 {
   RobotDispatch& dispatch = make(1);

@@ -133,6 +133,37 @@ TEST(DecisionClock, SlowerStatesAreEachDecidedAndSaidSlow)
   EXPECT_TRUE(v.slow);
 }
 
+TEST(DecisionClock, AJitteryDriverIsDecidedOnceAPeriodAndNotSaidSlowButAThirtyHertzOneIs)
+{
+  // A real-time driver's states 20 ms apart give or take 3 ms (a state often comes a little early
+  // for a decision a period after the last decided one): each is decided, none said slow. At
+  // 100 Hz with the same jitter, every other one is decided.
+  for (const Stamp every : {20 * kMs, 10 * kMs})
+  {
+    DecisionClock clock(0.02);
+    int decided = 0;
+    int slow = 0;
+    for (Stamp i = 0; i < 3000; ++i)
+    {
+      const Stamp jitter = static_cast<Stamp>((i * 7919) % 31) * 200000 - 3000000;  // -3 .. +3 ms
+      const DecisionClock::Verdict v = clock.onState(1000 * kMs + every * i + jitter);
+      decided += v.decide ? 1 : 0;
+      slow += v.slow ? 1 : 0;
+    }
+    EXPECT_EQ(every == 20 * kMs ? 3000 : 1500, decided) << every;
+    EXPECT_EQ(0, slow) << every;
+  }
+  // A 30 Hz driver: every state is decided, and the rate is said slow from the start.
+  DecisionClock thirty(0.02);
+  thirty.onState(1000 * kMs);
+  for (Stamp s = 1033 * kMs; s < 2000 * kMs; s += 33 * kMs)
+  {
+    const DecisionClock::Verdict v = thirty.onState(s);
+    EXPECT_TRUE(v.decide);
+    EXPECT_TRUE(v.slow);
+  }
+}
+
 TEST(DecisionClock, TimeSetBackAndUnstampedStatesPassAndAPeriodOfZeroDecidesEveryMessage)
 {
   DecisionClock clock(0.02);
