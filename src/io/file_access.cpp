@@ -1,5 +1,6 @@
 #include "cartpole_qlearning/io/file_access.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdlib>
@@ -151,7 +152,8 @@ Located locate(Descriptor base, const std::string& base_path, const std::string&
   return located;
 }
 
-std::string readOpenFile(const Descriptor& fd, const std::string& shown, std::uint64_t max_bytes)
+std::string readOpenFile(const Descriptor& fd, const std::string& shown, std::uint64_t max_bytes,
+                         const SizeFromHead& size_from_head)
 {
   struct stat status;
   if (::fstat(fd.get(), &status) != 0)
@@ -167,8 +169,27 @@ std::string readOpenFile(const Descriptor& fd, const std::string& shown, std::ui
            std::to_string(max_bytes) + ")");
   std::string text;
   char buffer[65536];
+  // A file longer than its head is held to the size its head claims before the rest is read.
+  bool head_judged = !size_from_head || static_cast<std::uint64_t>(status.st_size) <= kHeadBytes;
   for (;;)
   {
+    if (!head_judged && text.size() >= kHeadBytes)
+    {
+      head_judged = true;
+      std::uint64_t claimed = 0;
+      try
+      {
+        claimed = size_from_head(text.substr(0, kHeadBytes));
+      }
+      catch (const FileError& e)
+      {
+        refuse(shown + ": " + e.what());
+      }
+      if (static_cast<std::uint64_t>(status.st_size) > claimed)
+        refuse(shown + ": " + std::to_string(status.st_size) +
+               " bytes, more than its own beginning says it can have (" + std::to_string(claimed) + ")");
+      max_bytes = std::min(max_bytes, claimed);
+    }
     const ssize_t n = ::read(fd.get(), buffer, sizeof buffer);
     if (n < 0 && errno == EINTR)
       continue;
@@ -316,7 +337,8 @@ std::string resolvePathUnder(const std::string& directory, const std::string& pa
   return (fs::absolute(directory).lexically_normal() / relative).string();
 }
 
-std::string readFileUnder(const std::string& directory, const std::string& path, std::uint64_t max_bytes)
+std::string readFileUnder(const std::string& directory, const std::string& path, std::uint64_t max_bytes,
+                          const SizeFromHead& size_from_head)
 {
   const std::string relative = relativePathUnder(directory, path);
   const std::string base = fs::absolute(directory).lexically_normal().string();
@@ -330,7 +352,7 @@ std::string readFileUnder(const std::string& directory, const std::string& path,
       refuse("cannot open " + at.shown + ": it is a symbolic link (refused: no symbolic links below " + base + ")");
     refuse(systemError("cannot open", at.shown, error));
   }
-  return readOpenFile(fd, at.shown, max_bytes);
+  return readOpenFile(fd, at.shown, max_bytes, size_from_head);
 }
 
 void writeFileUnder(const std::string& directory, const std::string& path, const std::string& text)
@@ -353,12 +375,12 @@ bool makeDirectoryUnder(const std::string& directory, const std::string& path)
   refuse(systemError("cannot create directory", at.shown, errno));
 }
 
-std::string readFile(const std::string& path, std::uint64_t max_bytes)
+std::string readFile(const std::string& path, std::uint64_t max_bytes, const SizeFromHead& size_from_head)
 {
   Descriptor fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
   if (fd.get() < 0)
     refuse(systemError("cannot open", path, errno));
-  return readOpenFile(fd, path, max_bytes);
+  return readOpenFile(fd, path, max_bytes, size_from_head);
 }
 
 namespace

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -47,10 +48,18 @@ std::string withoutTrailingSlashes(const std::string& folder);
 // relativePathUnder, joined to the directory's absolute form: what messages show.
 std::string resolvePathUnder(const std::string& directory, const std::string& path);
 
+// A file that says at its beginning how long it can be (a table's header gives its rows and
+// actions): given the first kHeadBytes of a file longer than that, the most bytes the file may
+// have, or a FileError when the beginning is not what it should be. The rest is not read when the
+// file is longer: a huge file is refused at the cost of its head.
+constexpr std::uint64_t kHeadBytes = std::uint64_t(1) << 20;
+using SizeFromHead = std::function<std::uint64_t(const std::string& head)>;
+
 // The whole file `path` (relative, below the directory), refusing symbolic links on the way,
-// anything but a regular file and files over max_bytes. Throws FileError.
+// anything but a regular file, files over max_bytes and files over what their head claims
+// (size_from_head, when given). Throws FileError.
 std::string readFileUnder(const std::string& directory, const std::string& path,
-                          std::uint64_t max_bytes = kMaxFileBytes);
+                          std::uint64_t max_bytes = kMaxFileBytes, const SizeFromHead& size_from_head = {});
 
 // Writes `text` atomically to `path` below the directory, creating the directory and any
 // missing folders on the way (never through a symbolic link). Throws FileError.
@@ -62,7 +71,8 @@ bool makeDirectoryUnder(const std::string& directory, const std::string& path);
 
 // The same for a path of the caller's own (a command-line argument): links are followed as the
 // shell would. Throws FileError.
-std::string readFile(const std::string& path, std::uint64_t max_bytes = kMaxFileBytes);
+std::string readFile(const std::string& path, std::uint64_t max_bytes = kMaxFileBytes,
+                     const SizeFromHead& size_from_head = {});
 void writeFileAtomically(const std::string& path, const std::string& text);
 
 // A file kept open to add lines to, one write per line: a reader following the file sees each

@@ -305,11 +305,59 @@ TEST_F(QTableFileTest, AFileLargerThanItsTableCouldBeIsRefusedUnread)
               std::string(e.what()).find(std::to_string((3u << 20) + 3 + readFile(path("t.yaml")).size()) + " bytes"))
         << e.what();
   }
-  EXPECT_TRUE(bitIdentical(awkwardTable().values(), loadQTableFile(path("padded.yaml")).values()));
+  // Without a bound (a table given at start-up, whose shape nothing else tells) the file's own
+  // first MiB must say what it is: here it is all comment.
+  try
+  {
+    loadQTableFile(path("padded.yaml"));
+    FAIL() << "a file of 3 MiB whose first MiB is no table header was read";
+  }
+  catch (const FileError& e)
+  {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("no 'values:' line in its first 1048576 bytes"))
+        << e.what();
+  }
   // The bound holds for the longest values there are, in the widest table.
   QTable longest(DiscretiserParams(), std::vector<double>(kMaxActions, -1.0));
   longest.setValues(std::vector<double>(longest.values().size(), -std::numeric_limits<double>::min()));
   EXPECT_GE(maxQTableFileBytes(longest.stateCount(), kMaxActions), formatQTable(longest).size());
+}
+
+TEST_F(QTableFileTest, AFileLongerThanItsOwnHeaderClaimsIsRefusedAtTheCostOfItsHead)
+{
+  // A valid table followed by 5 MiB of rows its header does not count: with no bound given (the
+  // node at start-up, train_headless --evaluate), the header's 72 rows of 2 values bound it.
+  saveQTableFile(awkwardTable(), path("t.yaml"));
+  const std::string table = readFile(path("t.yaml"));
+  std::string rows;
+  while (rows.size() < (5u << 20))
+    rows += "  - [1.5, 2.5]\n";
+  write(path("long.yaml"), table + rows);
+  const std::string size = std::to_string(table.size() + rows.size());
+  for (const bool under : {false, true})
+  {
+    try
+    {
+      under ? loadQTableUnder(dir_.string(), "long.yaml") : loadQTableFile(path("long.yaml"));
+      FAIL() << "a file of 5 MiB was read for a table of 72 rows";
+    }
+    catch (const FileError& e)
+    {
+      EXPECT_NE(std::string::npos, std::string(e.what()).find("long.yaml: " + size +
+                                                              " bytes, more than its own beginning says it can have (" +
+                                                              std::to_string(maxQTableFileBytes(72, 2)) + ")"))
+          << e.what();
+    }
+  }
+  // A header that claims more than any table may hold is refused by the head alone too.
+  std::string huge = table;
+  const std::size_t at = huge.find("\nrows: 72\n");
+  ASSERT_NE(std::string::npos, at);
+  huge.replace(at, 10, "\nrows: 900000000\n");
+  write(path("huge.yaml"), huge + rows);
+  EXPECT_THROW(loadQTableFile(path("huge.yaml")), FileError);
+  // A table within its bound still loads.
+  EXPECT_TRUE(bitIdentical(awkwardTable().values(), loadQTableFile(path("t.yaml")).values()));
 }
 
 TEST_F(QTableFileTest, RowsLaidOutByHandLoadAsTheSameTable)
