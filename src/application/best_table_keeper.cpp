@@ -37,8 +37,9 @@ SuiteRun againstTheBest(const SuiteResult& best, std::vector<std::size_t> order)
 }
 }  // namespace
 
-BestTableKeeper::BestTableKeeper(const TrainingConfig& config, bool learning, std::vector<std::string> suite_folders)
-  : config_(config), learning_(learning), suite_folders_(std::move(suite_folders))
+BestTableKeeper::BestTableKeeper(const TrainingConfig& config, bool learning, std::vector<std::string> suite_folders,
+                                 bool control)
+  : config_(config), learning_(learning), control_(control), suite_folders_(std::move(suite_folders))
 {
 }
 
@@ -46,7 +47,7 @@ LogLines BestTableKeeper::loadSuite()
 {
   LogLines log;
   const std::string& name = config_.limits.suite;
-  if (!learning_ || name == "none")
+  if (!(learning_ || control_) || name == "none")
     return log;
   std::string where;
   if (name.front() == '/')
@@ -57,7 +58,7 @@ LogLines BestTableKeeper::loadSuite()
     if (std::ifstream(suite_folders_[i] + "/" + name).good())
       suite_path_ = suite_folders_[i] + "/" + name;
   }
-  const bool needed = config_.limits.suite_every > 0;
+  const bool needed = learning_ && config_.limits.suite_every > 0;
   try
   {
     if (suite_path_.empty())
@@ -73,7 +74,10 @@ LogLines BestTableKeeper::loadSuite()
   {
     if (needed)
       throw;
-    log.push_back({LogLine::Level::Warn, std::string("this run will end without a robustness verdict: ") + e.what()});
+    log.push_back(
+        {LogLine::Level::Warn, std::string(learning_ ? "this run will end without a robustness verdict: "
+                                                     : "no robustness verdict on the table before control: ") +
+                                   e.what()});
     return log;
   }
   if (needed)
@@ -87,6 +91,26 @@ LogLines BestTableKeeper::loadSuite()
                     when.c_str(),
                     config_.limits.until == TrainUntil::SuitePasses ? ", and training ends when it passes" : "")});
   }
+  return log;
+}
+
+LogLines BestTableKeeper::judgeBeforeControl(const QTable& table, unsigned predict_delay_steps) const
+{
+  LogLines log;
+  if (!suite_)
+    return log;
+  SuiteRun how = SuiteRun::untilDecided(order_);
+  how.stop_at_first_failure = true;
+  how.predict_delay_steps = predict_delay_steps;
+  const SuiteResult result = evaluateSuite(table, config_, *suite_, how);
+  if (result.passed())
+    log.push_back({LogLine::Level::Info, formatText("the table passes the robustness suite %s (%zu cases)",
+                                                    suite_path_.c_str(), suite_->cases.size())});
+  else
+    log.push_back({LogLine::Level::Warn,
+                   formatText("this table FAILS the robustness suite %s: %s. It was not shown to hold a robot that "
+                              "differs from its model (a late command, noise, other masses, pushes): watch the robot",
+                              suite_path_.c_str(), result.summary().c_str())});
   return log;
 }
 

@@ -24,8 +24,8 @@ std::string newtons(double value)
 }
 }  // namespace
 
-ControlMeter::ControlMeter(std::string robot, double tau, double max_gap, double force_mag, double report_every)
-  : robot_(std::move(robot)), tau_(tau), max_gap_(max_gap), force_mag_(force_mag), report_every_(report_every)
+ControlMeter::ControlMeter(std::string robot, double tau, double max_gap, double max_effort, double report_every)
+  : robot_(std::move(robot)), tau_(tau), max_gap_(max_gap), max_effort_(max_effort), report_every_(report_every)
 {
 }
 
@@ -42,6 +42,8 @@ LogLines ControlMeter::onReaction(const Reaction& reaction, bool fell)
     stats_.current_seconds = 0.0;
     last_stamp_ = 0;
   }
+  if (reaction.clock_set_back)
+    last_stamp_ = 0;  // the stretch goes on; the robot's clock starts again from this stamp
   if (reaction.episode_began)
     in_episode_ = true;
   if (reaction.episode_ended)
@@ -73,7 +75,7 @@ LogLines ControlMeter::onReaction(const Reaction& reaction, bool fell)
     stats_.current_seconds += dt;
     stats_.longest_seconds = std::max(stats_.longest_seconds, stats_.current_seconds);
   }
-  if (std::abs(reaction.effort) > force_mag_)
+  if (std::abs(reaction.effort) > max_effort_)
     ++stats_.clamped;
   since_report_ += dt;
   if (since_report_ >= report_every_ - 1e-9)
@@ -91,8 +93,9 @@ std::string ControlMeter::reportText() const
   const ControlStatsValues& s = stats_;
   return "balanced " + seconds(s.balanced_seconds) + " of " + seconds(s.seconds) + ", the longest stretch " +
          seconds(s.longest_seconds) + ", " + std::to_string(s.falls) + (s.falls == 1 ? " fall, " : " falls, ") +
-         std::to_string(s.clamped) + " of " + std::to_string(s.decisions) + " commands beyond the motor's " +
-         newtons(force_mag_);
+         (std::isfinite(max_effort_) ? std::to_string(s.clamped) + " of " + std::to_string(s.decisions) +
+                                           " commands beyond the motor's " + newtons(max_effort_)
+                                     : std::to_string(s.decisions) + " commands (the motor's limit not given)");
 }
 
 LogLine ControlMeter::summary() const

@@ -80,8 +80,15 @@ LearningCurveFile::LearningCurveFile(AppendingFile file, std::uint64_t episodes)
   if (text.compare(0, header.size(), header) != 0)
     throw FileError(file_.path() + " is not an episode CSV of cartpole_qlearning (its first line is not '" +
                     kLearningCurveHeader + "'): refused, left as it was");
-  // Rows are kept up to the first one the checkpoint did not cover, or the first cut short.
-  std::size_t keep = header.size();
+  keepUpTo(episodes);
+}
+
+std::uint64_t LearningCurveFile::keepUpTo(std::uint64_t episodes)
+{
+  const std::string text = file_.read();
+  // Rows are kept up to the first one past `episodes`, or the first cut short.
+  std::size_t keep = text.find('\n') == std::string::npos ? text.size() : text.find('\n') + 1;
+  std::uint64_t last = 0;
   while (keep < text.size())
   {
     const std::size_t end = text.find('\n', keep);
@@ -90,10 +97,12 @@ LearningCurveFile::LearningCurveFile(AppendingFile file, std::uint64_t episodes)
     const std::optional<std::uint64_t> episode = rowEpisode(text.substr(keep, end - keep));
     if (!episode || *episode > episodes)
       break;
+    last = *episode;
     keep = end + 1;
   }
   if (keep < text.size())
     file_.truncate(keep);
+  return last;
 }
 
 void LearningCurveFile::startOver()
@@ -217,6 +226,17 @@ void LearningCurve::startOver(std::uint64_t episodes, LogLines& log)
     return;
   try
   {
+    // A table of this run's own (saved now or at an earlier episode, then loaded) goes on where
+    // it was: the rows up to its episode stay. One that comes from further than this curve went
+    // is another run's, and its numbering starts a curve of its own.
+    if (episodes > 0 && file_->keepUpTo(episodes) == episodes)
+    {
+      log.push_back({LogLine::Level::Info,
+                     formatText("the learning curve %s goes on from the loaded table's episode %llu (the rows after it "
+                                "dropped)",
+                                file_->path().c_str(), static_cast<unsigned long long>(episodes))});
+      return;
+    }
     file_->startOver();
     log.push_back(
         {LogLine::Level::Info, formatText("the learning curve %s starts over from the loaded table's episode %llu",

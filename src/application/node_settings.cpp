@@ -212,9 +212,48 @@ void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& r
     priv.fail("command_index", std::to_string(index), "must be < ~command_size = " + std::to_string(size));
   robot.command_index = static_cast<std::size_t>(index);
   robot.command_size = static_cast<std::size_t>(size);
+  priv.read("max_effort", robot.max_effort);
+  if (!(robot.max_effort > 0.0))
+    priv.fail("max_effort", SectionReader::numberText(robot.max_effort),
+              "must be > 0 N: the most effort the robot may be commanded (absent: no limit)");
   robot.decision_period = tau;
   // Over a second the pole has fallen between two decisions.
   priv.readSeconds("decision_period", robot.decision_period, 0.0, 1.0, false);
+}
+
+// What a table driving a robot (evaluate, control) is allowed but its owner should hear once:
+// values far from the step the table learnt, and commands no limit bounds.
+std::vector<std::string> drivingWarnings(const ControllerSettings& settings)
+{
+  std::vector<std::string> warnings;
+  const double tau = settings.training.physics.tau;
+  const std::string step = "the table's step (physics/tau) of " + SectionReader::numberText(tau) + " s";
+  const auto times = [tau](double value) { return SectionReader::numberText(std::round(value / tau * 10.0) / 10.0); };
+  const double period = settings.robot.decision_period;
+  if (period > 0.0 && (period > 1.5 * tau || period < tau / 1.5))
+    warnings.push_back("~decision_period = " + SectionReader::numberText(period) + " s is " + times(period) +
+                       " times " + step + ": the table decides as if " + SectionReader::numberText(tau) +
+                       " s passed between its decisions");
+  const double freshness = settings.freshness_timeout;
+  if (freshness > 0.5 && freshness > 25.0 * tau)
+    warnings.push_back("~freshness_timeout = " + SectionReader::numberText(freshness) + " s is " + times(freshness) +
+                       " times " + step + ": when fresh states stop, the last command goes on pushing the robot " +
+                       "that long before 0");
+  const unsigned delay = settings.run.predict_delay_steps;
+  if (delay > 5)
+    warnings.push_back("~predict_delay_steps = " + std::to_string(delay) + " predicts " +
+                       SectionReader::numberText(delay * tau) + " s ahead at " + step +
+                       ": a robot that late is rare; the prediction drifts from the robot the further it looks");
+  if (settings.run.control && !std::isfinite(settings.robot.max_effort))
+  {
+    double largest = 0.0;
+    for (const double action : settings.training.agent.actions)
+      largest = std::max(largest, std::abs(action));
+    warnings.push_back("no ~max_effort: commands go out as the table's actions, up to " +
+                       SectionReader::numberText(largest) +
+                       " N; give the robot's limit (robot.launch max_effort:=N) to bound every command");
+  }
+  return warnings;
 }
 
 // An evaluation of a table with no configuration beside it: the table's own (table_config.h).
@@ -288,6 +327,9 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
     }
   };
   expand_home("q_table_dir", run.q_table_dir);
+  std::string config_file;  // the launch's config (train.launch config:=), named in the namespace
+  shared.get("config_file", config_file);
+  run.q_table_path = defaultTableName(config_file);
   priv.read("q_table_path", run.q_table_path);
   expand_home("q_table_path", run.q_table_path);
   // The node's parameters are the user's, as the launch arguments that set them: an absolute
@@ -406,8 +448,17 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   protocol.commands_unstamped = settings.robot.command_type != CommandType::JointState;
   // The freshness guard's bound: a few decision periods, and no less than 0.1 s (a real-time
   // machine's hiccup is not a robot gone). 0 turns it off: a lockstep sim holds no command.
-  settings.freshness_timeout = std::max(0.1, 5.0 * settings.robot.decision_period);
+  priv.read("robot_lockstep", settings.robot_lockstep);
+  settings.freshness_timeout = settings.robot_lockstep ? 0.0 : std::max(0.1, 5.0 * settings.robot.decision_period);
   priv.readSeconds("freshness_timeout", settings.freshness_timeout, 0.0, 10.0, false);
+  // A robot that holds its last command (every real one, a realtime sim) is pushed by it for as
+  // long as nothing replaces it: without the guard a driver that stops or freezes keeps the last
+  // push on. Only a sim that steps when answered holds nothing.
+  if (run.control && settings.freshness_timeout == 0.0 && !settings.robot_lockstep)
+    priv.fail("freshness_timeout", "0",
+              "mode control drives a robot that holds its last command: the guard that commands 0 when fresh "
+              "states stop can be off only for a sim in lockstep (~robot_lockstep: true)");
+  protocol.time_back_judged_by_state = run.control;
   // Control's clock: a gap between two decisions counts at most this (beyond it the guard has
   // commanded 0, or, with the guard off, the robot was not being driven).
   run.control_max_gap =
@@ -424,6 +475,8 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
     priv.know(key);
   priv.refuseUnknown();
   protocol.limits = settings.training.limits;
+  if (!run.learning)
+    settings.warnings = drivingWarnings(settings);
   return settings;
 }
 

@@ -54,7 +54,7 @@ struct RunApplication::Parts
              settings.own_absolute_paths ? AbsolutePaths::AreTheUsersFiles : AbsolutePaths::MustLieInTheFolder),
       folder(settings, tables, std::move(clocks.calendar)),
       curve(settings, folder, std::move(clocks.unix_seconds)),
-      keeper(config, settings.learning, settings.suite_folders),
+      keeper(config, settings.learning, settings.suite_folders, settings.control),
       meters(config, settings, clocks.steady),
       steady(std::move(clocks.steady))
   {
@@ -248,6 +248,8 @@ LogLines RunApplication::start(const RunIdentity& previous, int launcher)
   LogLines log = p.keeper.loadSuite();
   p.launcher = launcher;
   p.loadOnStart(log);
+  if (p.settings.control)
+    append(log, p.keeper.judgeBeforeControl(p.session.table(), p.settings.predict_delay_steps));
   p.curve.openUsersFile();
   if (p.settings.learning)
     p.opened(p.folder.open(previous, launcher, p.session, log), log);
@@ -284,7 +286,14 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
 
   const bool until_suite = p.config.limits.until == TrainUntil::SuitePasses;
   if (p.settings.learning && s.solved && p.first_solved == 0)
+  {
     p.first_solved = s.episode;
+    // A run that goes on after solving says so when it happens, not only at its end.
+    if (p.config.limits.goesOnAfterSolved() && !training_finished)
+      say(end.log, LogLine::Level::Info,
+          formatText("solved at episode %llu (mean return of the last %u: %.2f); training goes on to max_episodes",
+                     count(s.episode), p.config.task.solved_window, shownReturn(s.mean_return_window, 2)));
+  }
   std::optional<SuiteResult> verdict = p.keeper.evaluateWhenDue(p.session, training_finished, end.log);
   training_finished = training_finished || (until_suite && verdict && verdict->passed());
   if (training_finished && p.keeper.hasSuite())

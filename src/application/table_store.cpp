@@ -19,6 +19,21 @@ ServiceAnswer refusedLoad(const std::string& why)
 }
 }  // namespace
 
+std::string defaultTableName(const std::string& config_path)
+{
+  std::string name = config_path.substr(config_path.find_last_of('/') + 1);
+  for (const char* extension : {".yaml", ".yml"})
+  {
+    const std::string ext(extension);
+    if (name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0)
+    {
+      name.resize(name.size() - ext.size());
+      break;
+    }
+  }
+  return name.empty() || name == "cartpole" ? "q_table.yaml" : "q_table_" + name + ".yaml";
+}
+
 TableStore::TableStore(std::string folder, std::string default_table, AbsolutePaths absolute)
   : folder_(std::move(folder)), default_table_(std::move(default_table)), absolute_(absolute)
 {

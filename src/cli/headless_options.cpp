@@ -1,5 +1,7 @@
 #include "headless_options.h"
 
+#include "cartpole_qlearning/application/table_store.h"
+
 #include <algorithm>
 #include <exception>
 #include <limits>
@@ -266,6 +268,8 @@ RunSettings headlessRunSettings(const HeadlessOptions& options, std::uint64_t se
     settings.q_table_path = options.save_path;
   else if (options.no_run_folder)
     settings.q_table_path.clear();  // no default table either
+  else if (settings.learning)
+    settings.q_table_path = defaultTableName(config_path);
   settings.load_on_start = options.evaluating() ? options.evaluate_path : options.load_path;
   settings.stats_csv = !options.stats_csv_path.empty() ? options.stats_csv_path : options.no_run_folder ? "none" : "";
   settings.evaluation_episodes = options.evaluation_episodes;

@@ -257,9 +257,16 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
     }
     // The same older state twice (a restarted sim repeating its first state), or time set back.
     ++counts_.restarts;
-    reaction.sim_restarted = true;
-    session_.abortEpisode(params_.robot);
-    phase_ = Phase::WaitingForStart;
+    if (params_.time_back_judged_by_state && phase_ == Phase::InEpisode && !session_.task().isTerminal(state))
+    {
+      reaction.clock_set_back = true;
+    }
+    else
+    {
+      reaction.sim_restarted = true;
+      session_.abortEpisode(params_.robot);
+      phase_ = Phase::WaitingForStart;
+    }
   }
   return onNewState(reaction, state);
 }
@@ -382,6 +389,10 @@ LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts&
   if (reaction.sim_restarted && restart_ready())
     log.push_back({Level::Warn, formatText("%s: time went back to %.3f s: the sim restarted (or was reset); starting "
                                            "a new episode. Restarts so far: %llu",
+                                           robot.c_str(), stamp_s, count(c.restarts))});
+  if (reaction.clock_set_back && restart_ready())
+    log.push_back({Level::Warn, formatText("%s: time went back to %.3f s while the pole was up (the robot's clock was "
+                                           "set back, or its driver restarted): balancing goes on. Times so far: %llu",
                                            robot.c_str(), stamp_s, count(c.restarts))});
   if (reaction.waiting_for_start)
     log.push_back({Level::Info, formatText("%s: episode over; no reset service, so commanding 0 until the state is "

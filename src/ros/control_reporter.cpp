@@ -8,12 +8,12 @@
 namespace cartpole_qlearning
 {
 ControlReporter::ControlReporter(ros::NodeHandle& nh, const std::vector<std::string>& robots, double tau,
-                                 double max_gap, double force_mag, double report_every,
+                                 double max_gap, double max_effort, double report_every,
                                  std::function<void(const LogLines&)> say)
   : robots_(robots), publisher_(nh.advertise<ControlStats>("control_stats", 100)), say_(std::move(say))
 {
   for (const std::string& robot : robots_)
-    meters_.emplace_back(robot, tau, max_gap, force_mag, report_every);
+    meters_.emplace_back(robot, tau, max_gap, max_effort, report_every);
 }
 
 void ControlReporter::onReaction(std::size_t robot, const Reaction& reaction, bool fell)

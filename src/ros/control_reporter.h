@@ -16,10 +16,10 @@ namespace cartpole_qlearning
 class ControlReporter
 {
 public:
-  // robots: their namespaces ("" the learner's own); tau, max_gap, force_mag, report_every: as
+  // robots: their namespaces ("" the learner's own); tau, max_gap, max_effort, report_every: as
   // ControlMeter takes them; say: the node's log.
   ControlReporter(ros::NodeHandle& nh, const std::vector<std::string>& robots, double tau, double max_gap,
-                  double force_mag, double report_every, std::function<void(const LogLines&)> say);
+                  double max_effort, double report_every, std::function<void(const LogLines&)> say);
 
   // A state of `robot` as the protocol reacted to it (fell: the episode it ended ended on the
   // task's thresholds): the fall or the report said and published when due.

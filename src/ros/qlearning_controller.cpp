@@ -53,7 +53,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
   if (settings_.run.control)
     control_ = std::make_unique<ControlReporter>(nh_, settings_.robots, settings_.training.physics.tau,
-                                                 settings_.run.control_max_gap, settings_.training.physics.force_mag,
+                                                 settings_.run.control_max_gap, settings_.robot.max_effort,
                                                  settings_.run.report_every, [this](const LogLines& log) { say(log); });
   ros::NodeHandle services_nh(pnh_);
   services_nh.setCallbackQueue(&services_queue_);
@@ -68,6 +68,8 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
   say({{LogLine::Level::Info, controllerStartText(settings_, session_->table(), app_->tableDirectory(), served)}});
+  for (const std::string& warning : settings_.warnings)
+    say({{LogLine::Level::Warn, warning}});
   lock.unlock();
   startLiveTuning();
 }

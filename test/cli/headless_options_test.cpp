@@ -246,6 +246,10 @@ TEST(HeadlessOptions, TheRunSettingsAreTheControllersParametersFromTheCommandLin
   EXPECT_FALSE(bare.save_on_shutdown);
   EXPECT_FALSE(bare.run_folder);
   EXPECT_EQ(std::vector<std::string>({"."}), bare.suite_folders);
+  // Training's default table is named after its config: no config replaces another's.
+  EXPECT_EQ("q_table_c.yaml", headlessRunSettings(parse("").options, 0, "/t", "/etc/c.yaml", "").q_table_path);
+  EXPECT_EQ("q_table.yaml",
+            headlessRunSettings(parse("").options, 0, "/t", "/pkg/config/cartpole.yaml", "").q_table_path);
   EXPECT_EQ("s.yaml",
             headlessRunSettings(parse("--no-run-folder --save s.yaml").options, 0, "/t", "c.yaml", "").q_table_path);
   EXPECT_EQ("c.csv",

@@ -79,9 +79,11 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
         ++commands;
       }));
 
-  // The sim holds no command in lockstep: no freshness guard. A report each minute of robot time.
+  // The sim holds no command in lockstep: no freshness guard. A report each minute of robot time;
+  // the motor's limit is the table's 10 N, as the robot's owner gives it.
   TrainLaunch launch(home, "control",
-                     "mode:=control load:=robust.yaml freshness_timeout:=0 reset_service:=cartpole_sim/reset "
+                     "mode:=control load:=robust.yaml robot_lockstep:=true max_effort:=10 "
+                     "reset_service:=cartpole_sim/reset "
                      "report_every:=60 predict_delay:=" +
                          std::to_string(predict_delay),
                      "robot.launch");

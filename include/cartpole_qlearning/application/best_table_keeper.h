@@ -25,9 +25,10 @@ class BestTableKeeper
 public:
   // config: training/suite, suite_every, best_every, until and progress_every (the cadence of the
   // lines for tables not kept); the physics the suite's cases vary.
-  // learning: false (evaluating) keeps no suite. suite_folders: where a relative suite is looked
-  // for, in order.
-  BestTableKeeper(const TrainingConfig& config, bool learning, std::vector<std::string> suite_folders);
+  // learning: false (evaluating) keeps no suite, unless control (a table about to drive a robot:
+  // judgeBeforeControl). suite_folders: where a relative suite is looked for, in order.
+  BestTableKeeper(const TrainingConfig& config, bool learning, std::vector<std::string> suite_folders,
+                  bool control = false);
 
   // Finds and reads the suite (training, unless training/suite is none). Throws ConfigError when
   // training evaluates it (suite_every > 0); else says that the run ends without a verdict.
@@ -53,6 +54,12 @@ public:
   // evaluated now when the suite has not run at this episode), said as a table.
   SuiteResult settle(TrainingSession& session, std::optional<SuiteResult> last, LogLines& log);
 
+  // A table about to drive a robot (mode control): the suite's verdict on it, decided case by case
+  // and stopped at the first failure, said once and plainly (a warning when it fails: the table
+  // was not shown to hold a robot that is not its model). Decisions for the state predicted
+  // predict_delay_steps ahead, as the controller will make them. Nothing without a suite.
+  LogLines judgeBeforeControl(const QTable& table, unsigned predict_delay_steps) const;
+
   // A resumed run goes on comparing against the best table its folder holds, evaluated again (the
   // same suite gives the same verdict; a suite changed since is applied to both tables alike).
   // One that cannot be read or does not fit is said and forgotten.
@@ -67,11 +74,12 @@ public:
 private:
   bool evaluatesDuringTraining() const
   {
-    return suite_ && config_.limits.suite_every > 0;
+    return learning_ && suite_ && config_.limits.suite_every > 0;
   }
 
   TrainingConfig config_;
   bool learning_;
+  bool control_;
   std::vector<std::string> suite_folders_;
   std::unique_ptr<RobustnessSuite> suite_;  // none: no verdict (training/suite none, or not found)
   std::string suite_path_;

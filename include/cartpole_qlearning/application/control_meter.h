@@ -22,7 +22,7 @@ struct ControlStatsValues
   double current_seconds = 0.0;   // the stretch going on (0 while waiting for a start)
   std::uint64_t falls = 0;
   std::uint64_t decisions = 0;
-  std::uint64_t clamped = 0;  // decisions whose effort was beyond physics/force_mag
+  std::uint64_t clamped = 0;  // decisions whose effort was beyond the motor's limit (clamped to it)
 };
 
 class ControlMeter
@@ -30,8 +30,10 @@ class ControlMeter
 public:
   // robot: as the log names it ("" the learner's own); tau: the step the table learnt [s] (the
   // time of a decision without stamps); max_gap: the most time one decision counts [s];
-  // force_mag: the motor's limit [N]; report_every: a report line every this much robot time [s].
-  ControlMeter(std::string robot, double tau, double max_gap, double force_mag, double report_every);
+  // max_effort: the motor's limit as the robot's owner gave it [N] (commands beyond it were
+  // clamped to it; infinity: not given, and nothing is counted); report_every: a report line
+  // every this much robot time [s].
+  ControlMeter(std::string robot, double tau, double max_gap, double max_effort, double report_every);
 
   // One of the robot's states as the protocol reacted to it (reaction.stamp its stamp, 0: none);
   // fell: the episode it ended ended on the task's thresholds (TrainingSession::lastEpisode()
@@ -52,7 +54,7 @@ private:
   std::string robot_;
   double tau_;
   double max_gap_;
-  double force_mag_;
+  double max_effort_;
   double report_every_;
   bool in_episode_ = false;
   Stamp last_stamp_ = 0;  // of the last decision (0: none yet, or no stamps)

@@ -50,6 +50,9 @@ public:
   // Empties the curve down to its header: a loaded table brings episode numbers of its own, and
   // a curve holds one numbering (a resume keeps rows by their numbers). Throws FileError.
   void startOver();
+  // Drops the rows after episode `episodes` (and a last line cut short); returns the episode of
+  // the last row kept (0: none). Throws FileError.
+  std::uint64_t keepUpTo(std::uint64_t episodes);
 
   const std::string& path() const
   {

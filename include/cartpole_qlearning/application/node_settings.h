@@ -89,6 +89,12 @@ struct ControllerSettings
   double sim_timeout = 2.0;            // [s] wall: a robot silent this long is said to be gone
   // [s] wall: efforts go out only this long after a fresh, valid state was decided on (0: off).
   double freshness_timeout = 0.1;
+  // ~robot_lockstep: the robot is a sim in lockstep, which steps only when a command answers its
+  // state and holds none: the freshness guard is off by default, and may be in mode control.
+  bool robot_lockstep = false;
+  // What the parameters allow but a robot's owner should hear, once, as the controller starts
+  // (evaluate and control: values far from the table's step, no ~max_effort).
+  std::vector<std::string> warnings;
   std::string reset_service = "cartpole_sim/reset";  // "": a robot that cannot be reset on command
   std::vector<std::string> robots{""};               // namespaces relative to the learner's
   bool sync = true;                                  // several robots: served in lockstep rounds

@@ -39,6 +39,12 @@ enum class AbsolutePaths
   AreTheUsersFiles  // train_headless's command line, the node's parameters: followed as the shell would
 };
 
+// The default table of a run trained with the configuration file `config_path`, named after it
+// so that training one configuration never replaces another's table: q_table.yaml for
+// cartpole.yaml (the default) or no file, q_table_NAME.yaml for NAME.yaml (robust.yaml:
+// q_table_robust.yaml).
+std::string defaultTableName(const std::string& config_path);
+
 class TableStore
 {
 public:

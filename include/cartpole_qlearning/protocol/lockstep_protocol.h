@@ -194,6 +194,7 @@ struct Reaction
   bool waiting_for_start = false;  // no reset service: the episode ended, now commanding 0 until
                                    // the state is back in the start region (said once per gap)
   bool sim_restarted = false;      // time went back: the running episode was abandoned
+  bool clock_set_back = false;     // time went back with the pole up, and control went on
   bool first_unstamped = false;    // the first state of a stream without stamps (warn once)
 };
 
@@ -216,6 +217,10 @@ struct ControllerProtocolParams
   // every kRepeatsBeforeAnsweringAgain-th repeat: the sim has waited that long, the answer was lost
   // (a connection not up yet), not late (a loaded machine answering after the sim's timeout).
   bool commands_unstamped = false;
+  // Control (a table driving a robot, no learning): time going back is judged by the state, not
+  // the clock. A pole still up goes on being balanced (a robot's clock stepped back, a sim
+  // restarted at a start); only a fallen one waits for a start, as after any fall.
+  bool time_back_judged_by_state = false;
 };
 
 class ControllerProtocol

@@ -8,8 +8,10 @@
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
 #include "cartpole_qlearning/protocol/lockstep_protocol.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -41,6 +43,10 @@ struct RobotInterfaceParams
   std::size_t command_index = 0;                       // ~command_index: the cart's slot (float64_array)
   std::size_t command_size = 1;                        // ~command_size: the array's length (float64_array)
   double effort_sign = 1.0;                            // ~effort_sign: -1 when + effort pushes toward -x
+  // ~max_effort [N]: the robot owner's limit; every command is clamped to it, whatever the table's
+  // actions (a table's physics/force_mag is what it learnt with, not what the robot can take).
+  // Infinity: none given.
+  double max_effort = std::numeric_limits<double>::infinity();
   // ~decision_period [s]: decide at most once per this much time on the states' stamps (the
   // states between are answered with the effort held); 0: every message. Default: physics/tau.
   double decision_period = 0.02;
@@ -49,10 +55,10 @@ struct RobotInterfaceParams
 // An angle in (-pi, pi].
 double wrapAngle(double angle);
 
-// The task's effort as the robot takes it (effort_sign).
+// The task's effort within the robot's limit (max_effort), as the robot takes it (effort_sign).
 inline double robotEffort(const RobotInterfaceParams& params, double effort)
 {
-  return params.effort_sign * effort;
+  return params.effort_sign * std::clamp(effort, -params.max_effort, params.max_effort);
 }
 
 // One joint_states message as read from the robot (before any mapping).
@@ -91,9 +97,9 @@ private:
   double theta_dot_ = 0.0;
 };
 
-// Which states to decide on when they come faster than the decision period: a state is decided
-// when its stamp is at least one period (less a twentieth, for jitter) after the last decided
-// one. A repeat of the last decided stamp, a stamp 0 and a stamp older than the last decided one
+// Which states to decide on when they come faster than the decision period: decisions are due a
+// period apart, and the first state at its due time (less a fifth of a period, for jitter) or
+// after is decided. A repeat of the last decided stamp, a stamp 0 and a stamp older than the last decided one
 // (time set back) are always passed on: the protocol judges those.
 class DecisionClock
 {
@@ -102,14 +108,16 @@ public:
   struct Verdict
   {
     bool decide = true;
-    bool slow = false;  // the gap since the last decided state was over 1.5 periods
+    bool slow = false;  // the decided states' gaps average over 1.5 periods (a moving mean)
   };
   Verdict onState(Stamp stamp);
 
 private:
   Stamp period_;
-  Stamp tolerance_;
-  std::optional<Stamp> last_;
+  Stamp tolerance_;            // a state this much before its due time is decided
+  std::optional<Stamp> last_;  // the last decided state's stamp
+  Stamp due_ = 0;              // when the next decision is due
+  double mean_gap_ = 0.0;      // [ns] between decided states (0: no gap yet)
 };
 
 // The sim posing as a robot whose joint_states come every `period` of sim time while its physics

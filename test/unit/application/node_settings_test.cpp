@@ -5,11 +5,13 @@
 
 #include "cartpole_qlearning/application/headless_trainer.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
+#include "cartpole_qlearning/application/table_store.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
 
 #include <gtest/gtest.h>
 
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -219,6 +221,97 @@ TEST(ControllerSettings, APredictionOfTheRobotsDelayIsForAGreedyTable)
       "it needs ~decision_period = tau, not 0.01)");
   EXPECT_SAYS(controllerError("{mode: evaluate, predict_delay_steps: 1, decision_period: 0}", shared),
               "needs ~decision_period = tau, not 0)");
+}
+
+TEST(ControllerSettings, ARobotOwnersLimitBoundsEveryCommandWhateverTheTable)
+{
+  const std::string shared =
+      "{task: {max_episode_steps: 200}, physics: {force_mag: 1000}, learning: {actions: [-1000, 1000]}}";
+  const ControllerSettings limited = readController("{mode: control, load_on_start: t.yaml, max_effort: 12}", shared);
+  EXPECT_EQ(12.0, limited.robot.max_effort);
+  EXPECT_EQ(12.0, robotEffort(limited.robot, 1000.0));
+  EXPECT_EQ(-12.0, robotEffort(limited.robot, -1000.0));
+  EXPECT_EQ(5.0, robotEffort(limited.robot, 5.0));
+  // The sign applies to the clamped effort: a robot whose + pushes toward -x.
+  EXPECT_EQ(12.0,
+            robotEffort(
+                readController("{mode: control, load_on_start: t.yaml, max_effort: 12, effort_sign: -1}", shared).robot,
+                -1000.0));
+  for (const char* bad : {"0", "-5", ".nan"})
+    EXPECT_SAYS(controllerError(std::string("{mode: control, load_on_start: t.yaml, max_effort: ") + bad + "}", shared),
+                std::string("max_effort = ") + (std::string(bad) == ".nan" ? "nan" : bad) +
+                    " is not allowed (must be > 0 N: the most effort the robot may be commanded (absent: no limit))");
+  // Without one, control says once what goes out unbounded; with one, nothing.
+  const ControllerSettings unlimited = readController("{mode: control, load_on_start: t.yaml}", shared);
+  EXPECT_FALSE(std::isfinite(unlimited.robot.max_effort));
+  ASSERT_EQ(1u, unlimited.warnings.size());
+  EXPECT_EQ(
+      "no ~max_effort: commands go out as the table's actions, up to 1000 N; give the robot's limit "
+      "(robot.launch max_effort:=N) to bound every command",
+      unlimited.warnings[0]);
+  EXPECT_TRUE(limited.warnings.empty());
+}
+
+TEST(ControllerSettings, ControlRefusesTheFreshnessGuardOffUnlessTheRobotIsALockstepSim)
+{
+  const std::string shared = "{task: {max_episode_steps: 200}}";
+  EXPECT_SAYS(controllerError("{mode: control, load_on_start: t.yaml, freshness_timeout: 0}", shared),
+              "freshness_timeout = 0 is not allowed (mode control drives a robot that holds its last command: the "
+              "guard that commands 0 when fresh states stop can be off only for a sim in lockstep "
+              "(~robot_lockstep: true))");
+  const ControllerSettings lockstep =
+      readController("{mode: control, load_on_start: t.yaml, robot_lockstep: true}", shared);
+  EXPECT_EQ(0.0, lockstep.freshness_timeout);
+  EXPECT_EQ(0.0,
+            readController("{mode: control, load_on_start: t.yaml, robot_lockstep: true, freshness_timeout: 0}", shared)
+                .freshness_timeout);
+  EXPECT_EQ(0.0, readController("{mode: evaluate, freshness_timeout: 0}", shared).freshness_timeout);
+  EXPECT_EQ(0.0, readController("{mode: train, freshness_timeout: 0}", shared).freshness_timeout);
+  // Control judges time going back by the state; training and evaluation take it for a restart.
+  EXPECT_TRUE(lockstep.protocol.time_back_judged_by_state);
+  EXPECT_FALSE(readController("{mode: evaluate}", shared).protocol.time_back_judged_by_state);
+}
+
+TEST(ControllerSettings, ValuesFarFromTheTablesStepAreWarnedOnceNamingBoth)
+{
+  const std::string shared = "{task: {max_episode_steps: 200}}";
+  const std::string limit = ", max_effort: 10}";
+  const auto warnings = [&](const std::string& priv) {
+    return readController("{mode: control, load_on_start: t.yaml" + priv + limit, shared).warnings;
+  };
+  EXPECT_TRUE(warnings("").empty());
+  EXPECT_TRUE(warnings(", decision_period: 0.025, freshness_timeout: 0.5, predict_delay_steps: 0").empty());
+  // (The freshness bound follows the period: five of them, 5 s here, and is said too.)
+  EXPECT_EQ((std::vector<std::string>{"~decision_period = 1 s is 50 times the table's step (physics/tau) of 0.02 s: "
+                                      "the table decides as if 0.02 s passed between its decisions",
+                                      "~freshness_timeout = 5 s is 250 times the table's step (physics/tau) of 0.02 "
+                                      "s: when fresh states stop, the last command goes on pushing the robot that "
+                                      "long before 0"}),
+            warnings(", decision_period: 1"));
+  EXPECT_EQ(std::vector<std::string>{"~freshness_timeout = 10 s is 500 times the table's step (physics/tau) of 0.02 "
+                                     "s: when fresh states stop, the last command goes on pushing the robot that "
+                                     "long before 0"},
+            warnings(", freshness_timeout: 10"));
+  EXPECT_EQ(std::vector<std::string>{"~predict_delay_steps = 50 predicts 1 s ahead at the table's step (physics/tau) "
+                                     "of 0.02 s: a robot that late is rare; the prediction drifts from the robot the "
+                                     "further it looks"},
+            warnings(", predict_delay_steps: 50"));
+  // Training says none of them: the table learns the step it is given.
+  EXPECT_TRUE(readController("{mode: train, decision_period: 1}", shared).warnings.empty());
+}
+
+TEST(ControllerSettings, TheDefaultTableIsNamedAfterTheConfigSoThatNoConfigReplacesAnothers)
+{
+  EXPECT_EQ("q_table.yaml", readController("").run.q_table_path);
+  EXPECT_EQ("q_table.yaml",
+            readController("", "{config_file: /opt/share/cartpole_qlearning/config/cartpole.yaml}").run.q_table_path);
+  EXPECT_EQ("q_table_robust.yaml", readController("", "{config_file: /x/config/robust.yaml}").run.q_table_path);
+  EXPECT_EQ("q_table_mujoco_cartpole.yaml",
+            readController("", "{config_file: /x/mujoco_cartpole.yaml}").run.q_table_path);
+  // One given is the user's.
+  EXPECT_EQ("mine.yaml", readController("{q_table_path: mine.yaml}", "{config_file: /x/robust.yaml}").run.q_table_path);
+  EXPECT_EQ("q_table_swing.yaml", defaultTableName("swing.yml"));
+  EXPECT_EQ("q_table.yaml", defaultTableName(""));
 }
 
 TEST(ControllerSettings, RefusesAnUnknownMode)

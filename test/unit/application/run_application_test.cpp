@@ -4,6 +4,7 @@
 // the services' paths. Clocks are injected; tables go to a temporary folder.
 #include "cartpole_qlearning/application/headless_trainer.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
+#include "cartpole_qlearning/learning/table_config.h"
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/application/run_application.h"
@@ -507,7 +508,7 @@ TEST_F(RunApplicationTest, AStatsCsvOfTheUsersOwnIsOpenedAtTheStartOrRefused)
   EXPECT_FALSE(fs::exists(dir_ / quiet.app->runFolder() / "episodes.csv"));
 }
 
-TEST_F(RunApplicationTest, ALoadedTableStartsTheCurveOver)
+TEST_F(RunApplicationTest, ALoadedTableOfThisRunGoesOnWithItsCurveAndAnotherRunsStartsItOver)
 {
   settings_.checkpoint_every = 1;
   Run run = startRun();
@@ -515,20 +516,36 @@ TEST_F(RunApplicationTest, ALoadedTableStartsTheCurveOver)
   episode(run);
   saveQTableFile(run.session->table(), (dir_ / "two.yaml").string());
   episode(run);
+  // The table this run saved at episode 2: the curve keeps episodes 1 and 2 and goes on from there.
   const ServiceAnswer answer = run.app->load("two.yaml");
   EXPECT_TRUE(answer.success) << answer.message;
   EXPECT_EQ("loaded " + (dir_ / "two.yaml").string() + " (2 episodes, 2 steps of training)", answer.message);
   EXPECT_TRUE(says(answer.log, "load_q_table: loaded "));
-  const LogLine over = log(answer.log, "starts over");
-  EXPECT_EQ("the learning curve " + (dir_ / folderName() / "episodes.csv").string() +
-                " starts over from the loaded table's episode 2",
-            over.text);
-  EXPECT_EQ(1u, lines(dir_ / folderName() / "episodes.csv").size());
+  const std::string csv = (dir_ / folderName() / "episodes.csv").string();
+  EXPECT_EQ("the learning curve " + csv + " goes on from the loaded table's episode 2 (the rows after it dropped)",
+            log(answer.log, "goes on").text);
+  EXPECT_EQ(3u, lines(csv).size());
   EXPECT_EQ(2u, run.session->episodesEnded());
   episode(run);
-  const std::vector<std::string> rows = lines(dir_ / folderName() / "episodes.csv");
+  std::vector<std::string> rows = lines(csv);
+  ASSERT_EQ(4u, rows.size());
+  EXPECT_EQ(0u, rows[1].rfind("1,", 0)) << rows[1];
+  EXPECT_EQ(0u, rows[3].rfind("3,", 0)) << rows[3];
+
+  // A table from further than this curve went (another run's, 5 episodes): its numbering starts
+  // the curve over.
+  QTable other = run.session->table();
+  other.episodes = 5;
+  saveQTableFile(other, (dir_ / "other.yaml").string());
+  const ServiceAnswer elsewhere = run.app->load("other.yaml");
+  EXPECT_TRUE(elsewhere.success) << elsewhere.message;
+  EXPECT_EQ("the learning curve " + csv + " starts over from the loaded table's episode 5",
+            log(elsewhere.log, "starts over").text);
+  EXPECT_EQ(1u, lines(csv).size());
+  episode(run);
+  rows = lines(csv);
   ASSERT_EQ(2u, rows.size());
-  EXPECT_EQ(0u, rows[1].rfind("3,", 0)) << rows[1];
+  EXPECT_EQ(0u, rows[1].rfind("6,", 0)) << rows[1];
 }
 
 TEST_F(RunApplicationTest, ASolvedRunReplacesTheDefaultTable)
@@ -1381,4 +1398,35 @@ TEST_F(RunApplicationTest, AnEvaluationOrControlRunDecidesForThePredictedStateIt
   TrainingSession plain(config_.task, config_.agent, settings_.seed, true);
   const RunApplication training(settings_, config_, plain, clocks_);
   EXPECT_EQ(0u, plain.predictedDelaySteps());
+}
+
+TEST_F(RunApplicationTest, ATableAboutToDriveARobotIsJudgedByItsSuiteFirstAndAFailureSaidPlainly)
+{
+  // A passing table (robust.yaml's, seed 2) and its own configuration, as control starts it.
+  const QTable robust = loadQTableFile(CARTPOLE_SOURCE_DIR "/bench/robust_table.yaml");
+  config_ = tableConfig(robust, "robust_table.yaml").config;
+  fs::copy_file(CARTPOLE_SOURCE_DIR "/bench/robust_table.yaml", dir_ / "robust.yaml");
+  settings_.learning = false;
+  settings_.control = true;
+  settings_.load_on_start = "robust.yaml";
+  const Run passing = startRun();
+  const std::string suite = std::string(CARTPOLE_CONFIG_DIR) + "/" + config_.limits.suite;
+  EXPECT_EQ(LogLine::Level::Info, log(passing.started, "robustness suite").level);
+  EXPECT_EQ("the table passes the robustness suite " + suite + " (" +
+                std::to_string(loadRobustnessSuite(suite, config_).cases.size()) + " cases)",
+            log(passing.started, "robustness suite").text);
+
+  // The same suite on a table that never learnt: a warning, before any state is served.
+  QTable zeros = robust;
+  zeros.setValues(std::vector<double>(robust.values().size(), 0.0));
+  saveQTableFile(zeros, (dir_ / "zeros.yaml").string());
+  settings_.load_on_start = "zeros.yaml";
+  const Run failing = startRun();
+  const LogLine said = log(failing.started, "robustness suite");
+  EXPECT_EQ(LogLine::Level::Warn, said.level);
+  EXPECT_EQ(0u, said.text.rfind("this table FAILS the robustness suite " + suite + ": ", 0)) << said.text;
+  EXPECT_NE(std::string::npos, said.text.find("watch the robot")) << said.text;
+  // Evaluating says nothing of it (its own verdict is the evaluation).
+  settings_.control = false;
+  EXPECT_FALSE(says(startRun().started, "robustness suite"));
 }

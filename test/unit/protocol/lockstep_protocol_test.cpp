@@ -526,6 +526,45 @@ TEST_F(ControllerProtocolTest, TimeSetBackAndGoingOnIsARestartOnItsThirdState)
   EXPECT_EQ(1u, controller.counts().restarts);
 }
 
+TEST_F(ControllerProtocolTest, InControlTimeSetBackWithThePoleUpGoesOnBalancingAndWithThePoleDownWaits)
+{
+  // A table driving a robot (greedy, no learning): the robot's clock steps back an hour.
+  TrainingSession greedy(config_.task, config_.agent, 0, false);
+  params_.time_back_judged_by_state = true;
+  params_.reset_service = false;
+  ControllerProtocol controller(greedy, params_);
+  const Stamp hour = 3600ULL * 1000000000ULL;
+  controller.onState(hour + tick(1), kUpright);
+  for (std::uint64_t n = 2; n <= 10; ++n)
+    controller.onState(hour + tick(n), kSmall);
+  ASSERT_TRUE(greedy.inEpisode());
+  EXPECT_EQ(Reaction::Kind::Stale, controller.onState(tick(1), kSmall).kind);
+  EXPECT_EQ(Reaction::Kind::Stale, controller.onState(tick(2), kSmall).kind);
+  const Reaction r = controller.onState(tick(3), kSmall);
+  EXPECT_TRUE(r.clock_set_back);
+  EXPECT_FALSE(r.sim_restarted);
+  EXPECT_FALSE(r.episode_began);
+  EXPECT_FALSE(r.episode_ended);
+  EXPECT_TRUE(r.answer);
+  EXPECT_EQ(tick(3), r.stamp);
+  EXPECT_TRUE(greedy.inEpisode());
+  EXPECT_EQ(0u, greedy.episodesEnded());
+  EXPECT_EQ(ControllerProtocol::Phase::InEpisode, controller.phase());
+  const Reaction next = controller.onState(tick(4), kSmall);
+  EXPECT_EQ(Reaction::Kind::New, next.kind);
+  EXPECT_TRUE(next.answer);
+
+  // The same with the pole down when time goes back: that stretch is over, and a start is waited for.
+  const Stamp later = 2 * hour;
+  controller.onState(later, kSmall);
+  EXPECT_EQ(Reaction::Kind::Stale, controller.onState(tick(1), kFallen).kind);
+  EXPECT_EQ(Reaction::Kind::Stale, controller.onState(tick(2), kFallen).kind);
+  const Reaction down = controller.onState(tick(3), kFallen);
+  EXPECT_TRUE(down.sim_restarted);
+  EXPECT_FALSE(down.clock_set_back);
+  EXPECT_EQ(0.0, down.effort);
+}
+
 TEST_F(ControllerProtocolTest, AStampZeroAmidStampedStatesIsAStray)
 {
   ControllerProtocol controller(session_, params_);
