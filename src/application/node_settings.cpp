@@ -459,6 +459,7 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
               "mode control drives a robot that holds its last command: the guard that commands 0 when fresh "
               "states stop can be off only for a sim in lockstep (~robot_lockstep: true)");
   protocol.time_back_judged_by_state = run.control;
+  protocol.starts_when_up = !run.learning && !protocol.reset_service;
   // Control's clock: a gap between two decisions counts at most this (beyond it the guard has
   // commanded 0, or, with the guard off, the robot was not being driven).
   run.control_max_gap =
@@ -617,7 +618,12 @@ std::string controllerStartText(const ControllerSettings& settings, const QTable
             (settings.run.predict_delay_steps == 1 ? " step" : " steps") + " ahead (~predict_delay_steps)";
   return text + "; " +
          (settings.protocol.reset_service ? "resets by ~" + settings.reset_service
-                                          : "no reset service: episodes start when the state is in ~start_region");
+          : settings.protocol.starts_when_up
+              ? std::string("no reset service: an episode starts when the pole is up (inside the task's "
+                            "thresholds), the next at once after a step limit, and after a fall the pole stays "
+                            "down until someone stands it up (the robot's own count of episodes, if it keeps one, "
+                            "may differ)")
+              : "no reset service: episodes start when the state is in ~start_region");
 }
 
 }  // namespace cartpole_qlearning

@@ -153,13 +153,14 @@ void ControllerProtocol::begin(Reaction& reaction, const CartPoleState& state)
 
 void ControllerProtocol::waitForStartRegion(Reaction& reaction, const CartPoleState& state, bool terminal)
 {
-  if (!terminal && inStartRegion(state))
+  if (!terminal && (params_.starts_when_up || inStartRegion(state)))
   {
     begin(reaction, state);
     return;
   }
   // Said for a robot without a reset service; a failing reset is said by the reset caller.
   reaction.waiting_for_start = !params_.reset_service && phase_ != Phase::WaitingForPerson;
+  reaction.waiting_for_pole_up = params_.starts_when_up;
   phase_ = Phase::WaitingForPerson;
   answer(reaction, 0.0);
 }
@@ -356,7 +357,13 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
         requestReset(reaction);
         break;
       }
+      if (params_.starts_when_up && !session_.task().isTerminal(state))
+      {
+        begin(reaction, state);  // the step limit, the pole up: the next episode goes on from here
+        break;
+      }
       reaction.waiting_for_start = true;
+      reaction.waiting_for_pole_up = params_.starts_when_up;
       phase_ = Phase::WaitingForPerson;
       answer(reaction, 0.0);
       break;
@@ -395,9 +402,15 @@ LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts&
                                            "set back, or its driver restarted): balancing goes on. Times so far: %llu",
                                            robot.c_str(), stamp_s, count(c.restarts))});
   if (reaction.waiting_for_start)
-    log.push_back({Level::Info, formatText("%s: episode over; no reset service, so commanding 0 until the state is "
-                                           "back inside ~start_region (stand the pole up)",
-                                           robot.c_str())});
+    log.push_back(
+        {Level::Info,
+         reaction.waiting_for_pole_up
+             ? formatText("%s: the pole is down and there is no reset service: commanding 0 until it is back up "
+                          "(inside the task's thresholds): someone has to stand it up",
+                          robot.c_str())
+             : formatText("%s: episode over; no reset service, so commanding 0 until the state is back inside "
+                          "~start_region (stand the pole up)",
+                          robot.c_str())});
   return log;
 }
 

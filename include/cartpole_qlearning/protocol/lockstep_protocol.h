@@ -186,16 +186,17 @@ struct Reaction
   bool answer = false;  // publish a command: effort, stamped with stamp
   double effort = 0.0;
   Stamp stamp = 0;
-  bool learned = false;            // a transition was learnt from (at most once per stamp)
-  bool episode_began = false;      // this state starts an episode
-  bool episode_ended = false;      // TrainingSession::lastEpisode() describes it
-  bool training_finished = false;  // the episode just ended reached the training limits
-  bool request_reset = false;      // call the sim's reset service
-  bool waiting_for_start = false;  // no reset service: the episode ended, now commanding 0 until
-                                   // the state is back in the start region (said once per gap)
-  bool sim_restarted = false;      // time went back: the running episode was abandoned
-  bool clock_set_back = false;     // time went back with the pole up, and control went on
-  bool first_unstamped = false;    // the first state of a stream without stamps (warn once)
+  bool learned = false;              // a transition was learnt from (at most once per stamp)
+  bool episode_began = false;        // this state starts an episode
+  bool episode_ended = false;        // TrainingSession::lastEpisode() describes it
+  bool training_finished = false;    // the episode just ended reached the training limits
+  bool request_reset = false;        // call the sim's reset service
+  bool waiting_for_start = false;    // no reset service: the episode ended, now commanding 0 until
+                                     // the state is back in the start region (said once per gap)
+  bool waiting_for_pole_up = false;  // ... until the pole is up (starts_when_up), not in the start region
+  bool sim_restarted = false;        // time went back: the running episode was abandoned
+  bool clock_set_back = false;       // time went back with the pole up, and control went on
+  bool first_unstamped = false;      // the first state of a stream without stamps (warn once)
 };
 
 struct ControllerProtocolParams
@@ -221,6 +222,13 @@ struct ControllerProtocolParams
   // the clock. A pole still up goes on being balanced (a robot's clock stepped back, a sim
   // restarted at a start); only a fallen one waits for a start, as after any fall.
   bool time_back_judged_by_state = false;
+  // A table run greedily on a robot without a reset service (evaluate, control): an episode starts
+  // when the pole is up by the task's own thresholds (not terminal), not inside start_region,
+  // which noisy readings of a balanced pole can miss for long; and an episode that ends at its
+  // step limit with the pole up is followed at once by the next, answered as any state (an
+  // upright pole is never left at zero between episodes). Training keeps start_region: its
+  // episodes start where the task's starts are drawn.
+  bool starts_when_up = false;
 };
 
 class ControllerProtocol

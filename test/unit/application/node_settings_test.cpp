@@ -797,8 +797,15 @@ TEST(ControllerSettings, TheStartLineSaysWhatTheControllerDoes)
   EXPECT_EQ(
       "evaluating (greedy, no learning) in episodes of 500 steps with /cartpole, seed 3, 72 states x 2 actions, "
       "tables under /t; serving a, b, each as "
-      "its states come; no reset service: episodes start when the state is in ~start_region",
+      "its states come; no reset service: an episode starts when the pole is up (inside the task's thresholds), "
+      "the next at once after a step limit, and after a fall the pole stays down until someone stands it up (the "
+      "robot's own count of episodes, if it keeps one, may differ)",
       controllerStartText(e, table, "/t", "a, b"));
+  const ControllerSettings t = readController("{reset_service: ''}");
+  EXPECT_NE(std::string::npos, controllerStartText(t, table, "/t", "a")
+                                   .find("no reset service: episodes start when the state is in ~start_region"));
+  EXPECT_FALSE(t.protocol.starts_when_up);
+  EXPECT_TRUE(e.protocol.starts_when_up);
 }
 
 namespace

@@ -925,6 +925,41 @@ TEST_F(ControllerProtocolTest, AFirstStateThatIsTerminalRequestsAResetWithoutLea
   EXPECT_EQ(0u, learntSteps());
 }
 
+TEST_F(ControllerProtocolTest, AGreedyTableWithoutAResetStartsWhenThePoleIsUpAndGoesOnPastAStepLimit)
+{
+  // Evaluation on a robot with no reset: 3-step episodes, noisy readings outside the start region.
+  TaskParams task = config_.task;
+  task.max_episode_steps = 3;
+  TrainingSession greedy(task, config_.agent, 0, false);
+  params_.reset_service = false;
+  params_.starts_when_up = true;
+  ControllerProtocol controller(greedy, params_);
+  // Leaning 0.1 rad (outside the 0.05 start region, inside the 12-degree threshold): up.
+  EXPECT_TRUE(controller.onState(tick(1), kLeaning).episode_began);
+  controller.onState(tick(2), kLeaning);
+  controller.onState(tick(3), kLeaning);
+  // The step limit with the pole up: this episode ends and the next begins on the same state,
+  // answered with the table's effort, not 0.
+  const Reaction limit = controller.onState(tick(4), kLeaning);
+  EXPECT_TRUE(limit.episode_ended);
+  EXPECT_TRUE(limit.episode_began);
+  EXPECT_FALSE(limit.waiting_for_start);
+  EXPECT_TRUE(limit.answer);
+  EXPECT_NE(0.0, limit.effort);
+  EXPECT_TRUE(greedy.lastEpisode().truncated);
+  EXPECT_EQ(1u, greedy.episodesEnded());
+  // A fall: 0 until the pole is up again by the thresholds, whatever the start region says.
+  const Reaction fall = controller.onState(tick(5), kFallen);
+  EXPECT_TRUE(fall.episode_ended);
+  EXPECT_TRUE(fall.waiting_for_start);
+  EXPECT_TRUE(fall.waiting_for_pole_up);
+  EXPECT_EQ(0.0, fall.effort);
+  EXPECT_EQ(0.0, controller.onState(tick(6), kFallen).effort);
+  const Reaction up = controller.onState(tick(7), kLeaning);
+  EXPECT_TRUE(up.episode_began);
+  EXPECT_EQ(2u, greedy.episodesEnded());
+}
+
 TEST_F(ControllerProtocolTest, WithoutAResetServiceItCommandsZeroUntilTheStateIsInTheStartRegion)
 {
   params_.reset_service = false;
