@@ -226,6 +226,13 @@ class CsvToPngTest(PictureTest):
         result = self.draw([csv, "-o", self.path("live.png")])
         self.assertIn("300 episodes, solved at episode 270", result.stdout)
 
+    def test_a_curve_that_begins_solved_says_solved_by_its_first_episode_not_at_it(self):
+        # A --follow started late, or a bag recorded late: the rows from episode 281 on, all solved.
+        csv = self.write("late.csv", csv_text(synthetic_episodes(300, solved_from=270)[280:]))
+        result = self.draw([csv, "-o", self.path("late.png")])
+        self.assertIn("20 episodes, solved by episode 281 (already, where this curve begins)", result.stdout)
+        self.assertNotIn("solved at episode", result.stdout)
+
     def test_an_unsolved_run_has_no_solved_mark_and_the_png_goes_beside_the_csv(self):
         csv = self.write("unsolved.csv", csv_text(synthetic_episodes(150)))
         self.draw([csv])
