@@ -249,6 +249,7 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
     // Time going on from an older stamp for kTimeSetBack states (Gazebo's reset_simulation sets
     // time back) is a restart too; fewer are replayed or reordered messages.
     older_run_ = older_seen_ && stamp > *older_seen_ ? older_run_ + 1 : 1;
+    reaction.awaiting_reset = phase_ == Phase::AwaitingReset;
     if (older_seen_ != stamp && older_run_ < kTimeSetBack)
     {
       older_seen_ = stamp;
@@ -258,6 +259,7 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
     }
     // The same older state twice (a restarted sim repeating its first state), or time set back.
     ++counts_.restarts;
+    counts_.resets_back += reaction.awaiting_reset ? 1 : 0;
     if (params_.time_back_judged_by_state && phase_ == Phase::InEpisode && !session_.task().isTerminal(state))
     {
       reaction.clock_set_back = true;
@@ -379,7 +381,13 @@ LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts&
   using Level = LogLine::Level;
   const auto count = [](std::uint64_t n) { return static_cast<unsigned long long>(n); };
   LogLines log;
-  if (reaction.kind == Reaction::Kind::Stale && dropped_ready())
+  // A reset asked for that sets time back: its first states look older, and then time goes on
+  // from there. Said once, as what it is; every episode would otherwise warn twice.
+  if (reaction.awaiting_reset && reaction.sim_restarted && c.resets_back == 1)
+    log.push_back({Level::Info, formatText("%s: the reset set time back to %.3f s (as Gazebo's reset_simulation "
+                                           "does): each reset's start is taken from where time goes on (said once)",
+                                           robot.c_str(), stamp_s)});
+  if (reaction.kind == Reaction::Kind::Stale && !reaction.awaiting_reset && dropped_ready())
     log.push_back(
         {Level::Warn, formatText("dropped joint_states on %s stamped %.6f, older than the last state (a "
                                  "replayed or reordered message; a restarted sim is recognised when it "
@@ -393,7 +401,7 @@ LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts&
     log.push_back({Level::Warn, formatText("joint_states on %s carry no stamp (0): every message is taken as a new "
                                            "state, and commands go out unstamped",
                                            robot.c_str())});
-  if (reaction.sim_restarted && restart_ready())
+  if (reaction.sim_restarted && !reaction.awaiting_reset && restart_ready())
     log.push_back({Level::Warn, formatText("%s: time went back to %.3f s: the sim restarted (or was reset); starting "
                                            "a new episode. Restarts so far: %llu",
                                            robot.c_str(), stamp_s, count(c.restarts))});

@@ -195,8 +195,11 @@ struct Reaction
                                      // the state is back in the start region (said once per gap)
   bool waiting_for_pole_up = false;  // ... until the pole is up (starts_when_up), not in the start region
   bool sim_restarted = false;        // time went back: the running episode was abandoned
-  bool clock_set_back = false;       // time went back with the pole up, and control went on
-  bool first_unstamped = false;      // the first state of a stream without stamps (warn once)
+  // Time went back (a stale state, or a restart) while the reset asked for was awaited: a reset
+  // that sets time back (Gazebo's reset_simulation) does exactly that, every episode.
+  bool awaiting_reset = false;
+  bool clock_set_back = false;   // time went back with the pole up, and control went on
+  bool first_unstamped = false;  // the first state of a stream without stamps (warn once)
 };
 
 struct ControllerProtocolParams
@@ -251,6 +254,7 @@ public:
     std::uint64_t stale = 0;
     std::uint64_t stray = 0;
     std::uint64_t restarts = 0;
+    std::uint64_t resets_back = 0;  // of the restarts, those a requested reset made (awaiting_reset)
   };
 
   // The session is driven by this protocol (beginEpisode, observe, abortEpisode) and must

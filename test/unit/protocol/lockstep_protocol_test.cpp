@@ -1678,6 +1678,59 @@ TEST(LockstepProtocol, ASimRestartedMidEpisodeIsTakenUpOnItsFirstRepeatAndTraini
   EXPECT_EQ(0u, link.sim().counts().stale + link.sim().counts().future);
 }
 
+TEST(ReactionSaid, AResetThatSetsTimeBackIsSaidOnceAsWhatItIsNotAsDropsAndRestarts)
+{
+  const auto ready = [] { return true; };
+  Reaction stale;
+  stale.kind = Reaction::Kind::Stale;
+  stale.awaiting_reset = true;
+  ControllerProtocol::Counts counts;
+  counts.stale = 1;
+  EXPECT_TRUE(reactionLog(stale, counts, "/cartpole_v0/joint_states", 0.02, ready, ready).empty());
+  Reaction restart;
+  restart.sim_restarted = true;
+  restart.awaiting_reset = true;
+  counts.restarts = counts.resets_back = 1;
+  const LogLines first = reactionLog(restart, counts, "/cartpole_v0/joint_states", 0.04, ready, ready);
+  ASSERT_EQ(1u, first.size());
+  EXPECT_EQ(LogLine::Level::Info, first[0].level);
+  EXPECT_EQ(
+      "/cartpole_v0/joint_states: the reset set time back to 0.040 s (as Gazebo's reset_simulation does): "
+      "each reset's start is taken from where time goes on (said once)",
+      first[0].text);
+  counts.restarts = counts.resets_back = 2;
+  EXPECT_TRUE(reactionLog(restart, counts, "/cartpole_v0/joint_states", 0.04, ready, ready).empty());
+  // Not awaited: a restart, warned as before.
+  restart.awaiting_reset = false;
+  EXPECT_EQ(LogLine::Level::Warn, reactionLog(restart, counts, "x", 0.04, ready, ready).at(0).level);
+}
+
+TEST_F(ControllerProtocolTest, TimeSetBackByTheResetAskedForIsMarkedAsAwaited)
+{
+  // Gazebo's reset_simulation: the fall, the reset asked for, then states from time 0 again.
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(100), kUpright);
+  ASSERT_TRUE(controller.onState(tick(101), kFallen).request_reset);
+  controller.onResetOutcome(true);
+  const Reaction first = controller.onState(tick(1), kUpright);
+  EXPECT_EQ(Reaction::Kind::Stale, first.kind);
+  EXPECT_TRUE(first.awaiting_reset);
+  controller.onState(tick(2), kUpright);
+  const Reaction r = controller.onState(tick(3), kUpright);
+  EXPECT_TRUE(r.sim_restarted);
+  EXPECT_TRUE(r.awaiting_reset);
+  EXPECT_TRUE(r.episode_began);
+  EXPECT_EQ(1u, controller.counts().resets_back);
+  // Mid-episode, time back is no reset of ours.
+  controller.onState(tick(4), kSmall);
+  controller.onState(tick(1), kSmall);
+  controller.onState(tick(2), kSmall);
+  const Reaction restart = controller.onState(tick(3), kSmall);
+  EXPECT_TRUE(restart.sim_restarted);
+  EXPECT_FALSE(restart.awaiting_reset);
+  EXPECT_EQ(1u, controller.counts().resets_back);
+}
+
 TEST(ReactionSaid, SaysWhatHappenedAndAsksTheThrottleOnlyForWhatItThrottles)
 {
   int asked = 0;
