@@ -248,10 +248,11 @@ check "the saves while training left the solved default table" "cmp '$TABLES/q_t
 run "evaluate.launch" 200 0 "roslaunch cartpole_qlearning evaluate.launch q_table:=q_table.yaml" \
   "evaluation episode 1: [0-9]+ steps" \
   "EVALUATED 5 episodes: [0-5] balanced to the step limit \(500 steps\), mean return [0-9.]+"
-# The tutorial's picture of the whole table (plot_policy writes it in the current folder).
-run "plot_policy q_table.yaml" 60 0 "rosrun cartpole_qlearning plot_policy q_table.yaml" \
-  "plot_policy: q_table_policy.png: 201x201 states of q_table.yaml"
-check "plot_policy wrote q_table_policy.png" "test -s q_table_policy.png"
+# The tutorial's picture of the whole table (into /tmp, as the tutorial types it).
+rm -f /tmp/q_table_policy.png
+run "plot_policy q_table.yaml" 60 0 "rosrun cartpole_qlearning plot_policy q_table.yaml -o /tmp/q_table_policy.png" \
+  "plot_policy: /tmp/q_table_policy.png: 201x201 states of q_table.yaml"
+check "plot_policy wrote /tmp/q_table_policy.png" "test -s /tmp/q_table_policy.png"
 run "evaluate.launch q_table:=runs/my_table.yaml" 100 0 \
   "roslaunch cartpole_qlearning evaluate.launch q_table:=runs/my_table.yaml episodes:=1" \
   "cartpole_qlearning/cartpole/runs/my_table.yaml" "EVALUATED 1 episodes: [01] balanced to the step limit"
