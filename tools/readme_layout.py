@@ -65,7 +65,8 @@ def table():
         ("`launch/`", "the launch files users type: " + quoted(files("launch")) + "; `launch/include/` holds their parts"),
         ("`urdf/`, `rviz/`", "`cartpole.urdf` (links match the TF frames), `cartpole.rviz`"),
         ("`mjcf/`", "`cartpole.xml`: the cart-pole as a MuJoCo model (config/mujoco_cartpole.yaml; docs/mujoco.md)"),
-        ("`docs/`", "pages and pictures (`docs/images/`), each picture made by the command beside it"),
+        ("`docs/`", "the users' pages and pictures (`docs/images/`), each picture made by the command beside it; "
+         "`docs/notes/`: the developers' notes (tuning rounds, variants tried, earlier benchmark runs)"),
         ("`test/`", "`unit/<layer>/`: gtests of each core layer (`<layer>_tests`, no ROS) and of its layout; "
          "`ros/`: the ROS layer's message conversions (no master); `cli/`: `train_headless` run as a user runs "
          "it, and its options parsed without a process; `docs/`: the pages' links and parameters; `rostest/`: the nodes' wiring (`*.test` files and their "

@@ -1,4 +1,5 @@
-// Every relative link in README.md and docs/*.md leads somewhere: the file or folder exists and,
+// Every relative link in README.md and the pages under docs/ (docs/*.md and the developers' notes in
+// its folders) leads somewhere: the file or folder exists and,
 // for a link with #anchor into a Markdown page, that page has a heading with that anchor. The
 // pages move text between one another; a link left pointing at where the text was fails here.
 // Anchors are made the way GitHub makes them, since that is where users read the pages.
@@ -129,14 +130,25 @@ std::string brokenBecause(const fs::path& page, const std::string& target)
   return "";
 }
 
+// README.md, then every Markdown page under docs/, in its folders too (docs/notes/).
 std::vector<fs::path> pages()
 {
   std::vector<fs::path> found{kSource / "README.md"};
-  for (const fs::directory_entry& entry : fs::directory_iterator(kSource / "docs"))
+  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(kSource / "docs"))
     if (entry.is_regular_file() && entry.path().extension() == ".md")
       found.push_back(entry.path());
   std::sort(found.begin() + 1, found.end());
   return found;
+}
+
+// Whether a relative link of `page` leads to README.md (from docs/ that is ../README.md, from
+// docs/notes/ ../../README.md), with or without an anchor.
+bool leadsToTheReadme(const fs::path& page, const std::string& target)
+{
+  if (isExternal(target))
+    return false;
+  const fs::path file = (page.parent_path() / target.substr(0, target.find('#'))).lexically_normal();
+  return file == (kSource / "README.md").lexically_normal();
 }
 
 TEST(DocsLinksTest, AnchorsAreGitHubs)
@@ -165,6 +177,18 @@ TEST(DocsLinksTest, ABrokenLinkIsCaught)
   EXPECT_EQ(brokenBecause(readme, "#documentation"), "");
 }
 
+TEST(DocsLinksTest, TheDevelopersNotesAreAmongThePagesChecked)
+{
+  const std::vector<fs::path> found = pages();
+  EXPECT_NE(std::find(found.begin(), found.end(), kSource / "docs" / "notes" / "tuning.md"), found.end())
+      << "docs/notes/tuning.md is not among the pages whose links are checked";
+  const fs::path notes = kSource / "docs" / "notes" / "tuning.md";
+  EXPECT_TRUE(leadsToTheReadme(notes, "../../README.md#documentation"));
+  EXPECT_FALSE(leadsToTheReadme(notes, "../README.md#documentation"));
+  EXPECT_TRUE(leadsToTheReadme(kSource / "docs" / "design.md", "../README.md"));
+  EXPECT_FALSE(leadsToTheReadme(kSource / "docs" / "design.md", "https://example.org/README.md"));
+}
+
 TEST(DocsLinksTest, EveryRelativeLinkInTheReadmeAndDocsLeadsSomewhere)
 {
   std::size_t checked = 0;
@@ -191,8 +215,8 @@ TEST(DocsLinksTest, EveryDocsPageLinksBackToTheReadme)
       continue;
     const std::vector<std::string> links = linksOf(fileText(page));
     const bool back =
-        std::any_of(links.begin(), links.end(), [](const std::string& l) { return l.rfind("../README.md", 0) == 0; });
-    EXPECT_TRUE(back) << fs::relative(page, kSource).string() << " has no link back to ../README.md";
+        std::any_of(links.begin(), links.end(), [&page](const std::string& l) { return leadsToTheReadme(page, l); });
+    EXPECT_TRUE(back) << fs::relative(page, kSource).string() << " has no link back to the README";
   }
 }
 

@@ -134,7 +134,8 @@ class PolicyPictureTest(unittest.TestCase):
         if matplotlib.__version__ == MATPLOTLIB_OF_THE_DOCS:
             with open(os.path.join(PACKAGE_DIR, "docs", "images", "policy_%s.png" % name), "rb") as committed:
                 self.assertEqual(committed.read(), drawn, "docs/images/policy_%s.png is not what its command draws "
-                                 "now: run the command in docs/pictures.md again" % name)
+                                 "now: run the command in docs/pictures.md again with -o docs/images/policy_%s.png"
+                                 % (name, name))
 
     def test_the_default_tables_policy(self):
         self.check("bins", ties_expected=False)
