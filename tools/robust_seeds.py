@@ -67,11 +67,21 @@ def main():
         end = re.search(r'^(SUITE PASSED|suite NOT passed|SOLVED|NOT solved)\S* .*?after (\d+) episodes, (\d+) steps',
                         out, re.M)
         verdict = [l for l in out.splitlines() if re.search(r': (PASSED|FAILED)$', l) and ' at episode ' not in l]
-        if not end or not verdict:
+        if verdict:
+            cases = re.findall(r'(\w+) (\d+)/(\d+)', verdict[-1])
+            passed = verdict[-1].endswith('PASSED')
+            said = verdict[-1]
+        else:
+            # A run trained until solved prints its table's verdict as a table, for information:
+            # a row per case ("nominal  0/1  100  874.0  FAIL ..."), then "N of M cases pass".
+            summary = re.search(r'^(\d+) of (\d+) cases pass', out, re.M)
+            cases = re.findall(r'^(\w+) +(\d+)/(\d+) +\d+ ', out, re.M)
+            passed = bool(summary) and summary.group(1) == summary.group(2)
+            said = summary.group(0) if summary else ''
+        if not end or not cases:
             sys.exit('seed %d: no verdict in the output:\n%s' % (seed, out))
-        cases = re.findall(r'(\w+) (\d+)/(\d+)', verdict[-1])
-        print('seed %d: %s' % (seed, verdict[-1]), file=sys.stderr, flush=True)
-        return dict(seed=seed, passed=verdict[-1].endswith('PASSED'), episodes=int(end.group(2)),
+        print('seed %d: %s' % (seed, said), file=sys.stderr, flush=True)
+        return dict(seed=seed, passed=passed, episodes=int(end.group(2)),
                     steps=int(end.group(3)), wall=wall, cases=[(n, int(b)) for n, b, _ in cases])
 
     # A seed without a verdict stops the whole run at once (sys.exit in a worker thread would only
