@@ -7,6 +7,7 @@
 #include "cartpole_qlearning/application/table_store.h"
 #include "cartpole_qlearning/learning/table_config.h"
 #include "cartpole_qlearning/protocol/reset_calls.h"
+#include "cartpole_qlearning/simulation/engine_registry.h"
 
 #include <algorithm>
 #include <array>
@@ -167,7 +168,7 @@ void readFinite(SectionReader& priv, const std::string& name, double& value)
 // ~pole_joint still win): one config names them for the sim and the controller alike.
 void useModelJoints(const EngineParams& engine, RobotInterfaceParams& robot)
 {
-  if (engine.kind == EngineKind::Equations)
+  if (!engineOf(engine).names_joints)
     return;
   robot.cart_joint = engine.cart_joint;
   robot.pole_joint = engine.pole_joint;

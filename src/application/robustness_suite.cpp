@@ -1,5 +1,6 @@
 #include "cartpole_qlearning/application/robustness_suite.h"
 
+#include "cartpole_qlearning/simulation/engine_registry.h"
 #include "cartpole_qlearning/simulation/physics_engines.h"
 #include "cartpole_qlearning/learning/cartpole_task.h"
 #include "cartpole_qlearning/learning/delay_predictor.h"
@@ -72,19 +73,6 @@ double boundValue(const YAML::Node& node, const std::string& where)
   if (!(std::isfinite(value) && value >= 0.0))
     throw ConfigError(where + " = '" + YAML::Dump(node) + "' is not allowed (must be a finite number >= 0)");
   return value;
-}
-
-// A case's step, in steps of the unperturbed model: each noisy value draws a normal (a log, a
-// cosine and two draws, about half the physics' step: perf on the shipped suite), a push a draw.
-double stepCost(const SuiteCase& c)
-{
-  const PerturbationParams& p = c.perturbations;
-  double cost = 1.0;
-  for (std::size_t i = 0; i < p.noise_std.size(); ++i)
-    cost += p.noise_std[i] != 0.0 || p.noise_fraction[i] != 0.0 ? 0.5 : 0.0;
-  if (p.push_probability > 0.0 && p.push_force != 0.0)
-    cost += 0.1;
-  return cost;
 }
 }  // namespace
 
@@ -264,9 +252,7 @@ std::uint64_t fallsToFail(const CaseResult& result)
 
 bool episodesRunInAnyOrder(const SuiteCase& suite_case)
 {
-  const PerturbationParams& p = suite_case.perturbations;
-  return suite_case.engine.kind == EngineKind::Equations && !p.noisy() &&
-         !(p.push_probability > 0.0 && p.push_force != 0.0);
+  return engineOf(suite_case.engine).episodes_independent && !suite_case.perturbations.drawsWhileStepping();
 }
 
 namespace
@@ -446,7 +432,7 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
     taken[p] = p;
   if (!how.stop_at_first_failure)
     std::stable_sort(taken.begin(), taken.end(), [&](std::size_t a, std::size_t b) {
-      return stepCost(suite.cases[order[a]]) > stepCost(suite.cases[order[b]]);
+      return suite.cases[order[a]].perturbations.stepCost() > suite.cases[order[b]].perturbations.stepCost();
     });
   std::vector<CaseResult> results(order.size());
   std::atomic<std::size_t> next{0};
@@ -490,9 +476,10 @@ SuiteResult evaluateSuite(const QTable& table, const TrainingConfig& config, con
   };
   const unsigned cores = usableCores();
   std::size_t threads = std::min<std::size_t>(how.threads > 0 ? how.threads : cores, order.size());
-  // MuJoCo's XML loading is not documented as thread-safe: cases on a model run one after another.
+  // Cases on an engine that cannot be made on several threads at once (MuJoCo's XML loading) run one
+  // after another.
   if (std::any_of(suite.cases.begin(), suite.cases.end(),
-                  [](const SuiteCase& c) { return c.engine.kind != EngineKind::Equations; }))
+                  [](const SuiteCase& c) { return !engineOf(c.engine).makes_in_parallel; }))
     threads = 1;
   std::vector<std::thread> helpers;
   for (std::size_t t = 1; t < threads; ++t)

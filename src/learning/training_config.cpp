@@ -1,5 +1,7 @@
 #include "cartpole_qlearning/learning/training_config.h"
 
+#include "cartpole_qlearning/simulation/engine_registry.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <charconv>
@@ -273,50 +275,80 @@ std::string configFolder(const std::string& path)
   return slash == std::string::npos ? "." : path.substr(0, slash + (slash == 0));
 }
 
+namespace
+{
+// The engine's file keys (a model): ${VARIABLES} expanded, relative to the config's folder, required.
+void readEngineFiles(const ParameterSource& source, SectionReader& reader, const EngineDescription& own,
+                     EngineParams& engine)
+{
+  for (const EngineKey& key : own.keys)
+  {
+    if (key.file.empty())
+      continue;
+    std::string& path = engine.*key.text;
+    if (!source.keysUnder(reader.key(key.name)).empty())
+    {
+      const std::string given = path;
+      path = expandEnvironment(given, [&](const std::string& variable) {
+        reader.fail(key.name, "'" + given + "'",
+                    "the environment variable " + variable + " is not set: set it, or give the path itself");
+      });
+      if (path.empty())
+        reader.fail(key.name, "''", "must name " + key.file);
+      if (path.front() != '/' && !source.folder().empty())
+        path = source.folder() + "/" + path;
+    }
+    if (path.empty())
+      reader.fail(key.name, "''", "physics/engine " + own.name + " needs " + key.file);
+  }
+}
+}  // namespace
+
 void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound,
                  EngineParams& engine)
 {
   SectionReader reader(source, "physics");
-  readEnum(reader, "engine", engine.kind, engineKindFromString);
-  reader.read("model", engine.model);
-  reader.read("cart_joint", engine.cart_joint);
-  reader.read("pole_joint", engine.pole_joint);
-  reader.read("actuator", engine.actuator);
-  const bool mujoco = engine.kind == EngineKind::Mujoco;
-  const char* const equations_keys[] = {"gravity",    "mass_cart",     "mass_pole",    "half_length",
-                                        "integrator", "cart_friction", "pole_friction"};
-  const char* const model_keys[] = {"model", "cart_joint", "pole_joint", "actuator"};
-  for (const char* name : mujoco ? std::vector<const char*>(std::begin(equations_keys), std::end(equations_keys))
-                                 : std::vector<const char*>(std::begin(model_keys), std::end(model_keys)))
+  reader.read("engine", engine.name);
+  const EngineDescription* found = nullptr;
+  try
   {
-    if (!source.keysUnder(reader.key(name)).empty())
-      throw ConfigError(source.describe(reader.key(name)) + " is not allowed with physics/engine " +
-                        toString(engine.kind) +
-                        (mujoco ? " (the model sets it: edit the model)" : " (it names a MuJoCo model's parts)"));
+    found = &engineOf(engine);
   }
-  if (mujoco && !source.keysUnder(reader.key("model")).empty())
+  catch (const std::invalid_argument& e)
   {
-    const std::string given = engine.model;
-    engine.model = expandEnvironment(given, [&](const std::string& variable) {
-      reader.fail("model", "'" + given + "'",
-                  "the environment variable " + variable + " is not set: set it, or give the path itself");
-    });
-    if (engine.model.empty())
-      reader.fail("model", "''", "must name an MJCF file");
-    if (engine.model.front() != '/' && !source.folder().empty())
-      engine.model = source.folder() + "/" + engine.model;
+    reader.fail("engine", "'" + engine.name + "'", e.what());
   }
-  if (mujoco && engine.model.empty())
-    reader.fail("model", "''", "physics/engine mujoco needs an MJCF file");
-  reader.read("gravity", physics.gravity);
-  reader.read("mass_cart", physics.mass_cart);
-  reader.read("mass_pole", physics.mass_pole);
-  reader.read("half_length", physics.half_length);
+  const EngineDescription& own = *found;
+  // Every engine's texts, then the keys of the others refused (before any number is read), then
+  // every engine's numbers: an engine's keys keep their defaults unless given.
+  for (const EngineDescription& other : engineDescriptions())
+    for (const EngineKey& key : other.keys)
+      if (key.text != nullptr)
+        reader.read(key.name, engine.*key.text);
+  for (const EngineDescription& other : engineDescriptions())
+  {
+    for (const EngineKey& key : other.keys)
+    {
+      const bool owned = std::any_of(own.keys.begin(), own.keys.end(),
+                                     [&key](const EngineKey& mine) { return mine.name == key.name; });
+      if (!owned && !source.keysUnder(reader.key(key.name)).empty())
+        throw ConfigError(source.describe(reader.key(key.name)) + " is not allowed with physics/engine " + own.name +
+                          " (" + (own.foreign_keys_note.empty() ? other.own_keys_note : own.foreign_keys_note) + ")");
+    }
+  }
+  readEngineFiles(source, reader, own, engine);
+  for (const EngineDescription& other : engineDescriptions())
+  {
+    for (const EngineKey& key : other.keys)
+    {
+      if (key.number != nullptr)
+        reader.read(key.name, physics.*key.number);
+      else if (key.choice != nullptr)
+        readEnum(reader, key.name, physics.*key.choice, integratorFromString);
+    }
+  }
   reader.read("force_mag", physics.force_mag);
   reader.read("tau", physics.tau);
-  readEnum(reader, "integrator", physics.integrator, integratorFromString);
-  reader.read("cart_friction", physics.cart_friction);
-  reader.read("pole_friction", physics.pole_friction);
   reader.read("start_state_bound", start_state_bound);
   reader.refuseUnknown();
   reader.check(physics.validate());
@@ -327,58 +359,79 @@ void readPhysics(const ParameterSource& source, CartPoleParams& physics, double&
 void checkPerturbationsFitEngine(const ParameterSource& source, const EngineParams& engine,
                                  const PerturbationParams& perturbations)
 {
-  if (engine.kind != EngineKind::Equations && perturbations.half_length.varies())
+  if (!engineOf(engine).scales_half_length && perturbations.half_length.varies())
     throw ConfigError(source.describe("perturbations/half_length") + " is not allowed with physics/engine " +
-                      toString(engine.kind) + " (a model's pole is its geometry: scale it in the model)");
+                      engine.name + " (a model's pole is its geometry: scale it in the model)");
 }
 
-PerturbationParams readPerturbations(const ParameterSource& source)
+namespace
 {
-  PerturbationParams p;
-  SectionReader reader(source, "perturbations");
-  // One number of steps, or [low, high]: drawn per episode.
-  reader.know("delay_steps");
+// One number of steps, or [low, high]: drawn per episode.
+void readSteps(const ParameterSource& source, SectionReader& reader, const std::string& name, unsigned& low,
+               unsigned& high)
+{
+  reader.know(name);
   const char* const allowed = "must be a whole number of steps in [0, 1000], or [low, high] of them";
   std::int64_t steps = 0;
   bool single = false;
   try
   {
-    single = source.get(reader.key("delay_steps"), steps);
+    single = source.get(reader.key(name), steps);
   }
   catch (const ConfigError&)
   {
     std::vector<double> delay;
-    source.get(reader.key("delay_steps"), delay);  // not a list either: throws naming the key
+    source.get(reader.key(name), delay);  // not a list either: throws naming the key
     if (delay.size() != 2 || delay[0] != std::floor(delay[0]) || delay[1] != std::floor(delay[1]) || delay[0] < 0 ||
         delay[1] < delay[0] || delay[1] > 1000)
-      reader.fail("delay_steps", SectionReader::listText(delay), allowed);
-    p.delay_steps = static_cast<unsigned>(delay[0]);
-    p.delay_steps_max = static_cast<unsigned>(delay[1]);
+      reader.fail(name, SectionReader::listText(delay), allowed);
+    low = static_cast<unsigned>(delay[0]);
+    high = static_cast<unsigned>(delay[1]);
   }
   if (single)
   {
     if (steps < 0 || steps > 1000)
-      reader.fail("delay_steps", std::to_string(steps), allowed);
-    p.delay_steps = p.delay_steps_max = static_cast<unsigned>(steps);
+      reader.fail(name, std::to_string(steps), allowed);
+    low = high = static_cast<unsigned>(steps);
   }
-  reader.readDimensions("noise_std", p.noise_std, false);
-  reader.readDimensions("noise_fraction", p.noise_fraction, false);
-  for (const auto& [name, range] : {std::pair<const char*, ScaleRange*>{"mass_cart", &p.mass_cart},
-                                    {"mass_pole", &p.mass_pole},
-                                    {"half_length", &p.half_length},
-                                    {"motor", &p.motor}})
+}
+
+void readFactors(const ParameterSource& source, SectionReader& reader, const std::string& name, ScaleRange& range)
+{
+  std::vector<double> bounds;
+  reader.know(name);
+  if (!source.get(reader.key(name), bounds))
+    return;
+  if (bounds.size() != 2)
+    reader.fail(name, SectionReader::listText(bounds), "must list 2 factors: [low, high]");
+  range.low = bounds[0];
+  range.high = bounds[1];
+}
+}  // namespace
+
+PerturbationParams readPerturbations(const ParameterSource& source)
+{
+  using Form = PerturbationKey::Form;
+  PerturbationParams p;
+  SectionReader reader(source, "perturbations");
+  for (const PerturbationKey& key : perturbationKeys())
   {
-    std::vector<double> bounds;
-    reader.know(name);
-    if (!source.get(reader.key(name), bounds))
-      continue;
-    if (bounds.size() != 2)
-      reader.fail(name, SectionReader::listText(bounds), "must list 2 factors: [low, high]");
-    range->low = bounds[0];
-    range->high = bounds[1];
+    switch (key.form)
+    {
+      case Form::Steps:
+        readSteps(source, reader, key.name, p.*key.low, p.*key.high);
+        break;
+      case Form::Dimensions:
+        reader.readDimensions(key.name, p.*key.dimensions, false);
+        break;
+      case Form::Factors:
+        readFactors(source, reader, key.name, p.*key.factors);
+        break;
+      case Form::Number:
+        reader.read(key.name, p.*key.number);
+        break;
+    }
   }
-  reader.read("push_probability", p.push_probability);
-  reader.read("push_force", p.push_force);
   reader.refuseUnknown();
   reader.check(p.validate());
   return p;
@@ -538,24 +591,15 @@ std::string trainingConfigText(const TrainingConfig& config)
   const CartPoleParams& physics = config.physics;
   const EngineParams& engine = config.engine;
   out << YAML::Key << "physics" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "engine" << YAML::Value << toString(engine.kind);
-  if (engine.kind == EngineKind::Mujoco)
+  out << YAML::Key << "engine" << YAML::Value << engine.name;
+  for (const EngineKey& key : engineOf(engine).keys)
   {
-    for (const auto& [key, value] : {std::pair<const char*, const std::string*>{"model", &engine.model},
-                                     {"cart_joint", &engine.cart_joint},
-                                     {"pole_joint", &engine.pole_joint},
-                                     {"actuator", &engine.actuator}})
-      out << YAML::Key << key << YAML::Value << YAML::DoubleQuoted << *value;
-  }
-  else
-  {
-    emitNumber(out, "gravity", physics.gravity);
-    emitNumber(out, "mass_cart", physics.mass_cart);
-    emitNumber(out, "mass_pole", physics.mass_pole);
-    emitNumber(out, "half_length", physics.half_length);
-    out << YAML::Key << "integrator" << YAML::Value << toString(physics.integrator);
-    emitNumber(out, "cart_friction", physics.cart_friction);
-    emitNumber(out, "pole_friction", physics.pole_friction);
+    if (key.number != nullptr)
+      emitNumber(out, key.name.c_str(), physics.*key.number);
+    else if (key.choice != nullptr)
+      out << YAML::Key << key.name << YAML::Value << toString(physics.*key.choice);
+    else
+      out << YAML::Key << key.name << YAML::Value << YAML::DoubleQuoted << engine.*key.text;
   }
   emitNumber(out, "force_mag", physics.force_mag);
   emitNumber(out, "tau", physics.tau);
@@ -564,25 +608,28 @@ std::string trainingConfigText(const TrainingConfig& config)
 
   const PerturbationParams& p = config.perturbations;
   out << YAML::Key << "perturbations" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "delay_steps" << YAML::Value;
-  if (p.delay_steps == p.delay_steps_max)
-    out << p.delay_steps;
-  else
-    emitNumbers(out, std::array<unsigned, 2>{{p.delay_steps, p.delay_steps_max}});
-  out << YAML::Key << "noise_std" << YAML::Value;
-  emitNumbers(out, p.noise_std);
-  out << YAML::Key << "noise_fraction" << YAML::Value;
-  emitNumbers(out, p.noise_fraction);
-  for (const auto& [key, range] : {std::pair<const char*, const ScaleRange*>{"mass_cart", &p.mass_cart},
-                                   {"mass_pole", &p.mass_pole},
-                                   {"half_length", &p.half_length},
-                                   {"motor", &p.motor}})
+  for (const PerturbationKey& key : perturbationKeys())
   {
-    out << YAML::Key << key << YAML::Value;
-    emitNumbers(out, std::array<double, 2>{{range->low, range->high}});
+    out << YAML::Key << key.name << YAML::Value;
+    switch (key.form)
+    {
+      case PerturbationKey::Form::Steps:
+        if (p.*key.low == p.*key.high)
+          out << p.*key.low;
+        else
+          emitNumbers(out, std::array<unsigned, 2>{{p.*key.low, p.*key.high}});
+        break;
+      case PerturbationKey::Form::Dimensions:
+        emitNumbers(out, p.*key.dimensions);
+        break;
+      case PerturbationKey::Form::Factors:
+        emitNumbers(out, std::array<double, 2>{{(p.*key.factors).low, (p.*key.factors).high}});
+        break;
+      case PerturbationKey::Form::Number:
+        out << exactText(p.*key.number);
+        break;
+    }
   }
-  emitNumber(out, "push_probability", p.push_probability);
-  emitNumber(out, "push_force", p.push_force);
   out << YAML::EndMap;
 
   const TaskParams& task = config.task;

@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/ros/cartpole_sim.h"
 
 #include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/simulation/engine_registry.h"
 #include "cartpole_qlearning/simulation/physics_engines.h"
 #include "cartpole_qlearning/ros/conversions.h"
 #include "parameter_source.h"
@@ -113,9 +114,7 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
           });
     publishState(ros::Time::now());
   }
-  const std::string engine = settings_.engine.kind == EngineKind::Equations
-                                 ? "integrator " + toString(settings_.physics.integrator)
-                                 : "MuJoCo model " + settings_.engine.model;
+  const std::string engine = engineOf(settings_.engine).describe(settings_.physics, settings_.engine);
   say(ros::console::levels::Info, "cartpole_sim: %s mode, tau %g s, %s, seed %llu, start state [%g, %g, %g, %g]%s%s",
       settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau, engine.c_str(),
       static_cast<unsigned long long>(settings_.seed), simulation_->state()[0], simulation_->state()[1],

@@ -19,7 +19,7 @@ CartPoleSimulation::CartPoleSimulation(std::unique_ptr<PhysicsEngine> engine, do
     start_state_bound_(start_state_bound),
     perturbations_(perturbations),
     noisy_(perturbations.noisy()),
-    pushes_(perturbations.push_probability > 0.0 && perturbations.push_force != 0.0),
+    pushes_(perturbations.pushes()),
     rng_(seed, kEnvironmentStream),
     noise_rng_(seed, kNoiseStream),
     perturbation_rng_(seed, kPerturbationStream),
@@ -76,8 +76,7 @@ void CartPoleSimulation::beginEpisode()
   applied_force_ = 0.0;
   last_push_ = 0.0;
   unsigned delay = perturbations_.delay_steps;
-  if (perturbations_.mass_cart.varies() || perturbations_.mass_pole.varies() || perturbations_.half_length.varies() ||
-      perturbations_.motor.varies() || perturbations_.delay_steps_max != perturbations_.delay_steps)
+  if (perturbations_.drawnPerEpisode())
   {
     const EpisodeFactors factors = drawEpisodeFactors(perturbations_, perturbation_rng_, delay);
     motor_factor_ = factors.motor;

@@ -24,10 +24,26 @@ bool PerturbationParams::noisy() const
   return false;
 }
 
+bool PerturbationParams::drawnPerEpisode() const
+{
+  return mass_cart.varies() || mass_pole.varies() || half_length.varies() || motor.varies() ||
+         delay_steps_max != delay_steps;
+}
+
+double PerturbationParams::stepCost() const
+{
+  double cost = 1.0;
+  for (std::size_t i = 0; i < noise_std.size(); ++i)
+    cost += noise_std[i] != 0.0 || noise_fraction[i] != 0.0 ? 0.5 : 0.0;
+  if (pushes())
+    cost += 0.1;
+  return cost;
+}
+
 bool PerturbationParams::any() const
 {
   return delay_steps > 0 || delay_steps_max > 0 || noisy() || mass_cart.varies() || mass_pole.varies() ||
-         half_length.varies() || motor.varies() || (push_probability > 0.0 && push_force != 0.0);
+         half_length.varies() || motor.varies() || pushes();
 }
 
 std::string PerturbationParams::validate() const
@@ -63,6 +79,44 @@ std::string PerturbationParams::validate() const
   if (!(std::isfinite(push_force) && push_force >= 0.0))
     return bad("push_force", push_force, "must be finite and >= 0");
   return "";
+}
+
+const std::vector<PerturbationKey>& perturbationKeys()
+{
+  using Form = PerturbationKey::Form;
+  using P = PerturbationParams;
+  static const std::vector<PerturbationKey> keys = [] {
+    std::vector<PerturbationKey> list;
+    PerturbationKey delay{"delay_steps", Form::Steps};
+    delay.low = &P::delay_steps;
+    delay.high = &P::delay_steps_max;
+    list.push_back(delay);
+    for (const auto& [name, field] : {std::pair<const char*, std::array<double, 4> P::*>{"noise_std", &P::noise_std},
+                                      {"noise_fraction", &P::noise_fraction}})
+    {
+      PerturbationKey key{name, Form::Dimensions};
+      key.dimensions = field;
+      list.push_back(key);
+    }
+    for (const auto& [name, field] : {std::pair<const char*, ScaleRange P::*>{"mass_cart", &P::mass_cart},
+                                      {"mass_pole", &P::mass_pole},
+                                      {"half_length", &P::half_length},
+                                      {"motor", &P::motor}})
+    {
+      PerturbationKey key{name, Form::Factors};
+      key.factors = field;
+      list.push_back(key);
+    }
+    for (const auto& [name, field] : {std::pair<const char*, double P::*>{"push_probability", &P::push_probability},
+                                      {"push_force", &P::push_force}})
+    {
+      PerturbationKey key{name, Form::Number};
+      key.number = field;
+      list.push_back(key);
+    }
+    return list;
+  }();
+  return keys;
 }
 
 EpisodeFactors drawEpisodeFactors(const PerturbationParams& p, RandomStream& rng, unsigned& delay_steps)
@@ -121,7 +175,7 @@ std::string describePerturbations(const PerturbationParams& p, double tau)
     if (range->varies())
       item() << name << " x[" << range->low << ", " << range->high << "]";
   }
-  if (p.push_probability > 0.0 && p.push_force != 0.0)
+  if (p.pushes())
     item() << "pushes of " << p.push_force << " N on " << p.push_probability << " of the steps";
   return out.tellp() > 0 ? out.str() : "none";
 }

@@ -37,12 +37,12 @@ TEST(SimToSim, ARobustTableTrainedOnTheEquationsBalancesTheMujocoCartPole)
   EXPECT_NE(std::string::npos, training.output.find(": PASSED")) << training.output;
 
   const cq::TrainingConfig robust = cq::readTrainingConfig(*cq::loadYamlParameters(CARTPOLE_CONFIG_DIR "/robust.yaml"));
-  ASSERT_EQ(cq::EngineKind::Equations, robust.engine.kind) << "trained on the equations";
+  ASSERT_EQ("equations", robust.engine.name) << "trained on the equations";
   const cq::RobustnessSuite suite = cq::loadRobustnessSuite(CARTPOLE_CONFIG_DIR "/sim_to_sim_suite.yaml", robust);
   ASSERT_FALSE(suite.cases.empty());
   const cq::SuiteCase mujoco = suite.cases.front();
   ASSERT_EQ("mujoco", mujoco.name);
-  EXPECT_EQ(cq::EngineKind::Mujoco, mujoco.engine.kind);
+  EXPECT_EQ("mujoco", mujoco.engine.name);
   EXPECT_EQ(98u, mujoco.pass);
   EXPECT_EQ(3000u, suite.max_episode_steps);  // a minute, robust_suite.yaml's horizon
   const cq::SuiteResult result = cq::evaluateSuite(cq::loadQTableFile(table_file), robust, suite);

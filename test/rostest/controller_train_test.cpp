@@ -119,7 +119,7 @@ TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
                     .shapeMismatch(table));
   // joint_states name the joints as the engine does: a MuJoCo model's own, else the URDF's.
   const cartpole_qlearning::EngineParams engine = cartpole_qlearning::readTrainingConfig(*source).engine;
-  const std::vector<std::string> joints = engine.kind == cartpole_qlearning::EngineKind::Mujoco
+  const std::vector<std::string> joints = engine.name == "mujoco"
                                               ? std::vector<std::string>{engine.cart_joint, engine.pole_joint}
                                               : std::vector<std::string>{"cart_joint", "pole_joint"};
   EXPECT_EQ(joints, joint_names_);

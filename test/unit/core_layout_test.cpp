@@ -136,6 +136,36 @@ TEST(CoreLayoutTest, NoCoreFileIncludesAHeaderFromOutsideTheCoreOrFromALayerAbov
       EXPECT_FALSE(entry.is_regular_file()) << entry.path() << " lies outside the layers' folders";
 }
 
+// What in a file's text names a particular engine (its kind, or its name as a string): only the
+// engines' own files and their registry (the simulation layer) may.
+std::vector<std::string> engineNames(const std::string& text)
+{
+  std::vector<std::string> found;
+  for (const text_match::Groups& m : text_match::allMatches(text, R"((EngineKind|"mujoco"|"equations"))"))
+    found.push_back(m[1]);
+  return found;
+}
+
+TEST(CoreLayoutTest, OnlyTheSimulationLayerNamesAnEngine)
+{
+  EXPECT_EQ(engineNames("if (engine.kind == EngineKind::Mujoco)\n"), std::vector<std::string>{"EngineKind"});
+  EXPECT_EQ(engineNames("engine.name == \"mujoco\""), std::vector<std::string>{"\"mujoco\""});
+  EXPECT_TRUE(engineNames("engineOf(engine).names_joints").empty());
+  const fs::path include = kSource / "include" / "cartpole_qlearning";
+  for (const fs::path& root : {kSource / "src", include})
+  {
+    for (const fs::directory_entry& entry : fs::recursive_directory_iterator(root))
+    {
+      const fs::path folder = entry.path().parent_path();
+      if (!entry.is_regular_file() || folder == kSource / "src" / "simulation" || folder == include / "simulation")
+        continue;
+      for (const std::string& name : engineNames(readText(entry.path())))
+        ADD_FAILURE() << entry.path().string() << " names the engine " << name
+                      << ": ask the registry (simulation/engine_registry.h) what the engine does instead";
+    }
+  }
+}
+
 // The names in backquotes in the Layout row (of docs/design.md) that starts with `first_cell`,
 // leaving out paths and patterns (they name folders, not files). tools/readme_layout.py writes
 // the table.

@@ -51,10 +51,47 @@ struct PerturbationParams
   double push_force = 0.0;
 
   bool noisy() const;
+  bool pushes() const
+  {
+    return push_probability > 0.0 && push_force != 0.0;
+  }
+  // Something is drawn at each episode's start (the delay or a physics factor).
+  bool drawnPerEpisode() const;
+  // Random numbers are drawn at steps (noise, pushes), not only at resets: an episode then meets
+  // the draws of every step before it.
+  bool drawsWhileStepping() const
+  {
+    return noisy() || pushes();
+  }
+  // What a step costs, in steps of the unperturbed model: a noisy value draws a normal (a log, a
+  // cosine and two draws: about half the physics' step, perf on the shipped suite), a push a draw.
+  double stepCost() const;
   bool any() const;
   // Empty when valid, else a message naming the first bad field, its value and the allowed range.
   std::string validate() const;
 };
+
+// A key of the config's perturbations section and the field it sets, by the form its value takes.
+// The config's reader and a table's trained_with go through perturbationKeys(), in its order: a new
+// perturbation of one of these forms is its field, its line there, and what the simulation does.
+struct PerturbationKey
+{
+  enum class Form
+  {
+    Steps,       // a whole number of steps in [0, 1000], or [low, high] of them: `low` and `high`
+    Dimensions,  // one number per state value [x, x_dot, theta, theta_dot]: `dimensions`
+    Factors,     // [low, high], a factor drawn per episode: `factors`
+    Number       // `number`
+  };
+  std::string name;
+  Form form = Form::Number;
+  unsigned PerturbationParams::*low = nullptr;
+  unsigned PerturbationParams::*high = nullptr;
+  std::array<double, 4> PerturbationParams::*dimensions = nullptr;
+  ScaleRange PerturbationParams::*factors = nullptr;
+  double PerturbationParams::*number = nullptr;
+};
+const std::vector<PerturbationKey>& perturbationKeys();
 
 // The stream of the per-episode physics draws and the pushes (random.h has the others): its own,
 // so that turning perturbations on changes neither the start states nor exploration.

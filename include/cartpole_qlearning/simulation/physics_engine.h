@@ -14,21 +14,12 @@
 
 namespace cartpole_qlearning
 {
-enum class EngineKind
-{
-  Equations,  // CartPoleDynamics: CartPole-v1's equations (physics/gravity, masses, integrator, ...)
-  Mujoco      // a MuJoCo model (MJCF): the model sets the masses, geometry, integrator and timestep
-};
-
-// Parses "equations" or "mujoco"; throws std::invalid_argument otherwise.
-EngineKind engineKindFromString(const std::string& name);
-std::string toString(EngineKind kind);
-
-// Which engine, and for MuJoCo which model and which of its joints and actuator are the cart-pole's
-// (the config's physics/engine, model, cart_joint, pole_joint, actuator).
+// Which engine (engine_registry.h describes each), and for a model's engine which model and which
+// of its joints and actuator are the cart-pole's (the config's physics/engine, model, cart_joint,
+// pole_joint, actuator).
 struct EngineParams
 {
-  EngineKind kind = EngineKind::Equations;
+  std::string name = "equations";     // physics/engine: a name engine_registry.h lists
   std::string model;                  // the MJCF file (an absolute path, or one relative to the working folder)
   std::string cart_joint = "slider";  // a slide joint: x and x_dot are its qpos and qvel
   std::string pole_joint = "hinge";   // a hinge joint on a body the cart carries: theta and theta_dot

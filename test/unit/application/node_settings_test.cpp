@@ -495,7 +495,7 @@ TEST(SimSettings, DefaultsAreTheDocumentedOnes)
   // "": the engine's bodies, the equations' cart and pole (PhysicsEngine::cartBody, poleBody).
   EXPECT_EQ("", s.cart_frame);
   EXPECT_EQ("", s.pole_frame);
-  EXPECT_EQ(EngineKind::Equations, s.engine.kind);
+  EXPECT_EQ("equations", s.engine.name);
   EXPECT_EQ("cart_joint", s.pose.cart_joint);
   EXPECT_EQ("pole_joint", s.pose.pole_joint);
   EXPECT_FALSE(s.perturbations.any());
@@ -634,7 +634,7 @@ TEST(SimSettings, ReadsAMujocoModelRelativeToTheConfigsFolderAndPublishesItsJoin
 {
   const SimSettings s = readSimSettings(*parseYamlParameters(kModelPhysics, "/cartpole", "/home/me/config"),
                                         *parseYamlParameters("", kSim));
-  EXPECT_EQ(EngineKind::Mujoco, s.engine.kind);
+  EXPECT_EQ("mujoco", s.engine.name);
   EXPECT_EQ("/home/me/config/../mjcf/model.xml", s.engine.model);
   EXPECT_EQ("motor", s.engine.actuator);
   EXPECT_EQ("rail", s.pose.cart_joint);
@@ -654,7 +654,7 @@ TEST(SimSettings, PosesAsAMujocoCaseOfTheSimToSimSuite)
 {
   const std::string suite = std::string(CARTPOLE_CONFIG_DIR) + "/sim_to_sim_suite.yaml";
   const SimSettings s = readSim("{suite: " + suite + ", suite_case: mujoco}");
-  EXPECT_EQ(EngineKind::Mujoco, s.engine.kind);
+  EXPECT_EQ("mujoco", s.engine.name);
   EXPECT_EQ(std::string(CARTPOLE_CONFIG_DIR) + "/../mjcf/cartpole.xml", s.engine.model);
   EXPECT_EQ("cart_joint", s.pose.cart_joint);
   EXPECT_EQ(1000u, s.seed);

@@ -22,7 +22,7 @@ const std::string kModel = CARTPOLE_SOURCE_DIR "/mjcf/cartpole.xml";
 EngineParams projectModel()
 {
   EngineParams params;
-  params.kind = EngineKind::Mujoco;
+  params.name = "mujoco";
   params.model = kModel;
   params.cart_joint = "cart_joint";
   params.pole_joint = "pole_joint";
@@ -317,7 +317,7 @@ TEST(MujocoEngine, TheConfigMakesTheEngineAndTrainsOnIt)
 {
   const auto source = loadYamlParameters(CARTPOLE_CONFIG_DIR "/mujoco_cartpole.yaml");
   const TrainingConfig config = readTrainingConfig(*source);
-  EXPECT_EQ(EngineKind::Mujoco, config.engine.kind);
+  EXPECT_EQ("mujoco", config.engine.name);
   EXPECT_EQ(CARTPOLE_CONFIG_DIR "/../mjcf/cartpole.xml", config.engine.model);
   HeadlessTrainer trainer(config, 0);
   const EpisodeSummary& summary = trainer.runEpisode();
