@@ -580,14 +580,10 @@ void emitNumber(YAML::Emitter& out, const char* key, double value)
 {
   out << YAML::Key << key << YAML::Value << exactText(value);
 }
-}  // namespace
 
-std::string trainingConfigText(const TrainingConfig& config)
+// The physics section: only the keys the engine takes (readPhysics refuses the others beside it).
+void emitPhysics(YAML::Emitter& out, const TrainingConfig& config)
 {
-  YAML::Emitter out;
-  out << YAML::BeginMap;
-
-  // Only the keys the engine takes (readPhysics refuses the others beside it).
   const CartPoleParams& physics = config.physics;
   const EngineParams& engine = config.engine;
   out << YAML::Key << "physics" << YAML::Value << YAML::BeginMap;
@@ -605,8 +601,10 @@ std::string trainingConfigText(const TrainingConfig& config)
   emitNumber(out, "tau", physics.tau);
   emitNumber(out, "start_state_bound", config.start_state_bound);
   out << YAML::EndMap;
+}
 
-  const PerturbationParams& p = config.perturbations;
+void emitPerturbations(YAML::Emitter& out, const PerturbationParams& p)
+{
   out << YAML::Key << "perturbations" << YAML::Value << YAML::BeginMap;
   for (const PerturbationKey& key : perturbationKeys())
   {
@@ -631,6 +629,16 @@ std::string trainingConfigText(const TrainingConfig& config)
     }
   }
   out << YAML::EndMap;
+}
+}  // namespace
+
+std::string trainingConfigText(const TrainingConfig& config)
+{
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+
+  emitPhysics(out, config);
+  emitPerturbations(out, config.perturbations);
 
   const TaskParams& task = config.task;
   out << YAML::Key << "task" << YAML::Value << YAML::BeginMap;
