@@ -1,11 +1,18 @@
 #include "cartpole_qlearning/application/greedy_check.h"
 
+#include "cartpole_qlearning/application/greedy_episodes.h"
+#include "cartpole_qlearning/simulation/physics_engines.h"
+
+#include <optional>
 #include <stdexcept>
+#include <string>
 
 namespace cartpole_qlearning
 {
 GreedyCheck::GreedyCheck(const TrainingConfig& config, unsigned episodes, std::uint64_t seed)
-  : episodes_(episodes), trainer_(config, seed, 1, false)
+  : episodes_(episodes),
+    config_(config),
+    simulation_(makeSimulation(config.physics, config.engine, config.start_state_bound, seed, config.perturbations))
 {
   if (episodes < 1)
     throw std::invalid_argument("GreedyCheck: at least one episode");
@@ -13,14 +20,20 @@ GreedyCheck::GreedyCheck(const TrainingConfig& config, unsigned episodes, std::u
 
 bool GreedyCheck::passes(const QTable& table)
 {
-  const std::string mismatch = trainer_.session().replaceTable(table);
-  if (!mismatch.empty())
-    throw std::invalid_argument("GreedyCheck: the table does not fit the configuration: " + mismatch);
+  std::optional<GreedyEpisodes> greedy;
+  try
+  {
+    greedy.emplace(table, config_);
+  }
+  catch (const ConfigError& e)
+  {
+    throw std::invalid_argument(std::string("GreedyCheck: ") + e.what());
+  }
   for (unsigned e = 0; e < episodes_; ++e)
   {
-    const EpisodeSummary& s = trainer_.runEpisode();
-    steps_run_ += s.steps;
-    if (s.terminated || !s.truncated)
+    const GreedyEpisode episode = greedy->run(simulation_);
+    steps_run_ += episode.steps;
+    if (!episode.balanced)
       return false;
   }
   return true;

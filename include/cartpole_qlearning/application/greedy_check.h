@@ -6,15 +6,15 @@
 // step.
 #pragma once
 
-#include "cartpole_qlearning/application/headless_trainer.h"
 #include "cartpole_qlearning/learning/q_table.h"
 #include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/simulation/cartpole_simulation.h"
 
 #include <cstdint>
 
 namespace cartpole_qlearning
 {
-// The check's starts for a run of `seed`: apart from every robot's (robotSeed).
+// The check's starts for a run of `seed`: apart from every robot's (headless_trainer.h's robotSeed).
 inline std::uint64_t greedyCheckSeed(std::uint64_t seed)
 {
   return seed + 1000000;
@@ -27,8 +27,9 @@ public:
   // config's engine cannot be made.
   GreedyCheck(const TrainingConfig& config, unsigned episodes, std::uint64_t seed);
 
-  // Runs `table` greedily, episode by episode, stopping at the first that falls: true when all of
-  // them balanced to the step limit. Each call starts where the last left the check's starts.
+  // Runs `table` greedily (greedy_episodes.h), episode by episode, stopping at the first that
+  // falls: true when all of them balanced to the step limit. Each call starts where the last left
+  // the check's starts. Throws std::invalid_argument when the table does not fit the configuration.
   bool passes(const QTable& table);
   // Steps run by every call so far (none of them training's).
   std::uint64_t stepsRun() const
@@ -38,7 +39,8 @@ public:
 
 private:
   unsigned episodes_;
-  HeadlessTrainer trainer_;
+  TrainingConfig config_;
+  CartPoleSimulation simulation_;
   std::uint64_t steps_run_ = 0;
 };
 

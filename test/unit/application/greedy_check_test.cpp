@@ -1,5 +1,6 @@
 // The greedy check during training (greedy_check.h): every episode to the step limit, or not.
 #include "cartpole_qlearning/application/greedy_check.h"
+#include "cartpole_qlearning/application/headless_trainer.h"
 
 #include <gtest/gtest.h>
 
