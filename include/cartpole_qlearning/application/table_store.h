@@ -79,10 +79,6 @@ public:
   {
     return folder_;
   }
-  const std::string& defaultTable() const
-  {
-    return default_table_;
-  }
 
 private:
   bool isUsersFile(const std::string& path) const;

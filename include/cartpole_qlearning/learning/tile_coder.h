@@ -48,12 +48,6 @@ public:
   {
     return params_.tilings;
   }
-  // Tiles along one dimension of every tiling: tiles + 1 for a used dimension (a displaced grid
-  // needs one more tile to cover the bounds), 1 for an ignored one.
-  unsigned tilesAlong(std::size_t dimension) const
-  {
-    return span_[dimension];
-  }
   std::size_t tilesPerTiling() const
   {
     return tiles_per_tiling_;

@@ -60,14 +60,6 @@ public:
   }
 };
 
-// The value of a key, or fallback when it is absent (a wrong type still throws ConfigError).
-template <typename T>
-T valueOr(const ParameterSource& source, const std::string& key, T fallback)
-{
-  source.get(key, fallback);
-  return fallback;
-}
-
 // Reads the keys of one section, remembers which keys it knows, and refuses the others, so
 // that a misspelt key stops the run instead of being silently ignored.
 class SectionReader

@@ -44,10 +44,6 @@ public:
   // Robots silent for drop_out_after while another robot's state waits: they drop out now
   // (each returned once, until it is heard again).
   std::vector<std::size_t> dropOuts(WallClock::time_point now);
-  bool takesPart(std::size_t robot) const
-  {
-    return taking_part_.at(robot);
-  }
   // How long the robot has been silent: since it was last heard (or since start).
   WallClock::duration silentFor(std::size_t robot, WallClock::time_point now) const
   {
