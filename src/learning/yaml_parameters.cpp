@@ -1,0 +1,214 @@
+// The YAML adapter of ParameterSource (training_config.h): a config file, a suite file's sections,
+// or YAML text in a test, read as slash-separated keys.
+#include "cartpole_qlearning/learning/training_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <sstream>
+
+namespace cartpole_qlearning
+{
+namespace
+{
+std::vector<std::string> splitKey(const std::string& key)
+{
+  std::vector<std::string> parts;
+  std::stringstream in(key);
+  std::string part;
+  while (std::getline(in, part, '/'))
+    parts.push_back(part);
+  return parts;
+}
+
+class YamlParameters : public ParameterSource
+{
+public:
+  YamlParameters(YAML::Node root, std::string origin, std::string folder)
+    : root_(std::move(root)), origin_(std::move(origin)), folder_(std::move(folder))
+  {
+  }
+
+  bool get(const std::string& key, double& value) const override
+  {
+    return scalar(key, value, "a number");
+  }
+  bool get(const std::string& key, std::int64_t& value) const override
+  {
+    return scalar(key, value, "a whole number");
+  }
+  bool get(const std::string& key, bool& value) const override
+  {
+    return scalar(key, value, "true or false");
+  }
+  bool get(const std::string& key, std::string& value) const override
+  {
+    return scalar(key, value, "a string");
+  }
+  bool get(const std::string& key, std::vector<double>& value) const override
+  {
+    const YAML::Node node = find(key);
+    if (!node)
+      return false;
+    if (!node.IsSequence())
+      throw ConfigError(origin_ + ": " + key + " must be a list of numbers");
+    value.clear();
+    for (std::size_t i = 0; i < node.size(); ++i)
+    {
+      try
+      {
+        value.push_back(node[i].as<double>());
+      }
+      catch (const YAML::Exception&)
+      {
+        throw ConfigError(origin_ + ": " + key + "[" + std::to_string(i) + "] = '" + text(node[i]) +
+                          "' is not allowed (must be a number)");
+      }
+    }
+    return true;
+  }
+
+  bool get(const std::string& key, std::vector<std::string>& value) const override
+  {
+    const YAML::Node node = find(key);
+    if (!node)
+      return false;
+    if (!node.IsSequence())
+      throw ConfigError(origin_ + ": " + key + " must be a list of strings");
+    value.clear();
+    for (std::size_t i = 0; i < node.size(); ++i)
+    {
+      if (!node[i].IsScalar())
+        throw ConfigError(origin_ + ": " + key + "[" + std::to_string(i) + "] = '" + text(node[i]) +
+                          "' is not allowed (must be a string)");
+      value.push_back(node[i].Scalar());
+    }
+    return true;
+  }
+
+  std::vector<std::string> keysUnder(const std::string& section) const override
+  {
+    std::vector<std::string> keys;
+    const YAML::Node node = find(section);
+    if (node)
+      collect(node, section, keys);
+    return keys;
+  }
+
+  std::string origin() const override
+  {
+    return origin_;
+  }
+  std::string folder() const override
+  {
+    return folder_;
+  }
+
+private:
+  YAML::Node find(const std::string& key) const
+  {
+    // reset() rebinds; plain assignment between yaml-cpp nodes would overwrite the tree itself.
+    YAML::Node node;
+    node.reset(root_);
+    for (const std::string& part : splitKey(key))
+    {
+      if (part.empty())
+        continue;
+      if (!node.IsMap())
+        return YAML::Node(YAML::NodeType::Undefined);
+      const YAML::Node& parent = node;
+      const YAML::Node child = parent[part];  // const lookup: does not insert the key
+      if (!child)
+        return child;
+      node.reset(child);
+    }
+    return node;
+  }
+
+  template <typename T>
+  bool scalar(const std::string& key, T& value, const char* expected) const
+  {
+    const YAML::Node node = find(key);
+    if (!node)
+      return false;
+    try
+    {
+      if (!node.IsScalar())
+        throw YAML::Exception(YAML::Mark::null_mark(), "not a scalar");
+      value = node.as<T>();
+    }
+    catch (const YAML::Exception&)
+    {
+      throw ConfigError(origin_ + ": " + key + " = '" + text(node) + "' is not allowed (must be " + expected + ")");
+    }
+    return true;
+  }
+
+  static std::string text(const YAML::Node& node)
+  {
+    if (node.IsScalar())
+      return node.Scalar();
+    YAML::Emitter out;
+    out << YAML::Flow << node;
+    return out.c_str();
+  }
+
+  void collect(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& keys) const
+  {
+    if (!node.IsMap())
+    {
+      keys.push_back(prefix);
+      return;
+    }
+    for (const auto& entry : node)
+    {
+      // A key that is not a plain scalar (a list, a map, a null) names no parameter (found by
+      // test/fuzz/config_fuzzer.cpp: it used to escape as a YAML exception).
+      if (!entry.first.IsScalar())
+        throw ConfigError(origin_ + ": a key under '" + (prefix.empty() ? "/" : prefix) + "' is not a plain name");
+      collect(entry.second, (prefix.empty() ? "" : prefix + "/") + entry.first.Scalar(), keys);
+    }
+  }
+
+  YAML::Node root_;
+  std::string origin_;
+  std::string folder_;
+};
+}  // namespace
+
+std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin,
+                                                     const std::string& folder)
+{
+  YAML::Node root;
+  try
+  {
+    root = YAML::Load(text);
+  }
+  catch (const YAML::Exception& e)
+  {
+    throw ConfigError(origin + ": not valid YAML: " + e.what());
+  }
+  if (root.IsNull())
+    root = YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap())
+    throw ConfigError(origin + ": must be a YAML mapping of sections (physics, task, learning, training)");
+  return std::make_unique<YamlParameters>(root, origin, folder);
+}
+
+std::unique_ptr<ParameterSource> loadYamlParameters(const std::string& path)
+{
+  std::ifstream in(path);
+  if (!in)
+    throw ConfigError(path + ": cannot be read");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseYamlParameters(text.str(), path, configFolder(path));
+}
+
+std::string configFolder(const std::string& path)
+{
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? "." : path.substr(0, slash + (slash == 0));
+}
+
+}  // namespace cartpole_qlearning
