@@ -116,7 +116,7 @@ public:
     return greedyAction(table_, state);
   }
   // The same on any table of this shape: what an evaluation, which learns nothing and so needs no
-  // agent, runs (robustness_suite.cpp).
+  // agent, runs (greedy_episodes.cpp).
   static std::size_t greedyAction(const QTable& table, const ActiveRows& state)
   {
     return state.count == 1 ? table.argmax(state.rows[0]) : bestAction(table, state, nullptr);
