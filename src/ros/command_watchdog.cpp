@@ -57,14 +57,14 @@ CommandWatchdogNode::CommandWatchdogNode(const ros::NodeHandle& nh, const ros::N
                            hints);
       break;
   }
-  // A lost publisher is seen at the next tick: a tenth of the timeout, at most 10 ms, keeps a
-  // kill -9 to the robot's zero well within the timeout.
+  // The timeout is judged, and a lost publisher seen, at the next tick: a tenth of the timeout,
+  // at most 10 ms, stops the robot within a tick of either.
   const double tick = timeout_s_ > 0.0 ? std::min(0.01, timeout_s_ / 10.0) : 0.01;
   timer_ = nh_.createWallTimer(ros::WallDuration(tick), &CommandWatchdogNode::onTick, this);
   say({{LogLine::Level::Info, "forwarding " + in_.getTopic() + " to " + nh_.resolveName(robot_.command_topic) +
                                   (timeout_s_ > 0.0 ? formatText(", 0 after %.3f s without a command", timeout_s_)
                                                     : std::string(", no timeout")) +
-                                  " and at once when the controller is gone"}});
+                                  ", at once when the controller's publisher goes"}});
 }
 
 CommandWatchdogNode::~CommandWatchdogNode() = default;
@@ -147,7 +147,7 @@ void CommandWatchdogNode::carryOut(CommandWatchdog::Action action)
 void CommandWatchdogNode::say(const LogLines& log)
 {
   for (const LogLine& line : log)
-    logLine(name_, line.level, line.text);
+    logLine(name_, line.level, withPrefix("command_watchdog: ", line));
 }
 
 }  // namespace cartpole_qlearning

@@ -5,10 +5,12 @@
 // sends garbage.
 //
 // The node feeds it what happens: each command from the controller (its effort), each change in
-// the number of the controller's publishers (ros::Subscriber::getNumPublishers drops to 0 when the
-// controller's TCP link closes, as the kernel closes it when the process dies), its timer and its
-// own shutdown; the watchdog answers what to do with it: forward the command as it came, send
-// the robot 0, or nothing. Times are injected. It acts only while the robot may be pushed (the
+// the number of the controller's publishers, its timer and its own shutdown; the watchdog answers
+// what to do with it: forward the command as it came, send the robot 0, or nothing. Times are
+// injected. The count (ros::Subscriber::getNumPublishers) drops when the controller unregisters
+// (it ended, was restarted, `rosnode kill`); after kill -9 or a crash roscpp keeps the link and
+// retries it, since the master still lists the dead node, so it is the timeout that stops the
+// robot then (about 0.1 s: command_watchdog.test). It acts only while the robot may be pushed (the
 // last command forwarded was not 0): a controller that sent 0 and went quiet leaves nothing to
 // stop.
 #pragma once

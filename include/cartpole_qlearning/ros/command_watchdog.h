@@ -1,8 +1,8 @@
 // command_watchdog: between the controller and a robot, forwards the controller's commands as they
 // come and leaves the robot at 0 when they stop: no command for ~timeout while the robot may be
-// pushed, the controller's publisher gone (it ended or died, even by kill -9), a command that is no
-// number, and the watchdog's own end (core: protocol/command_watchdog.h). The twist_mux /
-// diff_drive_controller cmd_vel_timeout pattern, for robots that hold their last command for ever
+// pushed (a controller that hung, crashed or was killed by kill -9), the controller's publisher
+// gone (it unregistered), a command that is no number, and the watchdog's own end (core: protocol/command_watchdog.h).
+// The twist_mux / diff_drive_controller cmd_vel_timeout pattern, for robots that hold their last command for ever
 // (ros_control's JointEffortController). It takes the commands in the robot's type (~command_type,
 // as the controller writes them) on `controller_command` and publishes on ~command_topic (the
 // robot's). Logs on ros.cartpole_qlearning.command_watchdog.<its name, dots for slashes>.
