@@ -32,6 +32,12 @@ public:
   {
     publish(0.0, ros::Time());
   }
+  // A command another node wrote in this type, published as it came (command_watchdog).
+  template <class Message>
+  void forward(const boost::shared_ptr<const Message>& msg)
+  {
+    pub_.publish(msg);
+  }
 
 private:
   ros::Publisher pub_;

@@ -1,4 +1,4 @@
-// The two nodes as nodelets: the same classes as the executables, in one manager, so states
+// The nodes as nodelets: the same classes as the executables, in one manager, so states
 // and commands pass as pointers instead of through sockets.
 //
 // The lockstep topics (the sim's commands, the controller's states) of every cartpole nodelet
@@ -9,6 +9,7 @@
 // costs about ten times more than the step itself (bench/run_benchmarks.sh). Timers and
 // services stay on the manager's threads; the node classes lock their state for that.
 #include "cartpole_qlearning/ros/cartpole_sim.h"
+#include "cartpole_qlearning/ros/command_watchdog.h"
 #include "cartpole_qlearning/ros/qlearning_controller.h"
 #include "start_up.h"
 
@@ -113,6 +114,27 @@ struct NodeletTraits<QLearningControllerNode>
   }
 };
 
+template <>
+struct NodeletTraits<CommandWatchdogNode>
+{
+  static constexpr const char* kType = "command_watchdog";
+  // Its commands on the manager's own queues: it is no part of a lockstep step.
+  static std::unique_ptr<CommandWatchdogNode> make(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
+                                                   ros::CallbackQueue*)
+  {
+    return std::make_unique<CommandWatchdogNode>(nh, pnh);
+  }
+  // Unloaded (or its manager stopping): the robot gets 0 when it may be pushed, as the executable does.
+  static void unload(CommandWatchdogNode& node)
+  {
+    if (ros::ok())
+    {
+      node.stop();
+      ros::WallDuration(0.2).sleep();
+    }
+  }
+};
+
 // A node class as a nodelet: the same class the executable runs, its lockstep topics on the
 // manager's lockstep thread.
 template <class Node>
@@ -150,8 +172,10 @@ private:
 
 using CartPoleSimNodelet = NodeNodelet<CartPoleSimNode>;
 using QLearningControllerNodelet = NodeNodelet<QLearningControllerNode>;
+using CommandWatchdogNodelet = NodeNodelet<CommandWatchdogNode>;
 
 }  // namespace cartpole_qlearning
 
 PLUGINLIB_EXPORT_CLASS(cartpole_qlearning::CartPoleSimNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(cartpole_qlearning::QLearningControllerNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(cartpole_qlearning::CommandWatchdogNodelet, nodelet::Nodelet)
