@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets of test/fuzz/ (the Q-table file parser, the config reader) with
-# clang-14, AddressSanitizer and UndefinedBehaviorSanitizer, and runs each for a bounded time
-# from the seed corpus in test/fuzz/corpus/. Debian: clang-14 libclang-rt-14-dev libyaml-cpp-dev
+# clang (the release's clang-N, as tools/sanitize.sh), AddressSanitizer and UndefinedBehaviorSanitizer, and runs each for a bounded time
+# from the seed corpus in test/fuzz/corpus/. Debian: clang-N and its runtimes, libyaml-cpp-dev
 # libeigen3-dev (scripts/setup.sh installs them).
 #
 # usage: bash tools/fuzz.sh [SECONDS_EACH (default 60)] [RESULTS_DIR]
@@ -15,8 +15,11 @@ SECONDS_EACH=${1:-60}
 RESULTS=${2:-}
 [[ "$SECONDS_EACH" =~ ^[0-9]+$ ]] || { echo "fuzz.sh: SECONDS_EACH=$SECONDS_EACH must be a whole number" >&2; exit 2; }
 SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-CXX=${FUZZ_CXX:-clang++-14}
-command -v "$CXX" >/dev/null || { echo "fuzz.sh: $CXX not found (Debian: clang-14 libclang-rt-14-dev)" >&2; exit 2; }
+# shellcheck source=tools/llvm_toolchain.sh
+source "$SRC/tools/llvm_toolchain.sh"
+llvm_toolchain || true
+CXX=${FUZZ_CXX:-$CLANGXX}
+command -v "$CXX" >/dev/null || { echo "fuzz.sh: $CXX not found (Debian: scripts/setup.sh installs the release's clang-N and its runtimes)" >&2; exit 2; }
 WORK=${FUZZ_WORK:-$(mktemp -d "${TMPDIR:-/tmp}/cartpole_fuzz.XXXXXX")}
 mkdir -p "$WORK"
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the whole package and its tests (nodes, nodelet library, train_headless, gtests and
-# rostests, but for the six long trainings: see ARGS below) with clang-14's AddressSanitizer
+# rostests, but for the six long trainings: see ARGS below) with clang's AddressSanitizer
 # (with LeakSanitizer) and UndefinedBehaviorSanitizer in a build and devel space of their own
 # beside the plain ones ($WS/build_sanitize, $WS/devel_sanitize), and runs those tests there
 # (gtests, rostests, launch file checks). Any sanitizer report, in a test or in a node that
@@ -13,9 +13,10 @@
 #   per sanitizer report file written (failed), or one passed case when none was.
 # Exit status: 0 when the tests could be built and run (the JUnit files say what failed), 2 when
 # the workspace, the compiler or the symbolizer is missing, another non-zero one when the build
-# failed. Debian: clang-14 libclang-rt-14-dev llvm-14 (scripts/setup.sh installs them).
+# failed. Debian: the release's default clang-N, its sanitizer runtimes and llvm-N (scripts/setup.sh's
+# "sanitizers" set installs them; tools/llvm_toolchain.sh finds them, or CARTPOLE_LLVM_VERSION=N).
 #
-# The symbolizer (llvm-14's llvm-symbolizer, named by ASAN_SYMBOLIZER_PATH) is needed, not merely
+# The symbolizer (llvm-N's llvm-symbolizer, named by ASAN_SYMBOLIZER_PATH) is needed, not merely
 # nice: suppressions match function names, and without it a report's frames stay bare addresses,
 # so an upstream bug suppressed by name would count as ours. A report written without it fails
 # with a message that says so.
@@ -41,8 +42,11 @@ if [ -z "${CARTPOLE_WS:-}" ] && [ "$(basename "$(dirname "$SRC")")" = src ]; the
 fi
 WS=${CARTPOLE_WS:-$HOME/cartpole_ws}
 [ -e "$WS/src/cartpole_qlearning" ] || { echo "sanitize.sh: no workspace at $WS (run scripts/setup.sh first)" >&2; exit 2; }
-export CC=clang-14 CXX=clang++-14
-command -v "$CXX" >/dev/null || { echo "sanitize.sh: $CXX not found (Debian: clang-14 libclang-rt-14-dev)" >&2; exit 2; }
+# shellcheck source=tools/llvm_toolchain.sh
+source "$SRC/tools/llvm_toolchain.sh"
+llvm_toolchain || { echo "sanitize.sh: no clang++-N found (Debian: scripts/setup.sh installs the release's clang-N, its runtimes and llvm-N)" >&2; exit 2; }
+export CC=$CLANG CXX=$CLANGXX
+command -v "$CXX" >/dev/null || { echo "sanitize.sh: $CXX not found (Debian: clang-$LLVM_VERSION and its sanitizer runtimes)" >&2; exit 2; }
 BUILD="$WS/build_sanitize"
 DEVEL="$WS/devel_sanitize"
 LOGS="$BUILD/sanitizer_logs"
@@ -75,7 +79,8 @@ FLAGS="-O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefin
 # set time back) and application_tests (RunApplication: the suite judged during training, the best
 # table kept) already take under the sanitizers, for minutes of CI's time.
 ARGS=(--build "$BUILD" -DCATKIN_DEVEL_PREFIX="$DEVEL" -DCMAKE_BUILD_TYPE=Sanitize "-DCMAKE_CXX_FLAGS=$FLAGS"
-  -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE -DCARTPOLE_QLEARNING_LONG_TRAININGS=OFF)
+  -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE -DCARTPOLE_QLEARNING_LONG_TRAININGS=OFF
+  "-DCARTPOLE_WARNINGS_AS_ERRORS=${CARTPOLE_WARNINGS_AS_ERRORS:-ON}")
 [ -x /usr/bin/python3 ] && ARGS+=(-DPYTHON_EXECUTABLE=/usr/bin/python3)
 cd "$WS"
 echo "[sanitize] building the nodes, the nodelet library and every test with ASan + UBSan ($CXX) in $BUILD"
@@ -93,11 +98,11 @@ case ":$CMAKE_PREFIX_PATH:" in *":$WS/devel:"*) echo "sanitize.sh: $WS/devel sti
 wrapper="$DEVEL/lib/nodelet/nodelet"
 rm -rf "$DEVEL/lib/nodelet"  # (an empty folder there would hide Debian's from the search too)
 nodelet=$(python3 -c "import roslib.packages as p; print(p.find_node('nodelet', 'nodelet')[0])")
-runtime=$("$CXX" -print-file-name=libclang_rt.asan-x86_64.so)
-symbolizer=${ASAN_SYMBOLIZER_PATH:-$(command -v llvm-symbolizer-14 || echo /usr/lib/llvm-14/bin/llvm-symbolizer)}
-[ -x "$symbolizer" ] || { echo "sanitize.sh: no llvm-symbolizer at $symbolizer: reports would not be symbolized and suppressions could not match (Debian: llvm-14; or set ASAN_SYMBOLIZER_PATH)" >&2; exit 2; }
+runtime=$(asan_runtime || true)
+symbolizer=${ASAN_SYMBOLIZER_PATH:-$LLVM_SYMBOLIZER}
+[ -x "$symbolizer" ] || { echo "sanitize.sh: no llvm-symbolizer at $symbolizer: reports would not be symbolized and suppressions could not match (Debian: llvm-$LLVM_VERSION; or set ASAN_SYMBOLIZER_PATH)" >&2; exit 2; }
 export ASAN_SYMBOLIZER_PATH="$symbolizer" UBSAN_SYMBOLIZER_PATH="$symbolizer"
-[ -f "$runtime" ] || { echo "sanitize.sh: no $runtime (Debian: libclang-rt-14-dev)" >&2; exit 2; }
+[ -f "$runtime" ] || { echo "sanitize.sh: no $runtime (Debian: libclang-rt-$LLVM_VERSION-dev, or libclang-common-$LLVM_VERSION-dev before clang 14)" >&2; exit 2; }
 mkdir -p "$(dirname "$wrapper")"
 # shellcheck disable=SC2016 # $LD_PRELOAD and $@ are the wrapper's
 printf '#!/bin/sh\n# tools/sanitize.sh: %s with the ASan runtime preloaded\nexport LD_PRELOAD=%s${LD_PRELOAD:+:$LD_PRELOAD}\nexec %s "$@"\n' \
@@ -151,7 +156,7 @@ mapfile -t logs < <(find "$LOGS" -type f | sort)
     what=$(grep -m1 -oE '(ERROR|SUMMARY): [A-Za-z]+Sanitizer: [^(]*|runtime error: .*' "$log" | head -c 200 || true)
     # Frames without a function name: no symbolizer ran, so no suppression could have matched.
     if grep -q 'invalid path to external symbolizer' "$log" || ! grep -qE '^ +#[0-9]+ 0x[0-9a-f]+ in ' "$log"; then
-      what="UNSYMBOLIZED report (no llvm-symbolizer: install llvm-14 or set ASAN_SYMBOLIZER_PATH; suppressions cannot match without it): $what"
+      what="UNSYMBOLIZED report (no llvm-symbolizer: install llvm-$LLVM_VERSION or set ASAN_SYMBOLIZER_PATH; suppressions cannot match without it): $what"
     fi
     what=$(printf '%s' "$what" | sed 's/&/\&amp;/g; s/</\&lt;/g; s/>/\&gt;/g; s/"/\&quot;/g')
     echo "  <testcase classname=\"sanitizer_reports\" name=\"$(basename "$log")\"><failure message=\"$log: ${what:-a sanitizer report}\"/></testcase>"

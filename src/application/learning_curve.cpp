@@ -1,4 +1,5 @@
 #include "cartpole_qlearning/application/learning_curve.h"
+#include "cartpole_qlearning/io/number_text.h"
 
 #include <charconv>
 #include <cstdio>
@@ -15,9 +16,7 @@ namespace
 // Shortest text that reads back as the same double, whatever the locale.
 std::string exact(double value)
 {
-  char text[32];
-  const auto result = std::to_chars(text, text + sizeof text, value);
-  return std::string(text, result.ptr);
+  return shortestText(value);
 }
 
 const char* yesNo(bool value)

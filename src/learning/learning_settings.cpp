@@ -78,7 +78,9 @@ std::vector<std::pair<std::string, std::string>> fieldsOf(const LearningSettings
   std::vector<std::pair<std::string, std::string>> fields{{"epsilon_override", override(s.epsilon_override)},
                                                           {"alpha_override", override(s.alpha_override)},
                                                           {"gamma", number(s.gamma)}};
-  for (const auto& [name, p] : {std::make_pair("epsilon_", &s.epsilon), std::make_pair("alpha_", &s.alpha)})
+  // A named array, not a braced list of temporaries in the loop's head (GCC 14's -Wdangling-reference).
+  const std::pair<const char*, const ScheduleParams*> schedules[] = {{"epsilon_", &s.epsilon}, {"alpha_", &s.alpha}};
+  for (const auto& [name, p] : schedules)
   {
     fields.emplace_back(name + std::string("schedule"), toString(p->type));
     fields.emplace_back(name + std::string("start"), number(p->start));

@@ -1,4 +1,5 @@
 #include "cartpole_qlearning/learning/q_table_file.h"
+#include "cartpole_qlearning/io/number_text.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -92,17 +93,16 @@ std::string checksumOf(const QTable& table)
 
 // The shortest decimal (15 to 17 significant digits, as printf's %g writes them) that reads back
 // as the same double: exact, and 2.4 stays "2.4" rather than "2.3999999999999999". With to_chars
-// and from_chars (locale-free), not string streams: a table of 2,000,000 values took 6 s to write
+// and from_chars (locale-free; io/number_text.h where the library lacks them), not string streams: a table of 2,000,000 values took 6 s to write
 // through streams.
 void appendExact(std::string& text, double value)
 {
   char buffer[64];
   for (int precision = 15;; ++precision)
   {
-    const std::to_chars_result written =
-        std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::general, precision);
+    const std::to_chars_result written = writeGeneral(buffer, buffer + sizeof buffer, value, precision);
     double back = 0.0;
-    const std::from_chars_result read = std::from_chars(buffer, written.ptr, back);
+    const std::from_chars_result read = readDouble(buffer, written.ptr, back);
     if (precision == 17 || (read.ec == std::errc() && std::memcmp(&back, &value, sizeof value) == 0))
     {
       text.append(buffer, written.ptr);
@@ -348,7 +348,7 @@ std::optional<std::vector<double>> rowsAsWritten(std::string_view text, std::siz
     for (;;)
     {
       double value = 0.0;
-      const std::from_chars_result read = std::from_chars(at, end, value);
+      const std::from_chars_result read = readDouble(at, end, value);
       if (read.ec != std::errc() || !std::isfinite(value))
         return std::nullopt;
       values.push_back(value);

@@ -1,4 +1,5 @@
 #include "cartpole_qlearning/learning/training_config.h"
+#include "cartpole_qlearning/io/number_text.h"
 
 #include "cartpole_qlearning/simulation/engine_registry.h"
 
@@ -338,9 +339,7 @@ bool holdsTrainingConfig(const ParameterSource& source)
 
 std::string exactText(double value)
 {
-  char text[32];
-  const auto result = std::to_chars(text, text + sizeof text, value);
-  return std::string(text, result.ptr);
+  return shortestText(value);
 }
 
 namespace

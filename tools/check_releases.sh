@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# The user's two commands on the other Debian releases than CI's: `bash scripts/train.sh` and
+# `bash scripts/test.sh`, each in a brand-new root of Debian 11 (bullseye: GCC 10, CMake 3.18, no
+# MuJoCo; the nearest to Noetic's Ubuntu 20.04) and Debian 13 (trixie: GCC 14, CMake 3.31), through
+# ../shared/tools/fresh_machine.sh. CI runs on Debian 12 (the developer's machine); run this before
+# a change to scripts/setup.sh, CMakeLists.txt or code a compiler may take otherwise.
+#
+# usage (as root, from a clone with the change committed: the roots get `git archive HEAD`):
+#   bash tools/check_releases.sh [RELEASE...]          default: bullseye trixie
+#   CHECK=train|test|both (default both); LOGS=DIR (default a new folder under /tmp)
+#   FRESH_MACHINE=PATH: the fresh_machine.sh to use (default ../shared/tools/fresh_machine.sh
+#   beside the clone; without it the check is skipped with a note)
+# Prints, per release and command, the wall time, the exit status and the line that matters:
+# train.sh's SOLVED line, test.sh's last line ("N passed, N failed, N skipped"); exits 1 if any
+# of them is missing. About 10 min per train.sh and 25-45 per test.sh on 2 cores, one root at a
+# time (the first root of a release takes a few minutes more to make).
+set -uo pipefail
+SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+FRESH=${FRESH_MACHINE:-$SRC/../shared/tools/fresh_machine.sh}
+CHECK=${CHECK:-both}
+LOGS=${LOGS:-$(mktemp -d /tmp/check_releases.XXXXXX)}
+releases=("$@")
+[ "${#releases[@]}" -gt 0 ] || releases=(bullseye trixie)
+
+if [ ! -f "$FRESH" ]; then
+  echo "[releases] skipped: no $FRESH (the script that makes fresh Debian roots sits beside the project, in ../shared/tools)"
+  exit 0
+fi
+[ "$(id -u)" -eq 0 ] || { echo "[releases] fresh_machine.sh needs root (debootstrap, chroot, mounts)" >&2; exit 2; }
+cd "$SRC"
+if ! git diff --quiet HEAD 2>/dev/null; then
+  echo "[releases] note: uncommitted changes are not checked (the roots get git archive HEAD: $(git rev-parse --short HEAD))"
+fi
+case "$CHECK" in
+  train) commands=(train) ;;
+  test) commands=(test) ;;
+  both) commands=(train test) ;;
+  *) echo "[releases] CHECK=$CHECK: train, test or both" >&2; exit 2 ;;
+esac
+mkdir -p "$LOGS"
+echo "[releases] commit $(git rev-parse --short HEAD); logs in $LOGS"
+
+summary=()
+status=0
+for release in "${releases[@]}"; do
+  for command in "${commands[@]}"; do
+    log="$LOGS/$release-$command.log"
+    echo "[releases] $release: bash scripts/$command.sh in a fresh root (log: $log)"
+    start=$(date +%s)
+    DEBIAN_RELEASE=$release bash "$FRESH" "gcc --version 2>/dev/null | head -n 1; bash scripts/$command.sh" >"$log" 2>&1
+    rc=$?
+    wall=$(($(date +%s) - start))
+    if [ "$command" = train ]; then
+      line=$(grep -a 'SOLVED' "$log" | tail -n 1)
+    else
+      line=$(grep -av '^fresh-machine exit' "$log" | tail -n 1)
+      printf '%s' "$line" | grep -qE '^[0-9]+ passed, 0 failed' || line="${line:-} (not all passed)"
+    fi
+    [ -n "$line" ] || line="(no SOLVED line: see $log)"
+    case "$line" in "(no"* | *"(not all passed)") status=1 ;; esac
+    [ "$rc" -eq 0 ] || status=1
+    row=$(printf '%-9s %-6s %3d min %02d s  exit %d  %s' "$release" "$command" $((wall / 60)) $((wall % 60)) "$rc" "$line")
+    echo "[releases] $row"
+    summary+=("$row")
+  done
+done
+echo "[releases] summary (commit $(git rev-parse --short HEAD)):"
+printf '  %s\n' "${summary[@]}"
+exit "$status"
