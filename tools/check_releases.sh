@@ -47,7 +47,7 @@ for release in "${releases[@]}"; do
     log="$LOGS/$release-$command.log"
     echo "[releases] $release: bash scripts/$command.sh in a fresh root (log: $log)"
     start=$(date +%s)
-    DEBIAN_RELEASE=$release bash "$FRESH" "gcc --version 2>/dev/null | head -n 1; bash scripts/$command.sh" >"$log" 2>&1
+    DEBIAN_RELEASE=$release bash "$FRESH" ". /etc/os-release; echo \"[releases] \$PRETTY_NAME\"; bash scripts/$command.sh" >"$log" 2>&1
     rc=$?
     wall=$(($(date +%s) - start))
     if [ "$command" = train ]; then

@@ -111,30 +111,42 @@ Decimal neighbour(Decimal d, int step)
   return d;
 }
 
+// The P-digit decimal nearest to value (> 0, finite) that reads back as value, if one does: the
+// correctly rounded one, else its neighbour on the other side of value (the interval that rounds
+// to value is narrower below a power of two than above it); no other P-digit decimal can.
+bool readsBack(double value, int precision, Decimal& d)
+{
+  char text[48];
+  std::snprintf(text, sizeof text, "%.*e", precision - 1, value);
+  d = parseScientific(text);
+  const double back = std::strtod(text, nullptr);
+  if (back == value)
+    return true;
+  const Decimal other = neighbour(d, back > value ? -1 : +1);
+  if (parse(scientificText(other)) != value)
+    return false;
+  d = other;
+  return true;
+}
+
 // The shortest decimal that reads back as value (> 0, finite), and of those of that length the
-// nearest: what std::to_chars (Ryu in libstdc++) writes. For each length the correctly rounded
-// decimal is the nearest; when it does not read back, its neighbour on the other side of value
-// may (the interval that rounds to value is narrower below a power of two than above it).
+// nearest: what std::to_chars (Ryu in libstdc++) writes. Whether a P-digit decimal reads back only
+// grows with P (one of P digits is one of P + 1), so the length is found by bisection; 17 digits
+// always read back.
 Decimal shortest(double value)
 {
+  int low = 1;
+  int high = 17;
   Decimal d;
-  char text[48];
-  for (int precision = 1; precision <= 17; ++precision)
+  while (low < high)
   {
-    std::snprintf(text, sizeof text, "%.*e", precision - 1, value);
-    d = parseScientific(text);
-    const double back = std::strtod(text, nullptr);
-    if (back == value)
-      break;
-    if (precision == 17)
-      break;  // 17 digits always read back
-    const Decimal other = neighbour(d, back > value ? -1 : +1);
-    if (parse(scientificText(other)) == value)
-    {
-      d = other;
-      break;
-    }
+    const int middle = (low + high) / 2;
+    if (readsBack(value, middle, d))
+      high = middle;
+    else
+      low = middle + 1;
   }
+  readsBack(value, low, d);
   while (d.count > 1 && d.digits[d.count - 1] == '0')
     --d.count;
   return d;
