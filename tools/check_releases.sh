@@ -5,6 +5,7 @@
 # ../shared/tools/fresh_machine.sh. CI runs on Debian 12 (the developer's machine); run this before
 # a change to scripts/setup.sh, CMakeLists.txt or code a compiler may take otherwise.
 #
+# One fresh root per release, where the two commands run one after the other, as a user types them.
 # usage (as root, from a clone with the change committed: the roots get `git archive HEAD`):
 #   bash tools/check_releases.sh [RELEASE...]          default: bullseye trixie
 #   CHECK=train|test|both (default both); LOGS=DIR (default a new folder under /tmp)
@@ -43,23 +44,31 @@ echo "[releases] commit $(git rev-parse --short HEAD); logs in $LOGS"
 summary=()
 status=0
 for release in "${releases[@]}"; do
+  # One root per release, the commands in the order a user types them (train.sh, then test.sh on
+  # the same machine), each timed inside the root.
+  inner=". /etc/os-release; echo \"[releases] \$PRETTY_NAME\""
   for command in "${commands[@]}"; do
-    log="$LOGS/$release-$command.log"
-    echo "[releases] $release: bash scripts/$command.sh in a fresh root (log: $log)"
-    start=$(date +%s)
-    DEBIAN_RELEASE=$release bash "$FRESH" ". /etc/os-release; echo \"[releases] \$PRETTY_NAME\"; bash scripts/$command.sh" >"$log" 2>&1
-    rc=$?
-    wall=$(($(date +%s) - start))
+    inner+="; start=\$(date +%s); bash scripts/$command.sh; rc=\$?"
+    inner+="; echo \"[releases] $command.sh exit \$rc after \$((\$(date +%s) - start)) s\""
+  done
+  log="$LOGS/$release.log"
+  echo "[releases] $release: ${commands[*]/%/.sh} in a fresh root (log: $log)"
+  DEBIAN_RELEASE=$release bash "$FRESH" "$inner" >"$log" 2>&1
+  for command in "${commands[@]}"; do
+    end=$(grep -an "^\[releases\] $command.sh exit " "$log" | tail -n 1)
+    rc=$(printf '%s' "$end" | sed -n 's/.* exit \([0-9]*\) after.*/\1/p')
+    wall=$(printf '%s' "$end" | sed -n 's/.* after \([0-9]*\) s$/\1/p')
     if [ "$command" = train ]; then
       line=$(grep -a 'SOLVED' "$log" | tail -n 1)
+      [ -n "$line" ] || line="(no SOLVED line: see $log)"
     else
-      line=$(grep -av '^fresh-machine exit' "$log" | tail -n 1)
-      printf '%s' "$line" | grep -qE '^[0-9]+ passed, 0 failed' || line="${line:-} (not all passed)"
+      # test.sh's last line: the one before its exit line.
+      line=$(sed -n "$(( ${end%%:*} - 1 ))p" "$log" 2>/dev/null)
+      printf '%s' "$line" | grep -qE '^[0-9]+ passed, 0 failed' || line="${line:-(no last line)} (not all passed: see $log)"
     fi
-    [ -n "$line" ] || line="(no SOLVED line: see $log)"
-    case "$line" in "(no"* | *"(not all passed)") status=1 ;; esac
-    [ "$rc" -eq 0 ] || status=1
-    row=$(printf '%-9s %-6s %3d min %02d s  exit %d  %s' "$release" "$command" $((wall / 60)) $((wall % 60)) "$rc" "$line")
+    case "$line" in "(no"* | *"(not all passed"*) status=1 ;; esac
+    [ "${rc:-1}" = 0 ] || status=1
+    row=$(printf '%-9s %-6s %3d min %02d s  exit %s  %s' "$release" "$command" $((${wall:-0} / 60)) $((${wall:-0} % 60)) "${rc:-?}" "$line")
     echo "[releases] $row"
     summary+=("$row")
   done
