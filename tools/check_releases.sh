@@ -39,7 +39,8 @@ case "$CHECK" in
   *) echo "[releases] CHECK=$CHECK: train, test or both" >&2; exit 2 ;;
 esac
 mkdir -p "$LOGS"
-echo "[releases] commit $(git rev-parse --short HEAD); logs in $LOGS"
+commit=$(git rev-parse --short HEAD)
+echo "[releases] commit $commit; logs in $LOGS"
 
 summary=()
 status=0
@@ -59,7 +60,8 @@ for release in "${releases[@]}"; do
     rc=$(printf '%s' "$end" | sed -n 's/.* exit \([0-9]*\) after.*/\1/p')
     wall=$(printf '%s' "$end" | sed -n 's/.* after \([0-9]*\) s$/\1/p')
     if [ "$command" = train ]; then
-      line=$(grep -a 'SOLVED' "$log" | tail -n 1)
+      # The controller's SOLVED line, without roslaunch's colours and time stamp.
+      line=$(grep -a 'SOLVED' "$log" | tail -n 1 | sed 's/\x1b\[[0-9;]*m//g; s/^.*\(SOLVED\)/\1/; s/; saved .*//')
       [ -n "$line" ] || line="(no SOLVED line: see $log)"
     else
       # test.sh's last line: the one before its exit line.
@@ -73,6 +75,6 @@ for release in "${releases[@]}"; do
     summary+=("$row")
   done
 done
-echo "[releases] summary (commit $(git rev-parse --short HEAD)):"
+echo "[releases] summary (commit $commit):"
 printf '  %s\n' "${summary[@]}"
 exit "$status"
