@@ -238,7 +238,8 @@ void runVerdicts(benchmark::State& state, const QTable& table, const TrainingCon
   std::uint64_t steps = 0;
   for (auto _ : state)
   {
-    const SuiteResult result = evaluateSuite(table, config, suite, how);
+    // Not const: Google Benchmark 1.9 (Debian 13) deprecates DoNotOptimize(const T&) for such types.
+    SuiteResult result = evaluateSuite(table, config, suite, how);
     for (const CaseResult& c : result.cases)
       steps += c.steps;
     benchmark::DoNotOptimize(result);
