@@ -337,7 +337,14 @@ rm -f /tmp/learning_curve.png
 run "learning curve" 120 0 \
   "rosrun cartpole_qlearning train_headless --quiet --stats-csv /tmp/episodes.csv && rosrun cartpole_qlearning plot_learning_curve /tmp/episodes.csv -o /tmp/learning_curve.png" \
   "wrote /tmp/learning_curve.png \(259 episodes, solved at episode 259\)"
-check "the README's learning curve is what its command draws" "cmp -s /tmp/learning_curve.png docs/images/learning_curve.png"
+# Byte for byte only with the matplotlib that drew it (Debian 12's, 3.6.3): another release's
+# (Debian 11: 3.3, 13: 3.10) lays out and compresses otherwise; there the picture must be a PNG.
+if [ "$(/usr/bin/python3 -c 'import matplotlib; print(matplotlib.__version__)' 2>/dev/null)" = 3.6.3 ]; then
+  check "the README's learning curve is what its command draws" "cmp -s /tmp/learning_curve.png docs/images/learning_curve.png"
+else
+  check "the README's learning curve was drawn (another matplotlib than 3.6.3, which drew the shipped one: bytes not compared)" \
+    "head -c 8 /tmp/learning_curve.png | od -c | grep -q 'P   N   G'"
+fi
 
 # A robot's profile tried without the robot (last: it replaces the default table, and says so).
 run "try_robot.launch robot:=openai_ros_cartpole" 400 0 \
