@@ -164,6 +164,31 @@ void readFinite(SectionReader& priv, const std::string& name, double& value)
     priv.fail(name, SectionReader::numberText(value), "must be finite");
 }
 
+}  // namespace
+
+void readRobotCommand(SectionReader& priv, RobotInterfaceParams& robot)
+{
+  std::string type = "joint_state";
+  priv.readChoice("command_type", type, {"joint_state", "float64", "float64_array"});
+  robot.command_type = type == "float64"         ? CommandType::Float64
+                       : type == "float64_array" ? CommandType::Float64Array
+                                                 : CommandType::JointState;
+  robot.command_joint = robot.cart_joint;
+  priv.read("command_joint", robot.command_joint);
+  if (robot.command_joint.empty())
+    priv.fail("command_joint", "''", "must name the cart's joint as the robot takes commands for it");
+  std::uint64_t index = 0;
+  std::uint64_t size = 1;
+  priv.read("command_index", index, 0);
+  priv.read("command_size", size, 1);
+  if (index >= size)
+    priv.fail("command_index", std::to_string(index), "must be < ~command_size = " + std::to_string(size));
+  robot.command_index = static_cast<std::size_t>(index);
+  robot.command_size = static_cast<std::size_t>(size);
+}
+
+namespace
+{
 // A MuJoCo model's joints are the robot's by default (the sim publishes them; ~cart_joint and
 // ~pole_joint still win): one config names them for the sim and the controller alike.
 void useModelJoints(const EngineParams& engine, RobotInterfaceParams& robot)
@@ -196,23 +221,7 @@ void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& r
   priv.read("velocity_smoothing", robot.velocity_smoothing);
   if (!(robot.velocity_smoothing >= 0.0 && robot.velocity_smoothing < 1.0))
     priv.fail("velocity_smoothing", SectionReader::numberText(robot.velocity_smoothing), "must be in [0, 1)");
-  std::string type = "joint_state";
-  priv.readChoice("command_type", type, {"joint_state", "float64", "float64_array"});
-  robot.command_type = type == "float64"         ? CommandType::Float64
-                       : type == "float64_array" ? CommandType::Float64Array
-                                                 : CommandType::JointState;
-  robot.command_joint = robot.cart_joint;
-  priv.read("command_joint", robot.command_joint);
-  if (robot.command_joint.empty())
-    priv.fail("command_joint", "''", "must name the cart's joint as the robot takes commands for it");
-  std::uint64_t index = 0;
-  std::uint64_t size = 1;
-  priv.read("command_index", index, 0);
-  priv.read("command_size", size, 1);
-  if (index >= size)
-    priv.fail("command_index", std::to_string(index), "must be < ~command_size = " + std::to_string(size));
-  robot.command_index = static_cast<std::size_t>(index);
-  robot.command_size = static_cast<std::size_t>(size);
+  readRobotCommand(priv, robot);
   priv.read("max_effort", robot.max_effort);
   if (!(robot.max_effort > 0.0))
     priv.fail("max_effort", SectionReader::numberText(robot.max_effort),

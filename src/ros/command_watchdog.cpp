@@ -4,6 +4,7 @@
 #include "parameter_source.h"
 #include "start_up.h"
 
+#include "cartpole_qlearning/application/node_settings.h"
 #include "cartpole_qlearning/ros/conversions.h"
 
 #include <algorithm>
@@ -76,24 +77,8 @@ void CommandWatchdogNode::readParameters()
   priv.read("command_topic", robot_.command_topic);
   if (robot_.command_topic.empty())
     priv.fail("command_topic", "''", "must name the robot's command topic");
-  std::string type = "joint_state";
-  priv.readChoice("command_type", type, {"joint_state", "float64", "float64_array"});
-  robot_.command_type = type == "float64"         ? CommandType::Float64
-                        : type == "float64_array" ? CommandType::Float64Array
-                                                  : CommandType::JointState;
   priv.read("cart_joint", robot_.cart_joint);
-  robot_.command_joint = robot_.cart_joint;
-  priv.read("command_joint", robot_.command_joint);
-  if (robot_.command_joint.empty())
-    priv.fail("command_joint", "''", "must name the cart's joint as the robot takes commands for it");
-  std::uint64_t index = 0;
-  std::uint64_t size = 1;
-  priv.read("command_index", index, 0);
-  priv.read("command_size", size, 1);
-  if (index >= size)
-    priv.fail("command_index", std::to_string(index), "must be < ~command_size = " + std::to_string(size));
-  robot_.command_index = static_cast<std::size_t>(index);
-  robot_.command_size = static_cast<std::size_t>(size);
+  readRobotCommand(priv, robot_);
   // The controller commands at least once a decision period while it acts (a Float64 robot gets
   // nothing between decisions): five of them (0.1 s at the usual 0.02) leave room for a loaded
   // machine's jitter, as the controller's own freshness guard does, and still stop a robot whose

@@ -121,6 +121,11 @@ struct ControllerContext
   std::vector<std::string> suite_folders;  // RunSettings::suite_folders (the package's config/)
 };
 
+// The command a robot takes: ~command_type, ~command_joint (robot.cart_joint unless given),
+// ~command_index and ~command_size; read alike by the controller and the command watchdog.
+// Throws ConfigError naming a bad one.
+void readRobotCommand(SectionReader& priv, RobotInterfaceParams& robot);
+
 // Reads the shared sections from `shared` and the private parameters from `priv`. Throws
 // ConfigError naming the parameter, its value and what is allowed, on a bad value or an
 // unknown private key. An evaluation of a table (~mode evaluate, ~load_on_start) with no
