@@ -24,8 +24,9 @@ WORK=${FUZZ_WORK:-$(mktemp -d "${TMPDIR:-/tmp}/cartpole_fuzz.XXXXXX")}
 mkdir -p "$WORK"
 
 # The core layers the parsers live in and rest on (the table file and the config readers are
-# learning's), as CMakeLists.txt lists them for their libraries.
-mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_\(common\|io\|simulation\|learning\)/,/)$/p' "$SRC/CMakeLists.txt" |
+# learning's; the config reader asks the engines' registry), as CMakeLists.txt lists them for
+# their libraries. (-ldl: the registry's MuJoCo loader, whose dlopen is libdl's before glibc 2.34.)
+mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_\(common\|io\|simulation\|engines\|learning\)/,/)$/p' "$SRC/CMakeLists.txt" |
   grep -o 'src/[a-z_]*/[a-z_]*\.cpp')
 # Line tables only (as tools/sanitize.sh): a report's frames still name function, file and line,
 # for about 10 % less compile time.
@@ -58,7 +59,7 @@ echo "[fuzz] compiled in $SECONDS s"
 TARGETS=(${FUZZ_TARGETS:-q_table config})
 for target in "${TARGETS[@]}"; do
   echo "[fuzz] building $target"
-  "$CXX" "${COMPILE[@]}" -fsanitize=fuzzer "$SRC/test/fuzz/${target}_fuzzer.cpp" "$OBJECTS"/*.o -lyaml-cpp \
+  "$CXX" "${COMPILE[@]}" -fsanitize=fuzzer "$SRC/test/fuzz/${target}_fuzzer.cpp" "$OBJECTS"/*.o -lyaml-cpp -ldl \
     -o "$WORK/${target}_fuzzer"
 done
 # The targets run side by side (each on one core, for the same bounded time); their exit statuses
