@@ -93,8 +93,8 @@ std::string checksumOf(const QTable& table)
 
 // The shortest decimal (15 to 17 significant digits, as printf's %g writes them) that reads back
 // as the same double: exact, and 2.4 stays "2.4" rather than "2.3999999999999999". With to_chars
-// and from_chars (locale-free; io/number_text.h where the library lacks them), not string streams: a table of 2,000,000 values took 6 s to write
-// through streams.
+// and from_chars (locale-free; io/number_text.h where the library lacks them), not string
+// streams: a table of 2,000,000 values took 6 s to write through streams.
 void appendExact(std::string& text, double value)
 {
   char buffer[64];
