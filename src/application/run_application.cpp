@@ -258,6 +258,13 @@ LogLines RunApplication::start(const RunIdentity& previous, int launcher)
   return log;
 }
 
+void RunApplication::checkStart()
+{
+  Parts& p = *parts_;
+  LogLines log = p.keeper.loadSuite();
+  p.loadOnStart(log);
+}
+
 LogLines RunApplication::resume(const std::string& folder)
 {
   Parts& p = *parts_;

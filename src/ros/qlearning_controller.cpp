@@ -74,6 +74,14 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   startLiveTuning();
 }
 
+void QLearningControllerNode::checkParameters(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
+{
+  const ControllerSettings settings = readControllerParameters(nh, pnh, true);
+  TrainingSession session(settings.training.task, settings.training.agent, settings.run.seed, settings.run.learning,
+                          settings.robots.size());
+  RunApplication(settings.run, settings.training, session).checkStart();
+}
+
 void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
 {
   robots_.resize(settings_.robots.size());

@@ -2,43 +2,31 @@
 #include "cartpole_qlearning/ros/qlearning_controller.h"
 #include "start_up.h"
 
-#include <atomic>
-#include <csignal>
 #include <memory>
-
-namespace
-{
-std::atomic<bool> g_stop_requested{false};
-
-// Ctrl-C and roslaunch's kill (SIGINT, then SIGTERM): only noted here; main commands zero
-// effort while ROS still runs, then shuts it down.
-void requestStop(int)
-{
-  g_stop_requested = true;
-}
-}  // namespace
 
 int main(int argc, char** argv)
 {
+  const bool check_only = cartpole_qlearning::takeCheckFlag(argc, argv);
   ros::init(argc, argv, "qlearning_controller", ros::init_options::NoSigintHandler);
-  std::signal(SIGINT, requestStop);
-  std::signal(SIGTERM, requestStop);
+  // Ctrl-C and roslaunch's kill: the controller commands zero effort while ROS still runs.
+  cartpole_qlearning::noteStopSignals();
   ros::NodeHandle nh;
   ros::NodeHandle pnh("~");
   std::unique_ptr<cartpole_qlearning::QLearningControllerNode> node;
-  if (!cartpole_qlearning::startNode("qlearning_controller", ros::this_node::getName(), [&] {
-        node = std::make_unique<cartpole_qlearning::QLearningControllerNode>(
-            nh, pnh, [] { ros::shutdown(); }, true);
-      }))
+  if (!cartpole_qlearning::startNode(
+          "qlearning_controller", ros::this_node::getName(),
+          [&] {
+            if (check_only)
+              cartpole_qlearning::QLearningControllerNode::checkParameters(nh, pnh);
+            else
+              node = std::make_unique<cartpole_qlearning::QLearningControllerNode>(
+                  nh, pnh, [] { ros::shutdown(); }, true);
+          },
+          nullptr, !check_only))
     return 1;
-  while (ros::ok() && !g_stop_requested)
-    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.05));
-  if (g_stop_requested)
-  {
-    node->stop();
-    // The zero goes out on the publishers' connections, which ros::shutdown closes.
-    ros::WallDuration(0.2).sleep();
-    ros::shutdown();
-  }
+  if (check_only)
+    return 0;
+  // A training run that finished has shut ROS down itself: nothing to stop then.
+  cartpole_qlearning::spinUntilStopped(0.05, false, [&] { node->stop(); });
   return 0;
 }

@@ -2,9 +2,13 @@
 
 #include "launch_control.h"
 
+#include <ros/callback_queue.h>
 #include <ros/console.h>
+#include <ros/init.h>
 
 #include <algorithm>
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <map>
@@ -63,7 +67,7 @@ void logLine(const std::string& logger, LogLine::Level level, const std::string&
 }
 
 bool startNode(const std::string& type, const std::string& node_name, const std::function<void()>& start,
-               std::string* reason)
+               std::string* reason, bool end_launch)
 {
   // Only the start-up is caught here: an exception from a callback later is a crash like any
   // other, and under train.launch the node respawns.
@@ -77,13 +81,52 @@ bool startNode(const std::string& type, const std::string& node_name, const std:
     // The logger the node logs on afterwards.
     const std::string logger = nodeLogger(type, node_name);
     logLine(logger, ros::console::levels::Fatal, type + ": " + e.what());
-    if (endParentLaunch())
+    if (end_launch && endParentLaunch())
       logLine(logger, ros::console::levels::Fatal,
               type + ": ending the launch: this cannot work until the above is fixed");
     if (reason != nullptr)
       *reason = e.what();
     return false;
   }
+}
+
+bool takeCheckFlag(int& argc, char** argv)
+{
+  const std::string flag = "--check-parameters";
+  const auto end = argv + argc;
+  const auto found = std::find_if(argv + 1, end, [&](const char* arg) { return flag == arg; });
+  if (found == end)
+    return false;
+  std::rotate(found, found + 1, end);
+  --argc;
+  return true;
+}
+
+namespace
+{
+std::atomic<bool> g_stop_requested{false};
+
+void requestStop(int)
+{
+  g_stop_requested = true;
+}
+}  // namespace
+
+void noteStopSignals()
+{
+  std::signal(SIGINT, requestStop);
+  std::signal(SIGTERM, requestStop);
+}
+
+void spinUntilStopped(double period_s, bool always_stop, const std::function<void()>& stop)
+{
+  while (ros::ok() && !g_stop_requested)
+    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(period_s));
+  if (!g_stop_requested && !always_stop)
+    return;
+  stop();
+  ros::WallDuration(0.2).sleep();
+  ros::shutdown();
 }
 
 }  // namespace cartpole_qlearning

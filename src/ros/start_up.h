@@ -30,7 +30,23 @@ std::string withPrefix(const std::string& prefix, const LogLine& line);
 // nodeLogger(type, node_name), and, when roslaunch started this process, ends that launch: under
 // roslaunch the node may respawn, and would fail the same way forever. Returns false then, with
 // the reason in *reason when given.
+// end_launch false: the failure is only reported (a check of the parameters, below, must not end
+// the roslaunch that asked for it).
 bool startNode(const std::string& type, const std::string& node_name, const std::function<void()>& start,
-               std::string* reason = nullptr);
+               std::string* reason = nullptr, bool end_launch = true);
+
+// True when the command line asks the executable only to check its parameters
+// (--check-parameters, as scripts/check_launch runs it before a launch starts): the flag is taken
+// out of argv, so that ros::init sees the rest. The node then reads its parameters, opens what it
+// would open, exits 1 with its FATAL line when it would refuse them, else 0.
+bool takeCheckFlag(int& argc, char** argv);
+
+// For the executables that send the robot a last zero: SIGINT and SIGTERM (Ctrl-C, roslaunch's
+// kill) are only noted (ros::init must be given NoSigintHandler); spinUntilStopped spins the global
+// queue every period_s until ROS shuts down or such a signal came, then, when one came or
+// always_stop, calls stop() while ROS still runs, gives what it sent a moment to leave on the
+// publishers' connections (which ros::shutdown closes) and shuts ROS down.
+void noteStopSignals();
+void spinUntilStopped(double period_s, bool always_stop, const std::function<void()>& stop);
 
 }  // namespace cartpole_qlearning

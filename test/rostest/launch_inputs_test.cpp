@@ -5,8 +5,10 @@
 // robot: upright, the table pushes; the pole at 20 degrees, past the table's 12 but within the
 // leftovers' 60, the controller commands 0 (a fall), as it does on a clean master. A refused
 // parameter (a table that is not there, a value out of range) ends evaluate.launch, train.launch and
-// robot.launch by itself, the [FATAL] line naming it; roslaunch's own exit status is printed (on
-// roslaunch 1.15 it is 0 whatever its nodes did: docs/troubleshooting.md).
+// robot.launch before any node starts, the [FATAL] line naming it, with exit status 1 (the launch's
+// check, scripts/check_launch); without the check (check_parameters:=false) the node refuses it when
+// it starts and still ends the launch (then roslaunch 1.15's exit status is 0 whatever its nodes
+// did: docs/troubleshooting.md).
 #include "rostest_main.h"
 #include "test_support.h"
 
@@ -133,12 +135,22 @@ TEST(LaunchInputs, ARefusedParameterEndsEachLaunchNamingIt)
         Case{"robot.launch", "ns:=refused_robot decision_period:=20", "decision_period = 20 is not allowed"},
         Case{"robot.launch", "ns:=refused_watchdog watchdog_timeout:=5", "timeout = 5 is not allowed"}})
   {
-    TrainLaunch launch(home, "refused_" + std::to_string(n++), c.args, c.launch_file);
-    const int status = launch.waitFor(60.0);
-    const std::string output = launch.output();
-    EXPECT_GE(status, 0) << c.launch_file << " " << c.args << " did not end by itself:\n" << output;
-    EXPECT_NE(std::string::npos, output.find(c.names)) << output;
-    EXPECT_NE(std::string::npos, output.find("[FATAL]")) << output;
-    std::printf("roslaunch cartpole_qlearning %s %s: ended, exit status %d\n", c.launch_file, c.args, status);
+    for (const bool checked : {true, false})
+    {
+      const std::string args = std::string(c.args) + (checked ? "" : " check_parameters:=false");
+      TrainLaunch launch(home, "refused_" + std::to_string(n++), args, c.launch_file);
+      const int status = launch.waitFor(60.0);
+      const std::string output = launch.output();
+      EXPECT_GE(status, 0) << c.launch_file << " " << args << " did not end by itself:\n" << output;
+      EXPECT_NE(std::string::npos, output.find(c.names)) << output;
+      EXPECT_NE(std::string::npos, output.find("[FATAL]")) << output;
+      if (checked)
+      {
+        EXPECT_EQ(1, status) << c.launch_file << " " << args << ": a script cannot tell the launch failed\n" << output;
+        EXPECT_NE(std::string::npos, output.find("nothing was started")) << output;
+        EXPECT_EQ(std::string::npos, output.find("started with pid")) << "a node started:\n" << output;
+      }
+      std::printf("roslaunch cartpole_qlearning %s %s: ended, exit status %d\n", c.launch_file, args.c_str(), status);
+    }
   }
 }

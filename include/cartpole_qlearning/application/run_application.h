@@ -91,6 +91,10 @@ public:
   // cannot be read when training evaluates it (suite_every > 0; else a warning says that the run
   // ends without a verdict).
   LogLines start(const RunIdentity& previous = {}, int launcher = 0);
+  // What start() would refuse, found without starting: the suite training evaluates with and the
+  // table to load (its file, its fit, its config), throwing as start() throws. Writes nothing and
+  // judges nothing (a launch checks its nodes' parameters with it before they start).
+  void checkStart();
   // train_headless --resume FOLDER: goes on from that run folder's checkpoint (relative: under
   // the table folder), instead of start(): ~load_on_start plays no part, the curve keeps the rows
   // the checkpoint covers. Throws ConfigError when it holds no usable checkpoint, when the folder

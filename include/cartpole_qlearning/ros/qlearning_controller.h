@@ -55,6 +55,10 @@ public:
   // ~load_on_start table or ~stats_csv that cannot be used included).
   QLearningControllerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::function<void()> shutdown,
                           bool shutdown_by_default, ros::CallbackQueue* state_queue = nullptr);
+  // What the constructor would refuse, without starting: reads the parameters as it does and opens
+  // the table it would load (RunApplication::checkStart). Throws the same ConfigError; writes
+  // nothing. For a launch's check before its nodes start (scripts/check_launch).
+  static void checkParameters(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
   // Saves the table when ~save_on_shutdown (training, RunApplication::shutdown), after giving up
   // any reset call under way.
   ~QLearningControllerNode();
