@@ -1,4 +1,7 @@
 // What a service is, found out the way `rosservice info` and `rosservice type` do.
+// Hand-made because roscpp cannot tell: ros::service::exists and ServiceClient only say whether a
+// call of the type we name is accepted, never which type the server has (only rospy's rosservice
+// module sends a probe header), and "it serves std_srvs/Trigger, not Reset" is the message a user needs.
 #pragma once
 
 #include "cartpole_qlearning/protocol/reset_calls.h"

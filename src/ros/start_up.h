@@ -17,9 +17,11 @@ namespace cartpole_qlearning
 // set on ros.cartpole_qlearning.cartpole_sim still reaches every sim.
 std::string nodeLogger(const std::string& type, const std::string& node_name);
 
-// One line on a logger named as above (under ros.cartpole_qlearning), at its level. Unlike
-// ROS_*_NAMED, whose call site keeps the logger it first met (a static per line of code, so a second
-// sim in the same manager would log on the first one's), every logger name gets its own place.
+// One line on a logger named as above (under ros.cartpole_qlearning), at its level. Not
+// ROS_*_NAMED or NODELET_* (which expands to it): their call site keeps the logger it first met, a
+// static per line of code (ros/ros_comm#561), so a second sim in the same manager would log on the
+// first one's and a level set for one instance would reach the other. Here every logger name gets
+// its own place (ros_conversions_test's NodeLogger test).
 void logLine(const std::string& logger, ros::console::Level level, const std::string& text);
 void logLine(const std::string& logger, LogLine::Level level, const std::string& text);
 // A line's text as the node says it: after the node's prefix unless the line asks for none.
