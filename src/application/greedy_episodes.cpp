@@ -19,7 +19,7 @@ GreedyEpisode GreedyEpisodes::run(CartPoleSimulation& simulation)
 {
   simulation.resetRandom();
   // The model the table learnt, for a prediction of the robot's delay (none: decide for what is seen).
-  predictor_.begin();
+  predictor_.begin(simulation.observation());
   features_.activeRows(predicting_ ? predictor_.predict(simulation.observation()) : simulation.observation(), rows_);
   std::size_t action = QLearningAgent::greedyAction(table_, rows_);
   GreedyEpisode episode;
@@ -32,6 +32,7 @@ GreedyEpisode GreedyEpisodes::run(CartPoleSimulation& simulation)
     episode.episode_return += outcome.score;
     if (outcome.done())
       break;
+    predictor_.observed(simulation.observation());
     // The action just taken is part of what a previous_action table sees of the state.
     features_.activeRows(predicting_ ? predictor_.predict(simulation.observation()) : simulation.observation(), rows_,
                          action + 1);

@@ -250,7 +250,7 @@ std::vector<std::string> drivingWarnings(const ControllerSettings& settings)
                        " times " + step + ": when fresh states stop, the last command goes on pushing the robot " +
                        "that long before 0");
   const unsigned delay = settings.run.predict_delay_steps;
-  if (delay > 5)
+  if (delay > 5 && delay != kDelayFoundFromStates)
     warnings.push_back("~predict_delay_steps = " + std::to_string(delay) + " predicts " +
                        SectionReader::numberText(delay * tau) + " s ahead at " + step +
                        ": a robot that late is rare; the prediction drifts from the robot the further it looks");
@@ -421,6 +421,8 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   if (!run.control && !source.keysUnder("report_every").empty())
     priv.fail("report_every", SectionReader::numberText(run.report_every), "only with mode control");
   // A robot known to answer late: decide for the state the table's model predicts for when the command acts.
+  // Not told: found from the robot's states when greedy (below).
+  const bool delay_told = !source.keysUnder("predict_delay_steps").empty();
   priv.read("predict_delay_steps", run.predict_delay_steps, 0, kMaxPredictedDelaySteps);
   if (run.learning && run.predict_delay_steps > 0)
     priv.fail("predict_delay_steps", std::to_string(run.predict_delay_steps),
@@ -455,6 +457,11 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
                   SectionReader::numberText(settings.training.physics.tau) +
                   " s: it needs ~decision_period = tau, not " +
                   SectionReader::numberText(settings.robot.decision_period));
+  // A greedy table not told the delay finds it (DelayEstimator), when the model's steps are its
+  // decisions (as a told one needs, above).
+  if (!delay_told && !run.learning &&
+      std::abs(settings.robot.decision_period - settings.training.physics.tau) <= 1e-9)
+    run.predict_delay_steps = kDelayFoundFromStates;
   protocol.commands_unstamped = settings.robot.command_type != CommandType::JointState;
   // The freshness guard's bound: a few decision periods, and no less than 0.1 s (a real-time
   // machine's hiccup is not a robot gone). 0 turns it off: a lockstep sim holds no command.
@@ -623,7 +630,10 @@ std::string controllerStartText(const ControllerSettings& settings, const QTable
                      served;
   if (settings.robots.size() > 1)
     text += settings.sync ? " in lockstep rounds" : ", each as its states come";
-  if (settings.run.predict_delay_steps > 0)
+  if (settings.run.predict_delay_steps == kDelayFoundFromStates)
+    text += "; finding how many steps late the robot carries out its commands from how its states answer them, "
+            "then deciding for the state predicted that far ahead (~predict_delay_steps N tells it instead)";
+  else if (settings.run.predict_delay_steps > 0)
     text += "; deciding for the state predicted " + std::to_string(settings.run.predict_delay_steps) +
             (settings.run.predict_delay_steps == 1 ? " step" : " steps") + " ahead (~predict_delay_steps)";
   return text + "; " +

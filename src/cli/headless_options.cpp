@@ -231,8 +231,11 @@ HeadlessCommandLine parseHeadlessOptions(const std::vector<std::string>& args)
     else if (arg == "--predict-delay" && has_value)
     {
       o.predict_delay_given = true;
-      if (!parseCount(args[++i], o.predict_delay) || o.predict_delay > kMaxPredictedDelaySteps)
-        return refuse(arg, args[i], "must be a whole number in [0, " + std::to_string(kMaxPredictedDelaySteps) + "]");
+      if (std::string(args[++i]) == "auto")
+        o.predict_delay = kDelayFoundFromStates;
+      else if (!parseCount(args[i], o.predict_delay) || o.predict_delay > kMaxPredictedDelaySteps)
+        return refuse(arg, args[i],
+                      "must be auto or a whole number in [0, " + std::to_string(kMaxPredictedDelaySteps) + "]");
     }
     else if (arg == "--greedy-check" && has_value)
     {
@@ -277,7 +280,10 @@ RunSettings headlessRunSettings(const HeadlessOptions& options, std::uint64_t se
   settings.save_on_shutdown = !options.no_run_folder;
   settings.run_folder = !options.no_run_folder;
   settings.trace = options.trace;
-  settings.predict_delay_steps = static_cast<unsigned>(options.predict_delay);
+  // Not told: a greedy run finds the delay from the states, as the controller does.
+  settings.predict_delay_steps = options.predict_delay_given ? static_cast<unsigned>(options.predict_delay)
+                                 : settings.learning         ? 0u
+                                                             : kDelayFoundFromStates;
   settings.own_absolute_paths = true;
   settings.command_line = true;
   // A relative training/suite: beside the config first, then the package's config/.

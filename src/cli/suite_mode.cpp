@@ -36,7 +36,8 @@ int suiteMode(const HeadlessOptions& options, const HeadlessSetup& setup)
     if (!contradiction.empty())
       throw FileError(contradiction);
     SuiteRun how = SuiteRun::complete();
-    how.predict_delay_steps = static_cast<unsigned>(options.predict_delay);
+    how.predict_delay_steps =
+        options.predict_delay_given ? static_cast<unsigned>(options.predict_delay) : kDelayFoundFromStates;
     result = evaluateSuite(table, setup.config, suite, how);
   }
   catch (const std::runtime_error& e)  // FileError, ConfigError: the table cannot be read or does not fit
@@ -45,9 +46,11 @@ int suiteMode(const HeadlessOptions& options, const HeadlessSetup& setup)
     return 2;
   }
   const std::string predicting =
-      options.predict_delay == 0 ? ""
-                                 : ", each decision for the state predicted " + std::to_string(options.predict_delay) +
-                                       (options.predict_delay == 1 ? " step" : " steps") + " ahead";
+      options.predict_delay_given && options.predict_delay == 0 ? ""
+      : !options.predict_delay_given || options.predict_delay == kDelayFoundFromStates
+          ? ", each case's delay found from its states and each decision for the state predicted that far ahead"
+          : ", each decision for the state predicted " + std::to_string(options.predict_delay) +
+                (options.predict_delay == 1 ? " step" : " steps") + " ahead";
   if (!options.quiet)
     std::printf("suite %s: %zu cases, %llu greedy episodes each, seed %llu%s\n%s\n", suite_path.c_str(),
                 suite.cases.size(), static_cast<unsigned long long>(suite.episodes),

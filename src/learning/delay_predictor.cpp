@@ -6,36 +6,50 @@
 
 namespace cartpole_qlearning
 {
-DelayPredictor::DelayPredictor(const CartPoleParams& model, unsigned steps) : model_(model), in_flight_(steps, 0.0)
+DelayPredictor::DelayPredictor(const CartPoleParams& model, unsigned steps) : model_(model)
 {
-  if (steps > kMaxPredictedDelaySteps)
+  if (steps == kDelayFoundFromStates)
+    estimator_.emplace(model);
+  else if (steps > kMaxPredictedDelaySteps)
     throw std::invalid_argument("a prediction of " + std::to_string(steps) + " steps is not allowed (must be in [0, " +
                                 std::to_string(kMaxPredictedDelaySteps) + "])");
+  else
+    told_ = steps;
+  sent_.assign(std::max(told_, kLargestFoundDelay) + 1, 0.0);
 }
 
-void DelayPredictor::begin()
+unsigned DelayPredictor::steps() const
 {
-  std::fill(in_flight_.begin(), in_flight_.end(), 0.0);
-  oldest_ = 0;
+  return estimator_ ? estimator_->estimate().value_or(0) : told_;
+}
+
+void DelayPredictor::begin(const CartPoleState& start)
+{
+  std::fill(sent_.begin(), sent_.end(), 0.0);
+  if (estimator_)
+    estimator_->begin(start);
+}
+
+void DelayPredictor::observed(const CartPoleState& state)
+{
+  if (estimator_)
+    estimator_->observed(state);
 }
 
 void DelayPredictor::sent(double effort)
 {
-  if (in_flight_.empty())
-    return;
-  // The oldest command has now acted; the new one joins the end of the line.
-  in_flight_[oldest_] = effort;
-  oldest_ = oldest_ + 1 == in_flight_.size() ? 0 : oldest_ + 1;
+  newest_ = (newest_ + 1) % sent_.size();
+  sent_[newest_] = effort;
+  if (estimator_)
+    estimator_->sent(effort);
 }
 
 CartPoleState DelayPredictor::predict(const CartPoleState& observed) const
 {
   CartPoleState state = observed;
-  for (std::size_t i = 0; i < in_flight_.size(); ++i)
-  {
-    const std::size_t at = (oldest_ + i) % in_flight_.size();
-    state = model_.step(state, model_.clampForce(in_flight_[at]));
-  }
+  // In flight: the last `steps` commands, the oldest acting first.
+  for (std::size_t back = steps(); back-- > 0;)
+    state = model_.step(state, model_.clampForce(sent_[(newest_ + sent_.size() - back) % sent_.size()]));
   return state;
 }
 

@@ -50,7 +50,7 @@ std::string TrainingSession::predictDelay(const CartPoleParams& model, unsigned 
   if (learning_)
     return "a prediction of the robot's delay is for a greedy table (evaluate, control): training learns from the "
            "states it observes";
-  if (steps > kMaxPredictedDelaySteps)
+  if (steps > kMaxPredictedDelaySteps && steps != kDelayFoundFromStates)
     return "a prediction of " + std::to_string(steps) + " steps is not allowed (must be in [0, " +
            std::to_string(kMaxPredictedDelaySteps) + "])";
   predictors_.assign(episodes_.size(), DelayPredictor(model, steps));
@@ -75,7 +75,7 @@ double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size
   e.steps_before_table = 0;
   e.episode_return = 0.0;
   if (!predictors_.empty())
-    predictors_[robot].begin();
+    predictors_[robot].begin(start_state);
   agent_.activeRows(decidedFor(start_state, robot), e.rows[e.current]);
   e.action = chooseAction(e.state(), e.epsilon);
   const double effort = agent_.table().actions()[e.action];
@@ -91,6 +91,8 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   ++e.steps;
   decision.outcome = task_.evaluate(state, e.steps);
   e.episode_return += decision.outcome.score;
+  if (!predictors_.empty())
+    predictors_[robot].observed(state);
   // The action just taken: with previous_action, part of what the learner sees of this state.
   // (A predicting session does not learn: its rows are only what the next action is chosen on.)
   agent_.activeRows(decidedFor(state, robot), e.next(), e.action + 1);

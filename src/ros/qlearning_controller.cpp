@@ -8,6 +8,8 @@
 #include "reset_caller.h"
 #include "start_up.h"
 
+#include <std_msgs/UInt32.h>
+
 #include <cstdio>
 #include <optional>
 #include <utility>
@@ -51,6 +53,8 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   }
   startRun();
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
+  if (session_->findingDelay())
+    delay_pub_ = pnh_.advertise<std_msgs::UInt32>("found_delay_steps", 1, true);
   if (settings_.run.control)
     control_ = std::make_unique<ControlReporter>(nh_, settings_.robots, settings_.training.physics.tau,
                                                  settings_.run.control_max_gap, settings_.robot.max_effort,
@@ -308,6 +312,25 @@ void QLearningControllerNode::onWatchdog(const ros::SteadyTimerEvent&)
     robots_[r].command.stop();
   say(orders.log);
   serveDue();
+  reportFoundDelay();
+}
+
+void QLearningControllerNode::reportFoundDelay()
+{
+  if (!session_->findingDelay())
+    return;
+  const std::optional<unsigned> found = session_->foundDelaySteps(0);
+  if (!found || found == delay_said_)
+    return;
+  say({{LogLine::Level::Info,
+        formatText("%s carries out each command %u %s late, by how its states answer them: deciding for the state "
+                   "predicted %u %s ahead (~predict_delay_steps %u tells it; 0: decide for the state observed)",
+                   robots_.front().name.empty() ? "the robot" : robots_.front().name.c_str(), *found,
+                   *found == 1 ? "step" : "steps", *found, *found == 1 ? "step" : "steps", *found)}});
+  std_msgs::UInt32 msg;
+  msg.data = *found;
+  delay_pub_.publish(msg);
+  delay_said_ = found;
 }
 
 void QLearningControllerNode::startLiveTuning()

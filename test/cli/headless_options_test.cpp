@@ -171,7 +171,7 @@ TEST(HeadlessOptions, EachRuleRefusesWhatDoesNotGoTogether)
       "--predict-delay: is how a greedy table meets a robot that answers late: give it with --evaluate TABLE "
       "(training learns from the states it observes)",
       refusal("--predict-delay 1"));
-  EXPECT_EQ("--predict-delay 51 is not allowed (must be a whole number in [0, 50])",
+  EXPECT_EQ("--predict-delay 51 is not allowed (must be auto or a whole number in [0, 50])",
             refusal("--evaluate t.yaml --predict-delay 51"));
   const std::string evaluation = " with --evaluate: an evaluation learns nothing and writes nothing";
   for (const std::string option : {"--load l", "--resume r", "--save s", "--max-episodes 3", "--checkpoint-every 0",

@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
+#include <std_msgs/UInt32.h>
 
 #include <filesystem>
 #include <mutex>
@@ -52,8 +53,11 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
   ros::param::get("~seed", seed);
   std::string suite_case = "all_at_once";
   ros::param::get("~suite_case", suite_case);
+  // -1: not told (robot.launch's default): the controller finds the delay, which must be found_delay.
   int predict_delay = 0;
   ros::param::get("~predict_delay", predict_delay);
+  int found_delay = 1;
+  ros::param::get("~found_delay", found_delay);
   const auto trained =
       runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + CARTPOLE_CONFIG_DIR +
                  "/robust.yaml --seed " + std::to_string(seed) + " --quiet --no-run-folder --save robust.yaml");
@@ -71,6 +75,11 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
                                        last = *m;
                                        ++reports;
                                      }));
+  int published_delay = -1;
+  const ros::Subscriber delay = nh.subscribe<std_msgs::UInt32>(
+      "/cartpole/qlearning_controller/found_delay_steps", 10,
+      boost::function<void(const std_msgs::UInt32ConstPtr&)>(
+          [&](const std_msgs::UInt32ConstPtr& m) { published_delay = static_cast<int>(m->data); }));
   const ros::Subscriber command = nh.subscribe<sensor_msgs::JointState>(
       "/cartpole/joint_command", 1000,
       boost::function<void(const sensor_msgs::JointStateConstPtr&)>([&](const sensor_msgs::JointStateConstPtr& m) {
@@ -84,8 +93,8 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
   TrainLaunch launch(home, "control",
                      "mode:=control load:=robust.yaml robot_lockstep:=true max_effort:=10 "
                      "reset_service:=cartpole_sim/reset "
-                     "report_every:=60 predict_delay:=" +
-                         std::to_string(predict_delay),
+                     "report_every:=60" +
+                         (predict_delay < 0 ? std::string() : " predict_delay:=" + std::to_string(predict_delay)),
                      "robot.launch");
   ASSERT_TRUE(spinUntil([&] { return last.seconds >= 300.0; }, 300.0))
       << reports << " reports, the last at " << last.seconds << " s\n"
@@ -120,8 +129,17 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
     EXPECT_TRUE(cartpole_qlearning::test::text_match::contains(
         output, "deciding for the state predicted " + std::to_string(predict_delay) + " steps? ahead"))
         << output;
-  else
+  else if (predict_delay == 0)
     EXPECT_EQ(std::string::npos, output.find("deciding for the state predicted")) << output;
+  else
+  {
+    // Not told: found from the states, said once and published (latched).
+    EXPECT_EQ(1u, occurrences(output, "carries out each command " + std::to_string(found_delay) +
+                                          (found_delay == 1 ? " step" : " steps") + " late"))
+        << output;
+    EXPECT_EQ(1u, occurrences(output, "carries out each command")) << "another delay was said:\n" << output;
+    EXPECT_EQ(found_delay, published_delay);
+  }
   std::printf(
       "five minutes of control on %s, seed %d's table, predict_delay %d: %.1f s balanced, the longest "
       "stretch %.1f s, %llu falls\n",

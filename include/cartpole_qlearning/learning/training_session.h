@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -175,12 +176,22 @@ public:
   // A greedy session only (evaluate, control): each decision is made for the state `model`
   // predicts for when the command will act on a robot that answers `steps` late (DelayPredictor),
   // from the next decision (an episode under way counts zeros in flight); 0: for the state
-  // observed (the default). Returns what is wrong (a learning session, too many steps) and
+  // observed (the default); kDelayFoundFromStates: `steps` found for each robot from its states. Returns what is wrong (a learning session, too many steps) and
   // changes nothing then. The task still judges the observed state.
   std::string predictDelay(const CartPoleParams& model, unsigned steps);
   unsigned predictedDelaySteps() const
   {
     return predictors_.empty() ? 0 : predictors_.front().steps();
+  }
+  // predictDelay(model, kDelayFoundFromStates): the delay is found from the states of each robot.
+  bool findingDelay() const
+  {
+    return !predictors_.empty() && predictors_.front().finding();
+  }
+  // The delay found for a robot so far; none before its states tell it (or when not finding).
+  std::optional<unsigned> foundDelaySteps(std::size_t robot) const
+  {
+    return predictors_.empty() ? std::nullopt : predictors_.at(robot).found();
   }
 
   // The solved window's returns, oldest first: what a checkpoint records for resume().

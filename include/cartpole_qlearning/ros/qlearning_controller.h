@@ -36,6 +36,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -95,6 +96,8 @@ private:
   bool onSave(SaveQTable::Request& request, SaveQTable::Response& response);
   bool onLoad(LoadQTable::Request& request, LoadQTable::Response& response);
   void onWatchdog(const ros::SteadyTimerEvent& event);
+  // Says and publishes the robot's delay when it is found (or found other than before). Under mutex_.
+  void reportFoundDelay();
 
   // Carries out what the robot's protocol decided about one of its states.
   void serve(const RobotDispatch::Turn& turn);
@@ -128,6 +131,10 @@ private:
   WallThrottle bad_state_warning_{1.0};
 
   ros::Publisher stats_pub_;
+  // ~found_delay_steps (std_msgs/UInt32, latched): the robot's delay as found from its states, each
+  // time it is found anew (a greedy table not told ~predict_delay_steps); the log says it too.
+  ros::Publisher delay_pub_;
+  std::optional<unsigned> delay_said_;
   // ~mode control: how each robot is held, said and published on control_stats (none otherwise).
   std::unique_ptr<ControlReporter> control_;
   // ~save_q_table and ~load_q_table run on a thread of their own: writing or reading a large

@@ -201,7 +201,12 @@ TEST(ControllerSettings, ControlDrivesWithATableAndNoStepLimitNorVerdict)
 TEST(ControllerSettings, APredictionOfTheRobotsDelayIsForAGreedyTable)
 {
   const std::string shared = "{task: {max_episode_steps: 200}}";
-  EXPECT_EQ(0u, readController("{mode: control, load_on_start: t.yaml}", shared).run.predict_delay_steps);
+  // Not told: a greedy table finds it from the robot's states; training never predicts.
+  EXPECT_EQ(kDelayFoundFromStates,
+            readController("{mode: control, load_on_start: t.yaml}", shared).run.predict_delay_steps);
+  EXPECT_EQ(kDelayFoundFromStates, readController("{mode: evaluate}", shared).run.predict_delay_steps);
+  EXPECT_EQ(0u, readController("{mode: train}", shared).run.predict_delay_steps);
+  EXPECT_EQ(0u, readController("{mode: evaluate, predict_delay_steps: 0}", shared).run.predict_delay_steps);
   EXPECT_EQ(
       1u,
       readController("{mode: control, load_on_start: t.yaml, predict_delay_steps: 1}", shared).run.predict_delay_steps);
@@ -797,7 +802,9 @@ TEST(ControllerSettings, TheStartLineSaysWhatTheControllerDoes)
   EXPECT_EQ(
       "evaluating (greedy, no learning) in episodes of 500 steps with /cartpole, seed 3, 72 states x 2 actions, "
       "tables under /t; serving a, b, each as "
-      "its states come; no reset service: an episode starts when the pole is up (inside the task's thresholds), "
+      "its states come; finding how many steps late the robot carries out its commands from how its states answer "
+      "them, then deciding for the state predicted that far ahead (~predict_delay_steps N tells it instead); no "
+      "reset service: an episode starts when the pole is up (inside the task's thresholds), "
       "the next at once after a step limit, and after a fall the pole stays down until someone stands it up (the "
       "robot's own count of episodes, if it keeps one, may differ)",
       controllerStartText(e, table, "/t", "a, b"));

@@ -35,7 +35,7 @@ TEST(DelayPredictor, ThePredictionIsTheStateWhenTheCommandActs)
     for (int episode = 0; episode < 3; ++episode)
     {
       robot.resetRandom();
-      predictor.begin();
+      predictor.begin(robot.observation());
       // The states predicted when the last `delay` commands were sent, oldest first: the command
       // sent at step k acts from the state of step k + delay.
       std::deque<CartPoleState> predictions;
@@ -81,6 +81,37 @@ TEST(DelayPredictor, AnEpisodeBeginsWithZeroInFlight)
   predictor.sent(10.0);
   const CartPoleDynamics model(physics);
   expectSameState(model.step(state, 10.0), predictor.predict(state), "after a command");
-  predictor.begin();
+  predictor.begin(state);
   expectSameState(model.step(state, 0.0), predictor.predict(state), "after begin");
+}
+
+// Not told the delay: it predicts for the observed state until the delay is found from the states,
+// then for the state the command will meet, exactly as when told.
+TEST(DelayPredictor, AFoundDelayPredictsAsAToldOne)
+{
+  const CartPoleParams physics;
+  PerturbationParams late;
+  late.delay_steps = late.delay_steps_max = 2;
+  CartPoleSimulation robot(physics, 0.05, 5, late);
+  DelayPredictor found(physics, kDelayFoundFromStates);
+  DelayPredictor told(physics, 2);
+  EXPECT_TRUE(found.finding());
+  EXPECT_FALSE(told.finding());
+  robot.resetRandom();
+  found.begin(robot.observation());
+  told.begin(robot.observation());
+  EXPECT_EQ(0u, found.steps()) << "nothing found before a command";
+  expectSameState(robot.observation(), found.predict(robot.observation()), "before the delay is found");
+  for (int step = 0; step < 150; ++step)
+  {
+    const CartPoleState& s = robot.observation();
+    const double effort = s[2] + 0.3 * s[3] + 0.05 * s[1] > 0.0 ? 10.0 : -10.0;
+    found.sent(effort);
+    told.sent(effort);
+    robot.step(effort);
+    found.observed(robot.observation());
+    told.observed(robot.observation());
+  }
+  EXPECT_EQ(2u, found.steps());
+  expectSameState(told.predict(robot.observation()), found.predict(robot.observation()), "once found");
 }
