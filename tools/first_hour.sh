@@ -308,11 +308,11 @@ run "train_headless --robots 4" 120 0 "rosrun cartpole_qlearning train_headless 
 run "train_headless --save headless.yaml" 120 0 "rosrun cartpole_qlearning train_headless --save headless.yaml" \
   "the default table: saved .* to $TABLES/headless.yaml" "^until=solved reached=true solved=true"
 output docs/train_headless.md train_headless
-# A config that contradicts the table: refused, both sources named. On a master of its own (roslaunch
-# starts one): the config stays on a master after its launch, and the commands after this one run
-# without a config.
+# A config that contradicts the table: refused before anything starts (the launch's check), exit
+# status 1, both sources named. On a master of its own (roslaunch starts one): the config stays on
+# a master after its launch, and the commands after this one run without a config.
 PORT_OWN=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-ROS_MASTER_URI="http://127.0.0.1:$PORT_OWN" run "robot.launch: a config that contradicts the table" 60 0 \
+ROS_MASTER_URI="http://127.0.0.1:$PORT_OWN" run "robot.launch: a config that contradicts the table" 60 1 \
   "roslaunch cartpole_qlearning robot.launch mode:=evaluate load:=headless.yaml config:=\$(rospack find cartpole_qlearning)/config/tiles.yaml" \
   "cannot start from the table 'headless.yaml'"
 output docs/launch_files.md table_contradiction
