@@ -26,8 +26,15 @@ unsigned DelayPredictor::steps() const
 void DelayPredictor::begin(const CartPoleState& start)
 {
   std::fill(sent_.begin(), sent_.end(), 0.0);
+  // Each episode finds the delay afresh from its own states: its decisions never depend on the
+  // episodes before it (a suite's episodes run in any order, on any thread, and a verdict cut
+  // short goes on as if run whole), at the cost of its first second or so deciding for the state
+  // observed.
   if (estimator_)
+  {
+    estimator_.emplace(model_.params());
     estimator_->begin(start);
+  }
 }
 
 void DelayPredictor::observed(const CartPoleState& state)

@@ -490,10 +490,7 @@ TEST_F(TrainHeadlessTest, EvaluateOnASuitePrintsEachCaseAndEndsWithTheSuitesVerd
       cq::readTrainingConfig(*cq::loadYamlParameters(CARTPOLE_CONFIG_DIR "/cartpole.yaml"));
   const cq::QTable table = cq::loadQTableFile((tables() / "trained.yaml").string());
   cq::RobustnessSuite suite = cq::loadRobustnessSuite(suite_file, shipped);
-  // Not told a delay, each case finds its own (--predict-delay's default), as the controller does.
-  cq::SuiteRun how = cq::SuiteRun::complete();
-  how.predict_delay_steps = cq::kDelayFoundFromStates;
-  const cq::SuiteResult expected = cq::evaluateSuite(table, shipped, suite, how);
+  const cq::SuiteResult expected = cq::evaluateSuite(table, shipped, suite);
   ASSERT_EQ(8u, expected.cases.size());
   EXPECT_NE(std::string::npos, run.output.find(expected.table())) << run.output;
   std::size_t passed = 0;

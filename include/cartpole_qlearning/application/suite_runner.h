@@ -5,6 +5,7 @@
 
 #include "cartpole_qlearning/application/suite_file.h"
 #include "cartpole_qlearning/application/suite_report.h"
+#include "cartpole_qlearning/learning/delay_predictor.h"
 #include "cartpole_qlearning/learning/q_table.h"
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/simulation/cartpole_simulation.h"
@@ -87,8 +88,10 @@ struct SuiteRun
   // Cases run side by side on this many threads (0: one per core this process may use).
   unsigned threads = 0;
   // Each decision for the state the table's model predicts this many steps ahead (DelayPredictor:
-  // a controller that knows its robot answers late); 0: for the state observed.
-  unsigned predict_delay_steps = 0;
+  // a controller that knows its robot answers late); 0: for the state observed. By default the
+  // delay is found in each episode from its states, as the controller finds it when not told: a
+  // table is judged as it will run.
+  unsigned predict_delay_steps = kDelayFoundFromStates;
 
   // The complete verdict: every case to its last episode.
   static SuiteRun complete()

@@ -183,7 +183,8 @@ protected:
     return path.string();
   }
 
-  // Training until a suite no table passes here (a command a step late and hard pushes): it goes
+  // Training until a suite no table passes here (a command a step late and hard pushes, 9 N on 30 %
+  // of the steps: with the delay found, 8 N passed within 350 episodes): it goes
   // to max_episodes, keeping the table with the most balanced episodes in its worst case, the
   // first of equals. Every verdict is said unless progress_every says otherwise.
   TrainingConfig untilAnUnpassableSuite(std::uint64_t suite_every, std::uint64_t max_episodes)
@@ -191,7 +192,7 @@ protected:
     TrainingConfig config;
     config.limits.suite = writeSuite(
         "episodes: 20\ncases: [{name: pushed_hard, pass: 20, perturbations: "
-        "{delay_steps: 1, push_probability: 0.3, push_force: 8.0}}]");
+        "{delay_steps: 1, push_probability: 0.3, push_force: 9.0}}]");
     config.limits.suite_every = suite_every;
     config.limits.progress_every = suite_every;
     config.limits.until = TrainUntil::SuitePasses;
