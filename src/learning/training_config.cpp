@@ -395,6 +395,8 @@ void emitPhysics(YAML::Emitter& out, const TrainingConfig& config)
   out << YAML::Key << "engine" << YAML::Value << engine.name;
   for (const EngineKey& key : engineOf(engine).keys)
   {
+    if (key.omitted_at_default && key.number != nullptr && physics.*key.number == CartPoleParams().*key.number)
+      continue;
     if (key.number != nullptr)
       emitNumber(out, key.name.c_str(), physics.*key.number);
     else if (key.choice != nullptr)
