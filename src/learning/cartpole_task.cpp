@@ -154,9 +154,6 @@ std::string TaskParams::validate() const
     out << "x_cost = " << x_cost << " is not allowed (must be finite and >= 0)";
   else if (!(std::isfinite(x_dot_cost) && x_dot_cost >= 0.0))
     out << "x_dot_cost = " << x_dot_cost << " is not allowed (must be finite and >= 0)";
-  else if (isSuiteTask(kind) && max_episode_steps != kSuiteEpisodeSteps)
-    out << "max_episode_steps = " << max_episode_steps << " is not allowed with kind " << toString(kind)
-        << " (the Suite's episodes are " << kSuiteEpisodeSteps << " steps)";
   else if (isSuiteTask(kind) && (reward != RewardScheme::Gymnasium || solved_reward))
     out << "reward " << toString(reward) << (solved_reward ? " and solved_reward" : "") << " are not allowed with kind "
         << toString(kind) << " (the kind's own reward scores every step)";

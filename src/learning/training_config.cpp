@@ -247,6 +247,11 @@ TaskParams readTask(const ParameterSource& source)
   reader.read("x_threshold", task.x_threshold);
   reader.read("theta_threshold_deg", task.theta_threshold_deg);
   reader.read("max_episode_steps", task.max_episode_steps, 1, std::numeric_limits<int>::max());
+  // Trained on the Suite's whole episodes (an evaluation or a robot may run others).
+  if (isSuiteTask(task.kind) && task.max_episode_steps != kSuiteEpisodeSteps)
+    reader.fail("max_episode_steps", std::to_string(task.max_episode_steps),
+                "the Suite's episodes are " + std::to_string(kSuiteEpisodeSteps) + " steps (task/kind " +
+                    toString(task.kind) + ")");
   readEnum(reader, "reward", task.reward, rewardSchemeFromString);
   std::string solved_reward;
   reader.read("solved_reward", solved_reward);

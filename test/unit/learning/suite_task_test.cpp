@@ -115,11 +115,10 @@ TEST(SuiteTask, EpisodesEndOnlyAfterTheirThousandSteps)
   }
 }
 
-TEST(SuiteTask, ValidateRefusesOtherEpisodesAndCartPoleRewards)
+TEST(SuiteTask, ValidateRefusesCartPoleRewards)
 {
   TaskParams params;
   params.kind = TaskKind::Swingup;
-  EXPECT_NE(std::string::npos, params.validate().find("max_episode_steps = 500"));
   params.max_episode_steps = kSuiteEpisodeSteps;
   EXPECT_EQ("", params.validate());
   params.reward = RewardScheme::Seed;
