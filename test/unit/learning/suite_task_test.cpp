@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 using namespace cartpole_qlearning;
 
@@ -202,4 +204,26 @@ TEST(SuiteTask, TheConfigReadsTheKindAndWritesItOnlyWhenNotTheDefault)
   EXPECT_THROW(configOf("{physics: {tau: 0.01}, task: {kind: balance, max_episode_steps: 500}}"), ConfigError);
   EXPECT_THROW(configOf("{physics: {tau: 0.01}, task: {kind: balance, theta_threshold_deg: 12}}"), ConfigError);
   EXPECT_THROW(configOf("{task: {kind: swing}}"), ConfigError);
+}
+
+TEST(SuiteTask, TheShippedConfigsAreTheSuitesTasks)
+{
+  const std::pair<const char*, TaskKind> configs[] = {
+      {"swingup.yaml", TaskKind::Swingup},
+      {"swingup_sparse.yaml", TaskKind::SwingupSparse},
+      {"dmc_balance.yaml", TaskKind::Balance},
+  };
+  for (const auto& [file, kind] : configs)
+  {
+    const TrainingConfig config = readTrainingConfig(*loadYamlParameters(std::string(CARTPOLE_CONFIG_DIR "/") + file));
+    EXPECT_EQ(kind, config.task.kind) << file;
+    EXPECT_EQ(kSuiteEpisodeSteps, config.task.max_episode_steps) << file;
+    // The Suite's cart-pole: its gravity, step, integrator and rail, and an action set with a zero.
+    EXPECT_EQ(9.81, config.physics.gravity) << file;
+    EXPECT_EQ(Integrator::Rk4, config.physics.integrator) << file;
+    EXPECT_EQ(1.8, config.physics.rail_limit) << file;
+    EXPECT_GT(config.agent.actions.size(), 2u) << file;
+    EXPECT_NE(config.agent.actions.end(), std::find(config.agent.actions.begin(), config.agent.actions.end(), 0.0))
+        << file;
+  }
 }
