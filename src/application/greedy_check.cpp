@@ -16,6 +16,7 @@ GreedyCheck::GreedyCheck(const TrainingConfig& config, unsigned episodes, std::u
 {
   if (episodes < 1)
     throw std::invalid_argument("GreedyCheck: at least one episode");
+  simulation_.setStart(config.task.start(config.start_state_bound));
 }
 
 bool GreedyCheck::passes(const QTable& table)

@@ -28,7 +28,7 @@ GreedyEpisode GreedyEpisodes::run(CartPoleSimulation& simulation)
   {
     predictor_.sent(efforts_[action]);
     simulation.step(efforts_[action]);
-    outcome = task_.evaluate(simulation.observation(), ++episode.steps);
+    outcome = task_.evaluate(simulation.observation(), ++episode.steps, efforts_[action]);
     episode.episode_return += outcome.score;
     if (outcome.done())
       break;

@@ -11,8 +11,11 @@ HeadlessTrainer::HeadlessTrainer(const TrainingConfig& config, std::uint64_t see
 {
   simulations_.reserve(robots);
   for (std::size_t r = 0; r < robots; ++r)
+  {
     simulations_.push_back(makeSimulation(config.physics, config.engine, config.start_state_bound, robotSeed(seed, r),
                                           config.perturbations));
+    simulations_.back().setStart(config.task.start(config.start_state_bound));
+  }
 }
 
 const EpisodeSummary& HeadlessTrainer::runEpisode()

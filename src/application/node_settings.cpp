@@ -405,7 +405,8 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
     priv.fail("max_steps", std::to_string(max_steps),
               run.control ? "not with mode control, which has no step limit: only with mode evaluate"
                           : "only with mode evaluate: training's episodes are task/max_episode_steps long");
-  if (!run.learning)
+  // The Control Suite's tasks are scored over their own 1,000 steps unless told otherwise.
+  if (!run.learning && (!isSuiteTask(settings.training.task.kind) || !source.keysUnder("max_steps").empty()))
     settings.training.task.max_episode_steps = max_steps;
   if (run.control)
   {

@@ -90,8 +90,11 @@ CaseResult runCase(const QTable& table, const TrainingConfig& config, const Suit
     returns = progress->returns;
   }
   else
+  {
     simulation = std::make_unique<CartPoleSimulation>(makeSimulation(
         suite_case.physics, suite_case.engine, suite_case.start_state_bound, seed, suite_case.perturbations));
+    simulation->setStart(config.task.start(suite_case.start_state_bound));
+  }
   // Decided once target episodes balanced, or once more fell than that allows.
   const std::uint64_t decided_at = result.decidedAgainst();
   const std::uint64_t falls_to_fail = fallsToFail(result);
@@ -140,6 +143,7 @@ CaseResult evaluateEpisodes(const QTable& table, const TrainingConfig& config, c
     // between them (their steps draw nothing).
     CartPoleSimulation simulation = makeSimulation(suite_case.physics, suite_case.engine, suite_case.start_state_bound,
                                                    seed, suite_case.perturbations);
+    simulation.setStart(config.task.start(suite_case.start_state_bound));
     for (std::uint32_t before = 0; before < e; ++before)
       simulation.resetRandom();
     const std::uint64_t balanced = result.balanced;

@@ -133,8 +133,10 @@ std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options)
       return std::nullopt;
     }
   }
-  // An evaluation's episodes are its own length; a suite's cases, the suite's.
-  if (options.evaluating() && options.suite_path.empty())
+  // An evaluation's episodes are its own length; a suite's cases, the suite's; the Control Suite's
+  // tasks', unless told, their 1,000 steps (the score is their sum).
+  if (options.evaluating() && options.suite_path.empty() &&
+      (options.max_steps_given || !isSuiteTask(setup.config.task.kind)))
     setup.config.task.max_episode_steps = static_cast<unsigned>(options.max_steps);
   if (options.max_episodes > 0)
     setup.config.limits.max_episodes = options.max_episodes;

@@ -1,11 +1,67 @@
 #include "cartpole_qlearning/learning/cartpole_task.h"
 
 #include <cmath>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 
 namespace cartpole_qlearning
 {
+namespace
+{
+const char* const kTaskKindNames[] = {"cartpole_v1", "balance", "swingup", "swingup_sparse"};
+constexpr TaskKind kTaskKinds[] = {TaskKind::CartPoleV1, TaskKind::Balance, TaskKind::Swingup, TaskKind::SwingupSparse};
+
+// utils/rewards.py's tolerance of a value with bounds (0, 0), its gaussian sigmoid and its default
+// value_at_margin 0.1: 1 at 0, 0.1 at +-margin, falling as 0.1^((value / margin)^2).
+double gaussianNearZero(double value, double margin)
+{
+  const double scaled = value / margin;
+  return std::pow(0.1, scaled * scaled);
+}
+
+// tolerance with bounds (0, 0), margin 1, value_at_margin 0 and the quadratic sigmoid: 1 - u^2
+// inside +-1, 0 outside.
+double quadraticNearZero(double control)
+{
+  return std::fabs(control) < 1.0 ? 1.0 - control * control : 0.0;
+}
+}  // namespace
+
+TaskKind taskKindFromString(const std::string& name)
+{
+  for (std::size_t i = 0; i < std::size(kTaskKinds); ++i)
+    if (name == kTaskKindNames[i])
+      return kTaskKinds[i];
+  throw std::invalid_argument("unknown task kind '" + name +
+                              "' (allowed: cartpole_v1, balance, swingup, swingup_sparse)");
+}
+
+std::string toString(TaskKind kind)
+{
+  for (std::size_t i = 0; i < std::size(kTaskKinds); ++i)
+    if (kind == kTaskKinds[i])
+      return kTaskKindNames[i];
+  return "unknown";
+}
+
+double suiteSmoothReward(const CartPoleState& state, double control)
+{
+  const double upright = (std::cos(state[2]) + 1.0) / 2.0;
+  const double centred = (1.0 + gaussianNearZero(state[0], 2.0)) / 2.0;
+  const double small_control = (4.0 + quadraticNearZero(control)) / 5.0;
+  const double small_velocity = (1.0 + gaussianNearZero(state[3], 5.0)) / 2.0;
+  return upright * small_control * small_velocity * centred;
+}
+
+double suiteSparseReward(const CartPoleState& state)
+{
+  // Both bounds inclusive, as tolerance's with margin 0.
+  const bool centred = state[0] >= -0.25 && state[0] <= 0.25;
+  const bool upright = std::cos(state[2]) >= 0.995;
+  return centred && upright ? 1.0 : 0.0;
+}
+
 RewardScheme rewardSchemeFromString(const std::string& name)
 {
   if (name == "gymnasium")
@@ -69,6 +125,8 @@ std::string rewardMeaning(RewardScheme scheme)
 
 double TaskParams::largestReturn() const
 {
+  if (isSuiteTask(kind))
+    return static_cast<double>(max_episode_steps);  // at most 1 a step
   const RewardScheme score = scoreReward();
   return score == RewardScheme::SuttonBarto || score == RewardScheme::Centred ? 0.0
                                                                               : static_cast<double>(max_episode_steps);
@@ -96,10 +154,47 @@ std::string TaskParams::validate() const
     out << "x_cost = " << x_cost << " is not allowed (must be finite and >= 0)";
   else if (!(std::isfinite(x_dot_cost) && x_dot_cost >= 0.0))
     out << "x_dot_cost = " << x_dot_cost << " is not allowed (must be finite and >= 0)";
+  else if (isSuiteTask(kind) && (reward != RewardScheme::Gymnasium || solved_reward))
+    out << "reward " << toString(reward) << (solved_reward ? " and solved_reward" : "") << " are not allowed with kind "
+        << toString(kind) << " (the kind's own reward scores every step)";
   else if (reward != RewardScheme::AliveQuadratic && (x_cost != 0.0 || x_dot_cost != 0.0))
     out << "x_cost = " << x_cost << " and x_dot_cost = " << x_dot_cost << " are not allowed with reward "
         << toString(reward) << " (only alive_quadratic reads them: must be 0)";
   return out.str();
+}
+
+StartDistribution TaskParams::start(double start_state_bound) const
+{
+  StartDistribution start;
+  switch (kind)
+  {
+    case TaskKind::CartPoleV1:
+      return StartDistribution::uniform(start_state_bound);
+    case TaskKind::Balance:
+      // Cart uniform in +-0.1 m, pole uniform in +-0.034 rad, both velocities 0.01 x normal.
+      start.spread << 0.1, 0.01, 0.034, 0.01;
+      start.normal = {false, true, false, true};
+      return start;
+    case TaskKind::Swingup:
+    case TaskKind::SwingupSparse:
+      // Hanging: theta pi, every value 0.01 x normal about its centre.
+      start.centre << 0.0, 0.0, M_PI, 0.0;
+      start.spread.fill(0.01);
+      start.normal = {true, true, true, true};
+      return start;
+  }
+  return start;
+}
+
+StepOutcome CartPoleTask::evaluateSuite(const CartPoleState& new_state, unsigned steps_taken, double effort) const
+{
+  StepOutcome outcome;
+  outcome.truncated = steps_taken >= params_.max_episode_steps;
+  outcome.reward = params_.kind == TaskKind::SwingupSparse
+                       ? suiteSparseReward(new_state)
+                       : suiteSmoothReward(new_state, effort / kSuiteEffortPerControl);
+  outcome.score = outcome.reward;
+  return outcome;
 }
 
 CartPoleTask::CartPoleTask(const TaskParams& params) : params_(params), theta_threshold_rad_(params.thetaThresholdRad())

@@ -234,9 +234,24 @@ TaskParams readTask(const ParameterSource& source)
 {
   TaskParams task;
   SectionReader reader(source, "task");
+  readEnum(reader, "kind", task.kind, taskKindFromString);
+  if (isSuiteTask(task.kind))
+  {
+    task.max_episode_steps = kSuiteEpisodeSteps;
+    for (const char* key : {"x_threshold", "theta_threshold_deg", "reward", "solved_reward", "x_cost", "x_dot_cost"})
+      if (!source.keysUnder(reader.key(key)).empty())
+        throw ConfigError(
+            source.describe(reader.key(key)) + " is not allowed with task/kind " + toString(task.kind) +
+            " (CartPole-v1's: the Suite's tasks never end on the cart or the angle, and score by their own reward)");
+  }
   reader.read("x_threshold", task.x_threshold);
   reader.read("theta_threshold_deg", task.theta_threshold_deg);
   reader.read("max_episode_steps", task.max_episode_steps, 1, std::numeric_limits<int>::max());
+  // Trained on the Suite's whole episodes (an evaluation or a robot may run others).
+  if (isSuiteTask(task.kind) && task.max_episode_steps != kSuiteEpisodeSteps)
+    reader.fail("max_episode_steps", std::to_string(task.max_episode_steps),
+                "the Suite's episodes are " + std::to_string(kSuiteEpisodeSteps) + " steps (task/kind " +
+                    toString(task.kind) + ")");
   readEnum(reader, "reward", task.reward, rewardSchemeFromString);
   std::string solved_reward;
   reader.read("solved_reward", solved_reward);
@@ -315,6 +330,10 @@ TrainingConfig readTrainingConfig(const ParameterSource& source)
   config.perturbations = readPerturbations(source);
   checkPerturbationsFitEngine(source, config.engine, config.perturbations);
   config.task = readTask(source);
+  if (isSuiteTask(config.task.kind) && config.physics.tau != kSuiteTau)
+    throw ConfigError(source.describe("physics/tau") + " = " + exactText(config.physics.tau) +
+                      " is not allowed with task/kind " + toString(config.task.kind) +
+                      " (the Suite's steps are 0.01 s)");
   config.agent = readAgent(source);
   config.limits = readLimits(source);
   for (const double effort : config.agent.actions)
@@ -381,6 +400,8 @@ void emitPhysics(YAML::Emitter& out, const TrainingConfig& config)
   out << YAML::Key << "engine" << YAML::Value << engine.name;
   for (const EngineKey& key : engineOf(engine).keys)
   {
+    if (key.omitted_at_default && key.number != nullptr && physics.*key.number == CartPoleParams().*key.number)
+      continue;
     if (key.number != nullptr)
       emitNumber(out, key.name.c_str(), physics.*key.number);
     else if (key.choice != nullptr)
@@ -433,10 +454,20 @@ std::string trainingConfigText(const TrainingConfig& config)
 
   const TaskParams& task = config.task;
   out << YAML::Key << "task" << YAML::Value << YAML::BeginMap;
-  emitNumber(out, "x_threshold", task.x_threshold);
-  emitNumber(out, "theta_threshold_deg", task.theta_threshold_deg);
+  // The kind only when not the default, so that the tables of configs without it stay as they were;
+  // the Suite's kinds end and score by their own rules (readTask refuses CartPole-v1's keys beside them).
+  if (isSuiteTask(task.kind))
+  {
+    out << YAML::Key << "kind" << YAML::Value << toString(task.kind);
+  }
+  else
+  {
+    emitNumber(out, "x_threshold", task.x_threshold);
+    emitNumber(out, "theta_threshold_deg", task.theta_threshold_deg);
+  }
   out << YAML::Key << "max_episode_steps" << YAML::Value << task.max_episode_steps;
-  out << YAML::Key << "reward" << YAML::Value << toString(task.reward);
+  if (!isSuiteTask(task.kind))
+    out << YAML::Key << "reward" << YAML::Value << toString(task.reward);
   // Only when set, so that the tables of configs without them stay as they were.
   if (task.solved_reward)
     out << YAML::Key << "solved_reward" << YAML::Value << toString(*task.solved_reward);

@@ -89,7 +89,7 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   Episode& e = episodes_.at(robot);
   Decision decision;
   ++e.steps;
-  decision.outcome = task_.evaluate(state, e.steps);
+  decision.outcome = task_.evaluate(state, e.steps, agent_.table().actions()[e.action]);
   e.episode_return += decision.outcome.score;
   if (!predictors_.empty())
     predictors_[robot].observed(state);

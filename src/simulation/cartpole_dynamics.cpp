@@ -60,8 +60,9 @@ std::string CartPoleParams::validate() const
     out << name << " = " << value << " is not allowed (must be finite and > 0)";
     return out.str();
   };
-  for (const auto& [name, value] :
-       {std::pair<const char*, double>{"cart_friction", cart_friction}, {"pole_friction", pole_friction}})
+  for (const auto& [name, value] : {std::pair<const char*, double>{"cart_friction", cart_friction},
+                                    {"pole_friction", pole_friction},
+                                    {"rail_limit", rail_limit}})
   {
     if (!(std::isfinite(value) && value >= 0.0))
     {
@@ -85,6 +86,31 @@ CartPoleDynamics::CartPoleDynamics(const CartPoleParams& params) : params_(param
   const std::string error = params_.validate();
   if (!error.empty())
     throw std::invalid_argument(error);
+}
+
+CartPoleState CartPoleDynamics::derivativeAtEnd(const CartPoleState& state, double force) const
+{
+  // MuJoCo's soft limit (solref 0.08 1, solimp's largest impedance 0.95) in the stop's own
+  // direction: outward is +x at the right end, -x at the left.
+  constexpr double kTimeConstant = 0.08;
+  constexpr double kImpedance = 0.95;
+  constexpr double kDamping = 2.0 / (kImpedance * kTimeConstant);
+  constexpr double kStiffness = 1.0 / (kImpedance * kTimeConstant * kTimeConstant);
+  const double outward = state[0] > 0.0 ? 1.0 : -1.0;
+  const double past = outward * state[0] - params_.rail_limit;
+  const double speed = outward * state[1];
+  const CartPoleState free = freeDerivative(state, force);
+  const double free_acc = outward * free[1];
+  const double wanted = (1.0 - kImpedance) * free_acc - kImpedance * (kDamping * speed + kStiffness * past);
+  if (wanted >= free_acc)  // the stop only pushes the cart back, never pulls it on
+    return free;
+  // The cart's acceleration per newton on it, with the pole's reaction through the hinge (the
+  // equations are linear in the force).
+  const double total_mass = params_.mass_pole + params_.mass_cart;
+  const double cos_sq = std::cos(state[2]) * std::cos(state[2]);
+  const double per_newton =
+      (1.0 + params_.mass_pole * cos_sq / (total_mass * 4.0 / 3.0 - params_.mass_pole * cos_sq)) / total_mass;
+  return freeDerivative(state, force + outward * (wanted - free_acc) / per_newton);
 }
 
 CartPoleState CartPoleDynamics::rk4Step(const CartPoleState& state, double force) const

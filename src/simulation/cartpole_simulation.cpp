@@ -16,7 +16,7 @@ CartPoleSimulation::CartPoleSimulation(std::unique_ptr<PhysicsEngine> engine, do
                                        std::uint64_t seed, const PerturbationParams& perturbations)
   : engine_(std::move(engine)),
     equations_(dynamic_cast<EquationsEngine*>(engine_.get())),
-    start_state_bound_(start_state_bound),
+    start_(StartDistribution::uniform(start_state_bound)),
     perturbations_(perturbations),
     noisy_(perturbations.noisy()),
     pushes_(perturbations.pushes()),
@@ -42,7 +42,7 @@ CartPoleSimulation::CartPoleSimulation(std::unique_ptr<PhysicsEngine> engine, do
 CartPoleSimulation::CartPoleSimulation(const CartPoleSimulation& other)
   : engine_(other.engine_->clone()),
     equations_(dynamic_cast<EquationsEngine*>(engine_.get())),
-    start_state_bound_(other.start_state_bound_),
+    start_(other.start_),
     perturbations_(other.perturbations_),
     noisy_(other.noisy_),
     pushes_(other.pushes_),
@@ -87,11 +87,24 @@ void CartPoleSimulation::beginEpisode()
   observation_ = noisy_ ? addSensorNoise(state, perturbations_, noise_rng_) : state;
 }
 
+void CartPoleSimulation::setStart(const StartDistribution& start)
+{
+  for (std::size_t i = 0; i < kStateDimensions; ++i)
+    if (!(std::isfinite(start.centre[i]) && std::isfinite(start.spread[i]) && start.spread[i] >= 0.0))
+      throw std::invalid_argument(std::string("start of ") + stateDimensionName(i) + ": centre " +
+                                  std::to_string(start.centre[i]) + ", spread " + std::to_string(start.spread[i]) +
+                                  " is not allowed (must be finite, spread >= 0)");
+  start_ = start;
+}
+
 const CartPoleState& CartPoleSimulation::resetRandom()
 {
   CartPoleState start;
-  for (int i = 0; i < 4; ++i)
-    start[i] = rng_.uniform(-start_state_bound_, start_state_bound_);
+  for (std::size_t i = 0; i < kStateDimensions; ++i)
+  {
+    const double spread = start_.spread[i];
+    start[i] = start_.centre[i] + (start_.normal[i] ? spread * rng_.normal() : rng_.uniform(-spread, spread));
+  }
   return reset(start);
 }
 

@@ -20,6 +20,7 @@ EngineDescription equationsEngineDescription()
   d.keys.push_back(EngineKey{"integrator", nullptr, &CartPoleParams::integrator, nullptr, ""});
   d.keys.push_back(EngineKey{"cart_friction", &CartPoleParams::cart_friction, nullptr, nullptr, ""});
   d.keys.push_back(EngineKey{"pole_friction", &CartPoleParams::pole_friction, nullptr, nullptr, ""});
+  d.keys.push_back(EngineKey{"rail_limit", &CartPoleParams::rail_limit, nullptr, nullptr, "", true});
   d.scales_half_length = true;
   d.episodes_independent = true;
   d.makes_in_parallel = true;

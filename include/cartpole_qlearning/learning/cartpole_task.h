@@ -1,8 +1,10 @@
-// The CartPole-v1 task: when an episode ends and what each step is worth. The controller
+// The task: where an episode starts, when it ends and what each step is worth, for each kind
+// (CartPole-v1's balance, or one of DeepMind Control Suite's cart-pole tasks). The controller
 // decides this from the state it receives; the simulator is only physics, like a robot.
 #pragma once
 
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
+#include "cartpole_qlearning/simulation/cartpole_simulation.h"
 
 #include <optional>
 #include <string>
@@ -21,6 +23,37 @@ enum class RewardScheme
                   // runs costs long before the track's end does (a shaped training reward)
 };
 
+// Which task (task/kind). The Control Suite's kinds (suite/cartpole.py's Balance task) never end on
+// the angle or the cart, last 1,000 steps of 0.01 s, and score each step in [0, 1] by their own
+// reward (task/reward is CartPole-v1's alone).
+enum class TaskKind
+{
+  CartPoleV1,    // Gymnasium's CartPole-v1: starts near upright, ends past 12 degrees or 2.4 m (the default)
+  Balance,       // the Suite's balance: starts near upright, the smooth reward
+  Swingup,       // the Suite's swingup: starts hanging, the smooth reward
+  SwingupSparse  // the Suite's swingup_sparse: starts hanging, 1 when upright and centred, else 0
+};
+
+// Parses "cartpole_v1", "balance", "swingup" or "swingup_sparse"; throws std::invalid_argument otherwise.
+TaskKind taskKindFromString(const std::string& name);
+std::string toString(TaskKind kind);
+inline bool isSuiteTask(TaskKind kind)
+{
+  return kind != TaskKind::CartPoleV1;
+}
+
+// The Suite's episode (10 s of 0.01 s steps) and its motor: ctrl in [-1, 1] times gear 10, so that an
+// effort of F newtons is the control F / 10 its reward charges for.
+constexpr unsigned kSuiteEpisodeSteps = 1000;
+constexpr double kSuiteTau = 0.01;
+constexpr double kSuiteEffortPerControl = 10.0;
+
+// The Suite's reward for the state after a step and the control of that step (the effort / 10 N):
+// smooth = upright x small control x small velocity x centred, each a factor of
+// utils/rewards.py's tolerance; sparse = 1 when |x| <= 0.25 and cos(theta) >= 0.995, else 0.
+double suiteSmoothReward(const CartPoleState& state, double control);
+double suiteSparseReward(const CartPoleState& state);
+
 // What a step at the end of the track costs under RewardScheme::Centred, against -1 for the fall.
 constexpr double kCentredCost = 0.01;
 
@@ -33,6 +66,7 @@ std::string rewardMeaning(RewardScheme scheme);
 
 struct TaskParams
 {
+  TaskKind kind = TaskKind::CartPoleV1;           // the Suite's kinds read none of the CartPole-v1 keys below
   double x_threshold = 2.4;                       // [m] terminated when |x| > this
   double theta_threshold_deg = 12.0;              // [deg] terminated when |theta| > this
   unsigned max_episode_steps = 500;               // truncated after this many steps
@@ -63,6 +97,9 @@ struct TaskParams
   }
   // Empty when valid, else a message naming the first bad field, its value and the allowed range.
   std::string validate() const;
+  // Where a random episode starts: CartPole-v1's each value uniform in +-start_state_bound (the
+  // physics section's); the Suite's their own (start_state_bound unused).
+  StartDistribution start(double start_state_bound) const;
 };
 
 struct StepOutcome
@@ -90,12 +127,14 @@ public:
   // True when the state is outside the thresholds (strict inequalities, as Gymnasium).
   bool isTerminal(const CartPoleState& state) const;
 
-  // Judges the step that produced new_state, the steps_taken-th of its episode (1-based).
+  // Judges the step that produced new_state, the steps_taken-th of its episode (1-based), under the
+  // effort [N] commanded for it (the Suite's rewards charge for it).
   // Inline (below) with isTerminal: every step of training and of the suite's verdicts asks.
-  StepOutcome evaluate(const CartPoleState& new_state, unsigned steps_taken) const;
+  StepOutcome evaluate(const CartPoleState& new_state, unsigned steps_taken, double effort) const;
 
 private:
   double rewardOf(RewardScheme scheme, const CartPoleState& new_state, bool terminated) const;
+  StepOutcome evaluateSuite(const CartPoleState& new_state, unsigned steps_taken, double effort) const;
 
   TaskParams params_;
   double theta_threshold_rad_;
@@ -103,12 +142,16 @@ private:
 
 inline bool CartPoleTask::isTerminal(const CartPoleState& state) const
 {
+  if (isSuiteTask(params_.kind))
+    return false;
   return state[0] < -params_.x_threshold || state[0] > params_.x_threshold || state[2] < -theta_threshold_rad_ ||
          state[2] > theta_threshold_rad_;
 }
 
-inline StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned steps_taken) const
+inline StepOutcome CartPoleTask::evaluate(const CartPoleState& new_state, unsigned steps_taken, double effort) const
 {
+  if (isSuiteTask(params_.kind))
+    return evaluateSuite(new_state, steps_taken, effort);
   StepOutcome outcome;
   outcome.terminated = isTerminal(new_state);
   // A step that both falls and hits the limit counts as a fall: there is no future to bootstrap on.

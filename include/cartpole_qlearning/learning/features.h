@@ -8,6 +8,7 @@
 #include "cartpole_qlearning/learning/tile_coder.h"
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -95,8 +96,18 @@ public:
 
   // previous: 0 for none (an episode's first state), 1 + the index of the action taken last;
   // ignored unless params().previous_action.
+  // theta is seen on the circle, wrapped into [-pi, pi] (the pole turns whole turns in the Suite's
+  // tasks): a pole a turn further on is the same pole. Angles already in [-pi, pi] are seen as they
+  // are, so that CartPole-v1's tables stay as they were.
   void activeRows(const CartPoleState& state, ActiveRows& active, std::size_t previous = 0) const
   {
+    if (std::fabs(state[2]) > M_PI)
+    {
+      CartPoleState wrapped = state;
+      wrapped[2] = std::remainder(state[2], 2.0 * M_PI);
+      activeRows(wrapped, active, previous);
+      return;
+    }
     const auto offset = static_cast<std::uint32_t>(params_.previous_action ? previous * state_rows_ : 0);
     if (!tile_coder_)
     {

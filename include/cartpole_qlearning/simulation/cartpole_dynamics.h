@@ -46,6 +46,12 @@ struct CartPoleParams
   // (Gymnasium's model; their paper used 0.0005 and 0.000002).
   double cart_friction = 0.0;
   double pole_friction = 0.0;
+  // [m] the rail's ends at +-this (0: no ends, CartPole-v1's track, whose task ends at 2.4 m). Past an
+  // end a stop pushes the cart back as MuJoCo's soft joint limit does with the Suite's solreflimit
+  // (0.08 s, damping ratio 1) and impedance 0.95: the cart's acceleration becomes
+  // 0.05 a_free - 0.95 (b v + k r) (r past the end, v outwards, b = 2 / (0.95 x 0.08),
+  // k = 1 / (0.95 x 0.08^2)), never pulling it outwards. A continuous force, so that RK4 steps it.
+  double rail_limit = 0.0;
 
   // Empty when valid, else a message naming the first bad field, its value and the allowed range.
   std::string validate() const;
@@ -78,11 +84,22 @@ public:
 private:
   // step() under Integrator::Rk4.
   CartPoleState rk4Step(const CartPoleState& state, double force) const;
+  // The derivative with the rail's stop acting (the cart past an end).
+  CartPoleState derivativeAtEnd(const CartPoleState& state, double force) const;
+  // The derivative without the rail's ends.
+  CartPoleState freeDerivative(const CartPoleState& state, double force) const;
 
   CartPoleParams params_;
 };
 
 inline CartPoleState CartPoleDynamics::derivative(const CartPoleState& state, double force) const
+{
+  if (params_.rail_limit > 0.0 && std::fabs(state[0]) > params_.rail_limit)
+    return derivativeAtEnd(state, force);
+  return freeDerivative(state, force);
+}
+
+inline CartPoleState CartPoleDynamics::freeDerivative(const CartPoleState& state, double force) const
 {
   // Written in Gymnasium's order of operations so that Euler steps agree with it to the last bits.
   const double total_mass = params_.mass_pole + params_.mass_cart;

@@ -9,11 +9,29 @@
 #include "cartpole_qlearning/simulation/perturbations.h"
 #include "cartpole_qlearning/common/random.h"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 
 namespace cartpole_qlearning
 {
+// How a random reset draws each state value (x, x_dot, theta, theta_dot): centre + spread x a
+// standard normal draw where `normal`, else uniformly in centre +- spread.
+struct StartDistribution
+{
+  CartPoleState centre = CartPoleState::Zero();
+  CartPoleState spread = CartPoleState::Zero();
+  std::array<bool, kStateDimensions> normal{};
+
+  // Every value uniform in +-bound (CartPole-v1's starts).
+  static StartDistribution uniform(double bound)
+  {
+    StartDistribution start;
+    start.spread.fill(bound);
+    return start;
+  }
+};
+
 class CartPoleSimulation
 {
 public:
@@ -79,8 +97,15 @@ public:
     return perturbations_;
   }
 
-  // A new episode: draws x, x_dot, theta, theta_dot in that order from the environment stream,
-  // then this episode's physics (when the perturbations vary it). Returns the true state.
+  // Where resetRandom starts (by default each value uniform in +-start_state_bound). Throws
+  // std::invalid_argument on a spread that is negative or not finite.
+  void setStart(const StartDistribution& start);
+  const StartDistribution& start() const
+  {
+    return start_;
+  }
+  // A new episode: draws x, x_dot, theta, theta_dot in that order from the environment stream
+  // (start()), then this episode's physics (when the perturbations vary it). Returns the true state.
   const CartPoleState& resetRandom();
   // A new episode from the given state (physics drawn as resetRandom does).
   const CartPoleState& reset(const CartPoleState& state);
@@ -97,7 +122,7 @@ private:
   // engine_ when it is the equations (else null): stepped without a virtual call. It points into
   // the engine's own heap object, so a moved simulation keeps it valid.
   EquationsEngine* equations_ = nullptr;
-  double start_state_bound_;
+  StartDistribution start_;
   PerturbationParams perturbations_;
   // What the perturbations ask of every step, worked out once.
   bool noisy_ = false;

@@ -25,6 +25,9 @@ struct EngineKey
   // For a text that names a file, what it is ("an MJCF file"): ${VARIABLES} in it are expanded, a
   // relative path is the config file's folder's, and the engine needs it. Empty: not a file.
   std::string file;
+  // A number a table's trained_with leaves out at its default (CartPoleParams()'s), so that the
+  // tables of configs from before the key stay as they were.
+  bool omitted_at_default = false;
 };
 
 struct EngineDescription

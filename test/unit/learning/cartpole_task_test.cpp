@@ -41,12 +41,12 @@ TEST(CartPoleTask, TruncatesAtTheStepLimitNotBefore)
 {
   const CartPoleTask task;
   const CartPoleState upright = CartPoleState::Zero();
-  EXPECT_FALSE(task.evaluate(upright, 499).done());
-  const StepOutcome last = task.evaluate(upright, 500);
+  EXPECT_FALSE(task.evaluate(upright, 499, 0.0).done());
+  const StepOutcome last = task.evaluate(upright, 500, 0.0);
   EXPECT_TRUE(last.truncated);
   EXPECT_FALSE(last.terminated);
   // Falling on the last step is a fall: no bootstrapping on it.
-  const StepOutcome fall = task.evaluate(CartPoleState(0, 0, 0.5, 0), 500);
+  const StepOutcome fall = task.evaluate(CartPoleState(0, 0, 0.5, 0), 500, 0.0);
   EXPECT_TRUE(fall.terminated);
   EXPECT_FALSE(fall.truncated);
 }
@@ -54,25 +54,25 @@ TEST(CartPoleTask, TruncatesAtTheStepLimitNotBefore)
 TEST(CartPoleTask, GymnasiumRewardIsOneEveryStepIncludingTheFall)
 {
   const CartPoleTask task = taskWith(RewardScheme::Gymnasium);
-  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1).reward);
-  EXPECT_EQ(1.0, task.evaluate(CartPoleState(3, 0, 0, 0), 7).reward);
-  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 500).reward);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1, 0.0).reward);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState(3, 0, 0, 0), 7, 0.0).reward);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 500, 0.0).reward);
 }
 
 TEST(CartPoleTask, SeedRewardIsMinusOneOnTheFall)
 {
   const CartPoleTask task = taskWith(RewardScheme::Seed);
-  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1).reward);
-  EXPECT_EQ(-1.0, task.evaluate(CartPoleState(0, 0, -0.3, 0), 9).reward);
-  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 500).reward);  // truncation is no fall
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1, 0.0).reward);
+  EXPECT_EQ(-1.0, task.evaluate(CartPoleState(0, 0, -0.3, 0), 9, 0.0).reward);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 500, 0.0).reward);  // truncation is no fall
 }
 
 TEST(CartPoleTask, SuttonBartoRewardIsZeroUntilTheFall)
 {
   const CartPoleTask task = taskWith(RewardScheme::SuttonBarto);
-  EXPECT_EQ(0.0, task.evaluate(CartPoleState::Zero(), 1).reward);
-  EXPECT_EQ(-1.0, task.evaluate(CartPoleState(-2.5, 0, 0, 0), 3).reward);
-  EXPECT_EQ(0.0, task.evaluate(CartPoleState::Zero(), 500).reward);
+  EXPECT_EQ(0.0, task.evaluate(CartPoleState::Zero(), 1, 0.0).reward);
+  EXPECT_EQ(-1.0, task.evaluate(CartPoleState(-2.5, 0, 0, 0), 3, 0.0).reward);
+  EXPECT_EQ(0.0, task.evaluate(CartPoleState::Zero(), 500, 0.0).reward);
 }
 
 TEST(CartPoleTask, BadParametersAreRefused)
@@ -93,13 +93,13 @@ TEST(CartPoleTask, AliveQuadraticCostsTheCartsPlaceAndSpeedAndNothingOnTheFall)
   params.x_cost = 0.5;
   params.x_dot_cost = 0.25;
   const CartPoleTask task(params);
-  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1).reward);
-  EXPECT_DOUBLE_EQ(1.0 - 0.5 * 0.04 - 0.25 * 0.36, task.evaluate(CartPoleState(-0.2, 0.6, 0.0, 0.0), 1).reward);
-  EXPECT_EQ(0.0, task.evaluate(CartPoleState(0.5, 1.0, 0.3, 0.0), 4).reward);  // the fall
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1, 0.0).reward);
+  EXPECT_DOUBLE_EQ(1.0 - 0.5 * 0.04 - 0.25 * 0.36, task.evaluate(CartPoleState(-0.2, 0.6, 0.0, 0.0), 1, 0.0).reward);
+  EXPECT_EQ(0.0, task.evaluate(CartPoleState(0.5, 1.0, 0.3, 0.0), 4, 0.0).reward);  // the fall
   // Without costs it is alive's, bit for bit.
   TaskParams plain;
   plain.reward = RewardScheme::AliveQuadratic;
-  EXPECT_EQ(1.0, CartPoleTask(plain).evaluate(CartPoleState(0.7, -0.4, 0.1, 0.2), 3).reward);
+  EXPECT_EQ(1.0, CartPoleTask(plain).evaluate(CartPoleState(0.7, -0.4, 0.1, 0.2), 3, 0.0).reward);
   EXPECT_EQ(RewardScheme::AliveQuadratic, cartpole_qlearning::rewardSchemeFromString("alive_quadratic"));
   EXPECT_EQ("alive_quadratic", cartpole_qlearning::toString(RewardScheme::AliveQuadratic));
   // The costs belong to alive_quadratic alone, and are never negative.
@@ -119,16 +119,16 @@ TEST(CartPoleTask, TheSolvedRewardScoresEpisodesWhateverTheLearnerTrainsOn)
   params.solved_mean_return = 950.0;
   // Unset: the score is the training reward.
   EXPECT_EQ(RewardScheme::AliveQuadratic, params.scoreReward());
-  const StepOutcome unscored = CartPoleTask(params).evaluate(CartPoleState(0.5, 0.0, 0.0, 0.0), 1);
+  const StepOutcome unscored = CartPoleTask(params).evaluate(CartPoleState(0.5, 0.0, 0.0, 0.0), 1, 0.0);
   EXPECT_EQ(unscored.reward, unscored.score);
   // Set: each step is worth the solved reward's (v5's +1 while alive) to the return, the
   // training reward's to the learner.
   params.solved_reward = RewardScheme::Alive;
   const CartPoleTask task(params);
-  const StepOutcome step = task.evaluate(CartPoleState(0.5, 0.0, 0.0, 0.0), 1);
+  const StepOutcome step = task.evaluate(CartPoleState(0.5, 0.0, 0.0, 0.0), 1, 0.0);
   EXPECT_DOUBLE_EQ(0.75, step.reward);
   EXPECT_EQ(1.0, step.score);
-  const StepOutcome fall = task.evaluate(CartPoleState(0.5, 0.0, 0.3, 0.0), 2);
+  const StepOutcome fall = task.evaluate(CartPoleState(0.5, 0.0, 0.3, 0.0), 2, 0.0);
   EXPECT_EQ(0.0, fall.reward);
   EXPECT_EQ(0.0, fall.score);
   EXPECT_TRUE(params.solvable());

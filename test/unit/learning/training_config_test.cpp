@@ -231,8 +231,8 @@ TEST(Config, TheAliveRewardIsInvertedPendulumsV5)
   TaskParams params;
   params.reward = rewardSchemeFromString("alive");
   const CartPoleTask task(params);
-  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1).reward);
-  EXPECT_EQ(0.0, task.evaluate(CartPoleState(0.0, 0.0, 1.0, 0.0), 1).reward);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState::Zero(), 1, 0.0).reward);
+  EXPECT_EQ(0.0, task.evaluate(CartPoleState(0.0, 0.0, 1.0, 0.0), 1, 0.0).reward);
   EXPECT_EQ("alive", toString(RewardScheme::Alive));
 }
 
@@ -243,14 +243,14 @@ TEST(Config, TheCentredRewardCostsACartOffTheCentreAndTheFallMore)
   const CartPoleTask task(params);
   // At the centre a step costs nothing (sutton_barto's 0); half way to the end of the track a
   // quarter of kCentredCost, either side; at the very end kCentredCost; past it, the fall's -1.
-  EXPECT_EQ(0.0, task.evaluate(CartPoleState::Zero(), 1).reward);
-  EXPECT_DOUBLE_EQ(-0.25 * kCentredCost, task.evaluate(CartPoleState(1.2, 0.0, 0.0, 0.0), 1).reward);
-  EXPECT_DOUBLE_EQ(-0.25 * kCentredCost, task.evaluate(CartPoleState(-1.2, 0.0, 0.0, 0.0), 1).reward);
-  EXPECT_DOUBLE_EQ(-kCentredCost, task.evaluate(CartPoleState(2.4, 0.0, 0.0, 0.0), 1).reward);
-  EXPECT_EQ(-1.0, task.evaluate(CartPoleState(2.5, 0.0, 0.0, 0.0), 1).reward);
-  EXPECT_EQ(-1.0, task.evaluate(CartPoleState(0.0, 0.0, 1.0, 0.0), 1).reward);
+  EXPECT_EQ(0.0, task.evaluate(CartPoleState::Zero(), 1, 0.0).reward);
+  EXPECT_DOUBLE_EQ(-0.25 * kCentredCost, task.evaluate(CartPoleState(1.2, 0.0, 0.0, 0.0), 1, 0.0).reward);
+  EXPECT_DOUBLE_EQ(-0.25 * kCentredCost, task.evaluate(CartPoleState(-1.2, 0.0, 0.0, 0.0), 1, 0.0).reward);
+  EXPECT_DOUBLE_EQ(-kCentredCost, task.evaluate(CartPoleState(2.4, 0.0, 0.0, 0.0), 1, 0.0).reward);
+  EXPECT_EQ(-1.0, task.evaluate(CartPoleState(2.5, 0.0, 0.0, 0.0), 1, 0.0).reward);
+  EXPECT_EQ(-1.0, task.evaluate(CartPoleState(0.0, 0.0, 1.0, 0.0), 1, 0.0).reward);
   // Truncation is no fall: the step is worth what its state is.
-  const StepOutcome last = task.evaluate(CartPoleState(1.2, 0.0, 0.0, 0.0), params.max_episode_steps);
+  const StepOutcome last = task.evaluate(CartPoleState(1.2, 0.0, 0.0, 0.0), params.max_episode_steps, 0.0);
   EXPECT_TRUE(last.truncated);
   EXPECT_DOUBLE_EQ(-0.25 * kCentredCost, last.reward);
   EXPECT_EQ("centred", toString(RewardScheme::Centred));

@@ -132,13 +132,13 @@ TEST_F(InvertedPendulumV5, TerminationAndRewardMatchGymnasium)
   // returns and the solved window count, whatever reward the learner trains on.
   ASSERT_TRUE(config_.task.solved_reward.has_value());
   EXPECT_EQ(RewardScheme::Alive, config_.task.scoreReward());
-  EXPECT_EQ(1.0, task.evaluate(CartPoleState(0.0, 0.0, 0.1, 0.0), 1).score);
-  EXPECT_EQ(1.0, task.evaluate(CartPoleState(0.9, 0.5, 0.1, 0.0), 1).score);
-  const StepOutcome fall = task.evaluate(CartPoleState(0.0, 0.0, -0.21, 0.0), 5);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState(0.0, 0.0, 0.1, 0.0), 1, 0.0).score);
+  EXPECT_EQ(1.0, task.evaluate(CartPoleState(0.9, 0.5, 0.1, 0.0), 1, 0.0).score);
+  const StepOutcome fall = task.evaluate(CartPoleState(0.0, 0.0, -0.21, 0.0), 5, 0.0);
   EXPECT_TRUE(fall.terminated);
   EXPECT_EQ(0.0, fall.score);
-  EXPECT_TRUE(task.evaluate(CartPoleState::Zero(), 1000).truncated);
-  EXPECT_FALSE(task.evaluate(CartPoleState::Zero(), 999).truncated);
+  EXPECT_TRUE(task.evaluate(CartPoleState::Zero(), 1000, 0.0).truncated);
+  EXPECT_FALSE(task.evaluate(CartPoleState::Zero(), 999, 0.0).truncated);
   EXPECT_EQ(1000u, config_.task.max_episode_steps);
   EXPECT_EQ(950.0, config_.task.solved_mean_return);
   EXPECT_EQ(100u, config_.task.solved_window);
