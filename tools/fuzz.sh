@@ -26,7 +26,7 @@ mkdir -p "$WORK"
 # The core layers the parsers live in and rest on (the table file and the config readers are
 # learning's; the config reader asks the engines' registry), as CMakeLists.txt lists them for
 # their libraries. (-ldl: the registry's MuJoCo loader, whose dlopen is libdl's before glibc 2.34.)
-mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_\(common\|io\|simulation\|engines\|learning\)/,/)$/p' "$SRC/CMakeLists.txt" |
+mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_\(common\|config\|io\|simulation\|engines\|learning\)/,/)$/p' "$SRC/CMakeLists.txt" |
   grep -o 'src/[a-z_]*/[a-z_]*\.cpp')
 # Line tables only (as tools/sanitize.sh): a report's frames still name function, file and line,
 # for about 10 % less compile time.

@@ -33,22 +33,27 @@ def quoted(names):
 def table():
     rows = [
         ("`include/cartpole_qlearning/common/`, `src/common/`",
-         "core layer 1 of 6 (no ROS; each links only layers listed before it here): random numbers, "
+         "core layer 1 of 7 (no ROS; each links only layers listed before it here): random numbers, "
          "log lines as values, a wall-clock throttle: " + quoted(stems("include/cartpole_qlearning/common", "src/common"))),
+        ("`include/cartpole_qlearning/config/`, `src/config/`",
+         "core layer 2: settings as tables of keys, whatever holds them (a section's keys listed once drive "
+         "reading, refusing unknown keys, writing and the docs check): "
+         + quoted(stems("include/cartpole_qlearning/config", "src/config"))),
         ("`include/cartpole_qlearning/io/`, `src/io/`",
-         "core layer 2: files (atomic saves, confined paths, size-checked reads): "
+         "core layer 3: files (atomic saves, confined paths, size-checked reads), YAML documents as parameter "
+         "sources and sinks: "
          + quoted(stems("include/cartpole_qlearning/io", "src/io"))),
         ("`include/cartpole_qlearning/simulation/`, `src/simulation/`",
-         "core layer 3: the cart-pole's physics (the equations; a MuJoCo model, its own library) and what a real one does: "
+         "core layer 4: the cart-pole's physics (the equations; a MuJoCo model, its own library) and what a real one does: "
          + quoted(stems("include/cartpole_qlearning/simulation", "src/simulation"))),
         ("`include/cartpole_qlearning/learning/`, `src/learning/`",
-         "core layer 4: the task, features, the Q-table and its file, the learner, a training session, the "
-         "configuration readers: " + quoted(stems("include/cartpole_qlearning/learning", "src/learning"))),
+         "core layer 5: the task, features, the Q-table and its file, the learner, a training session, the "
+         "configuration's sections (their key tables): " + quoted(stems("include/cartpole_qlearning/learning", "src/learning"))),
         ("`include/cartpole_qlearning/protocol/`, `src/protocol/`",
-         "core layer 5: the lockstep and controller message protocols, several robots, reset calls: "
+         "core layer 6: the lockstep and controller message protocols, several robots, reset calls: "
          + quoted(stems("include/cartpole_qlearning/protocol", "src/protocol"))),
         ("`include/cartpole_qlearning/application/`, `src/application/`",
-         "core layer 6: runs, tables, suites and evaluation, what the nodes and train_headless carry out: "
+         "core layer 7: runs, tables, suites and evaluation, what the nodes and train_headless carry out: "
          + quoted(stems("include/cartpole_qlearning/application", "src/application"))),
         ("`include/cartpole_qlearning/ros/`, `src/ros/`",
          "the ROS layer: the node classes and their mains (`*_node.cpp`), the nodelets (one class template), "

@@ -440,7 +440,7 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
                        endsWith(settings.reset_service, "cartpole_sim/reset_simulation");
   std::array<double, kStateDimensions> region{};
   region.fill(settings.training.start_state_bound);
-  priv.readDimensions("start_region", region, false);
+  readDimensions(priv, "start_region", region, false);
   for (std::size_t i = 0; i < kStateDimensions; ++i)
   {
     if (!(std::isfinite(region[i]) && region[i] > 0.0))

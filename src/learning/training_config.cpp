@@ -3,42 +3,14 @@
 
 #include "cartpole_qlearning/simulation/engine_registry.h"
 
-#include <yaml-cpp/yaml.h>
-
-#include <charconv>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <limits>
 
 namespace cartpole_qlearning
 {
 namespace
 {
-template <typename Enum, typename Parse>
-void readEnum(SectionReader& reader, const std::string& name, Enum& value, Parse parse)
-{
-  std::string text = toString(value);
-  reader.read(name, text);
-  try
-  {
-    value = parse(text);
-  }
-  catch (const std::invalid_argument& e)
-  {
-    reader.fail(name, "'" + text + "'", e.what());
-  }
-}
-
-void readSchedule(SectionReader& reader, const std::string& name, ScheduleParams& schedule)
-{
-  readEnum(reader, name + "/schedule", schedule.type, scheduleTypeFromString);
-  reader.read(name + "/start", schedule.start);
-  reader.read(name + "/min", schedule.min);
-  reader.read(name + "/decay_episodes", schedule.decay_episodes);
-  reader.read(name + "/decay_rate", schedule.decay_rate);
-  reader.read(name + "/log_divisor", schedule.log_divisor);
-}
-
 // The text with each ${NAME} replaced by the environment variable NAME; on_missing(NAME) is called
 // (and must throw) for one that is not set.
 template <typename OnMissing>
@@ -61,36 +33,97 @@ std::string expandEnvironment(const std::string& text, OnMissing on_missing)
   return out + text.substr(at);
 }
 
-// The engine's file keys (a model): ${VARIABLES} expanded, relative to the config's folder, required.
-void readEngineFiles(const ParameterSource& source, SectionReader& reader, const EngineDescription& own,
-                     EngineParams& engine)
+// A file key of the engine in use (a model): ${VARIABLES} expanded, relative to the config's folder,
+// required.
+void resolveFile(SectionReader& reader, const EngineKey& key, const std::string& engine_name, std::string& path)
 {
-  for (const EngineKey& key : own.keys)
+  if (reader.has(key.name))
   {
-    if (key.file.empty())
-      continue;
-    std::string& path = engine.*key.text;
-    if (!source.keysUnder(reader.key(key.name)).empty())
-    {
-      const std::string given = path;
-      path = expandEnvironment(given, [&](const std::string& variable) {
-        reader.fail(key.name, "'" + given + "'",
-                    "the environment variable " + variable + " is not set: set it, or give the path itself");
-      });
-      if (path.empty())
-        reader.fail(key.name, "''", "must name " + key.file);
-      if (path.front() != '/' && !source.folder().empty())
-        path = source.folder() + "/" + path;
-    }
+    const std::string given = path;
+    path = expandEnvironment(given, [&](const std::string& variable) {
+      reader.fail(key.name, "'" + given + "'",
+                  "the environment variable " + variable + " is not set: set it, or give the path itself");
+    });
     if (path.empty())
-      reader.fail(key.name, "''", "physics/engine " + own.name + " needs " + key.file);
+      reader.fail(key.name, "''", "must name " + key.file);
+    if (path.front() != '/' && !reader.source().folder().empty())
+      path = reader.source().folder() + "/" + path;
   }
+  if (path.empty())
+    reader.fail(key.name, "''", "physics/engine " + engine_name + " needs " + key.file);
+}
+
+bool takes(const EngineDescription& engine, const std::string& name)
+{
+  return std::any_of(engine.keys.begin(), engine.keys.end(),
+                     [&name](const EngineKey& mine) { return mine.name == name; });
+}
+
+// physics/engine: one the registry knows; every other engine's keys are refused beside it.
+ConfigKey<PhysicsSection> engineKey()
+{
+  return {"engine", "string: the physics engine (engine_registry.h)",
+          [](SectionReader& reader, PhysicsSection& s) {
+            reader.read("engine", s.engine.name);
+            const EngineDescription* own = nullptr;
+            try
+            {
+              own = &engineOf(s.engine);
+            }
+            catch (const std::invalid_argument& e)
+            {
+              reader.fail("engine", "'" + s.engine.name + "'", e.what());
+            }
+            for (const EngineDescription& other : engineDescriptions())
+              for (const EngineKey& key : other.keys)
+                if (!takes(*own, key.name) && reader.has(key.name))
+                  throw ConfigError(reader.source().describe(reader.key(key.name)) +
+                                    " is not allowed with physics/engine " + own->name + " (" +
+                                    (own->foreign_keys_note.empty() ? other.own_keys_note : own->foreign_keys_note) +
+                                    ")");
+          },
+          [](SectionWriter& writer, const PhysicsSection& s) { writer.word("engine", s.engine.name); }};
+}
+
+// A key an engine alone takes: read whatever the engine (its default stays unless given), written
+// beside its engine only.
+ConfigKey<PhysicsSection> engineOwnKey(const EngineKey& key)
+{
+  using P = PhysicsSection;
+  ConfigKey<P> own;
+  if (key.number != nullptr)
+    own = plainKey<P>(
+        key.name, "double", [key](auto& p) -> auto& { return p.physics.*key.number; });
+  else if (key.choice != nullptr)
+    own = nameKey<P>(
+        key.name, "string", [key](auto& p) -> auto& { return p.physics.*key.choice; }, integratorFromString);
+  else
+  {
+    own = plainKey<P>(
+        key.name, key.file.empty() ? "string" : "string, path: " + key.file, [key](auto& p) -> auto& {
+          return p.engine.*key.text;
+        });
+    own.read = [key](SectionReader& reader, P& p) {
+      reader.read(key.name, p.engine.*key.text);
+      const EngineDescription& engine = engineOf(p.engine);
+      if (!key.file.empty() && takes(engine, key.name))
+        resolveFile(reader, key, engine.name, p.engine.*key.text);
+    };
+  }
+  own.write = [key, write = own.write](SectionWriter& writer, const P& p) {
+    // (A key omitted at its default: the tables of configs from before it stay as they were.)
+    const bool omitted =
+        key.omitted_at_default && key.number != nullptr && p.physics.*key.number == CartPoleParams().*key.number;
+    if (takes(engineOf(p.engine), key.name) && !omitted)
+      write(writer, p);
+  };
+  return own;
 }
 
 // One number of steps, or [low, high]: drawn per episode.
-void readSteps(const ParameterSource& source, SectionReader& reader, const std::string& name, unsigned& low,
-               unsigned& high)
+void readSteps(SectionReader& reader, const std::string& name, unsigned& low, unsigned& high)
 {
+  const ParameterSource& source = reader.source();
   reader.know(name);
   const char* const allowed = "must be a whole number of steps in [0, 1000], or [low, high] of them";
   std::int64_t steps = 0;
@@ -117,8 +150,9 @@ void readSteps(const ParameterSource& source, SectionReader& reader, const std::
   }
 }
 
-void readFactors(const ParameterSource& source, SectionReader& reader, const std::string& name, ScaleRange& range)
+void readFactors(SectionReader& reader, const std::string& name, ScaleRange& range)
 {
+  const ParameterSource& source = reader.source();
   std::vector<double> bounds;
   reader.know(name);
   if (!source.get(reader.key(name), bounds))
@@ -128,70 +162,126 @@ void readFactors(const ParameterSource& source, SectionReader& reader, const std
   range.low = bounds[0];
   range.high = bounds[1];
 }
+
+ConfigKey<PerturbationParams> perturbationKey(const PerturbationKey& key)
+{
+  using Form = PerturbationKey::Form;
+  switch (key.form)
+  {
+    case Form::Steps:
+      return {
+          key.name, "int or [low, high], steps",
+          [key](SectionReader& reader, PerturbationParams& p) { readSteps(reader, key.name, p.*key.low, p.*key.high); },
+          [key](SectionWriter& writer, const PerturbationParams& p) {
+            if (p.*key.low == p.*key.high)
+              writer.write(key.name, p.*key.low);
+            else
+              writer.write(key.name, std::vector<double>{double(p.*key.low), double(p.*key.high)});
+          }};
+    case Form::Dimensions:
+      return {key.name, "4 doubles",
+              [key](SectionReader& reader, PerturbationParams& p) {
+                readDimensions(reader, key.name, p.*key.dimensions, false);
+              },
+              [key](SectionWriter& writer, const PerturbationParams& p) { writer.write(key.name, p.*key.dimensions); }};
+    case Form::Factors:
+      return {key.name, "[low, high] factors",
+              [key](SectionReader& reader, PerturbationParams& p) { readFactors(reader, key.name, p.*key.factors); },
+              [key](SectionWriter& writer, const PerturbationParams& p) {
+                writer.write(key.name, std::vector<double>{(p.*key.factors).low, (p.*key.factors).high});
+              }};
+    case Form::Number:
+      break;
+  }
+  return plainKey<PerturbationParams>(
+      key.name, "double", [key](auto& p) -> auto& { return p.*key.number; });
+}
+
+// The five sections' names, in the file's order.
+const std::vector<std::string>& sectionNames()
+{
+  static const std::vector<std::string> names{physicsSection().name, perturbationsSection().name, taskSection().name,
+                                              learningSection().name, trainingSection().name};
+  return names;
+}
 }  // namespace
+
+const ConfigSection<PhysicsSection>& physicsSection()
+{
+  static const ConfigSection<PhysicsSection> section = [] {
+    ConfigSection<PhysicsSection> s{"physics", {engineKey()}, [](const SectionReader& reader, const PhysicsSection& p) {
+                                      reader.check(p.physics.validate());
+                                      if (!(std::isfinite(p.start_state_bound) && p.start_state_bound >= 0.0))
+                                        reader.fail("start_state_bound", std::to_string(p.start_state_bound),
+                                                    "must be finite and >= 0");
+                                    }};
+    for (const EngineDescription& engine : engineDescriptions())
+      for (const EngineKey& key : engine.keys)
+        if (std::none_of(s.keys.begin(), s.keys.end(), [&key](const auto& k) { return k.name == key.name; }))
+          s.keys.push_back(engineOwnKey(key));
+    const auto physics = [](auto member) {
+      return [member](auto& p) -> auto&
+      {
+        return p.physics.*member;
+      };
+    };
+    s.keys.push_back(plainKey<PhysicsSection>("force_mag", "double, N: commands are clamped to +-this",
+                                              physics(&CartPoleParams::force_mag)));
+    s.keys.push_back(plainKey<PhysicsSection>("tau", "double, s: the step", physics(&CartPoleParams::tau)));
+    s.keys.push_back(plainKey<PhysicsSection>(
+        "start_state_bound", "double: random starts are uniform in +-this",
+        [](auto& p) -> auto& { return p.start_state_bound; }));
+    return s;
+  }();
+  return section;
+}
+
+const ConfigSection<PerturbationParams>& perturbationsSection()
+{
+  static const ConfigSection<PerturbationParams> section = [] {
+    ConfigSection<PerturbationParams> s{
+        "perturbations", {}, [](const SectionReader& reader, const PerturbationParams& p) {
+          reader.check(p.validate());
+        }};
+    for (const PerturbationKey& key : perturbationKeys())
+      s.keys.push_back(perturbationKey(key));
+    return s;
+  }();
+  return section;
+}
+
+std::vector<std::string> configKeys()
+{
+  std::vector<std::string> keys;
+  for (const std::vector<std::string>& section :
+       {physicsSection().keyNames(), perturbationsSection().keyNames(), taskSection().keyNames(),
+        learningSection().keyNames(), trainingSection().keyNames()})
+    keys.insert(keys.end(), section.begin(), section.end());
+  return keys;
+}
 
 void refuseUnknownSections(const ParameterSource& source)
 {
-  static const std::set<std::string> sections{"physics", "perturbations", "task", "learning", "training"};
+  const std::vector<std::string>& sections = sectionNames();
+  std::string list;
+  for (std::size_t i = 0; i < sections.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == sections.size() ? " and " : ", ") + sections[i];
   for (const std::string& key : source.keysUnder(""))
   {
     const std::string section = key.substr(0, key.find('/'));
-    if (sections.count(section) == 0 || key == section)
-      throw ConfigError(source.origin() + ": unknown key " + key +
-                        " (the file holds the sections physics, perturbations, task, learning and training)");
+    if (std::find(sections.begin(), sections.end(), section) == sections.end() || key == section)
+      throw ConfigError(source.origin() + ": unknown key " + key + " (the file holds the sections " + list + ")");
   }
 }
 
 void readPhysics(const ParameterSource& source, CartPoleParams& physics, double& start_state_bound,
                  EngineParams& engine)
 {
-  SectionReader reader(source, "physics");
-  reader.read("engine", engine.name);
-  const EngineDescription* found = nullptr;
-  try
-  {
-    found = &engineOf(engine);
-  }
-  catch (const std::invalid_argument& e)
-  {
-    reader.fail("engine", "'" + engine.name + "'", e.what());
-  }
-  const EngineDescription& own = *found;
-  // Every engine's texts, then the keys of the others refused (before any number is read), then
-  // every engine's numbers: an engine's keys keep their defaults unless given.
-  for (const EngineDescription& other : engineDescriptions())
-    for (const EngineKey& key : other.keys)
-      if (key.text != nullptr)
-        reader.read(key.name, engine.*key.text);
-  for (const EngineDescription& other : engineDescriptions())
-  {
-    for (const EngineKey& key : other.keys)
-    {
-      const bool owned = std::any_of(own.keys.begin(), own.keys.end(),
-                                     [&key](const EngineKey& mine) { return mine.name == key.name; });
-      if (!owned && !source.keysUnder(reader.key(key.name)).empty())
-        throw ConfigError(source.describe(reader.key(key.name)) + " is not allowed with physics/engine " + own.name +
-                          " (" + (own.foreign_keys_note.empty() ? other.own_keys_note : own.foreign_keys_note) + ")");
-    }
-  }
-  readEngineFiles(source, reader, own, engine);
-  for (const EngineDescription& other : engineDescriptions())
-  {
-    for (const EngineKey& key : other.keys)
-    {
-      if (key.number != nullptr)
-        reader.read(key.name, physics.*key.number);
-      else if (key.choice != nullptr)
-        readEnum(reader, key.name, physics.*key.choice, integratorFromString);
-    }
-  }
-  reader.read("force_mag", physics.force_mag);
-  reader.read("tau", physics.tau);
-  reader.read("start_state_bound", start_state_bound);
-  reader.refuseUnknown();
-  reader.check(physics.validate());
-  if (!(std::isfinite(start_state_bound) && start_state_bound >= 0.0))
-    reader.fail("start_state_bound", std::to_string(start_state_bound), "must be finite and >= 0");
+  PhysicsSection s{physics, engine, start_state_bound};
+  physicsSection().read(source, s);
+  physics = s.physics;
+  engine = s.engine;
+  start_state_bound = s.start_state_bound;
 }
 
 void checkPerturbationsFitEngine(const ParameterSource& source, const EngineParams& engine,
@@ -204,122 +294,29 @@ void checkPerturbationsFitEngine(const ParameterSource& source, const EnginePara
 
 PerturbationParams readPerturbations(const ParameterSource& source)
 {
-  using Form = PerturbationKey::Form;
   PerturbationParams p;
-  SectionReader reader(source, "perturbations");
-  for (const PerturbationKey& key : perturbationKeys())
-  {
-    switch (key.form)
-    {
-      case Form::Steps:
-        readSteps(source, reader, key.name, p.*key.low, p.*key.high);
-        break;
-      case Form::Dimensions:
-        reader.readDimensions(key.name, p.*key.dimensions, false);
-        break;
-      case Form::Factors:
-        readFactors(source, reader, key.name, p.*key.factors);
-        break;
-      case Form::Number:
-        reader.read(key.name, p.*key.number);
-        break;
-    }
-  }
-  reader.refuseUnknown();
-  reader.check(p.validate());
+  perturbationsSection().read(source, p);
   return p;
 }
 
 TaskParams readTask(const ParameterSource& source)
 {
   TaskParams task;
-  SectionReader reader(source, "task");
-  readEnum(reader, "kind", task.kind, taskKindFromString);
-  if (isSuiteTask(task.kind))
-  {
-    task.max_episode_steps = kSuiteEpisodeSteps;
-    for (const char* key : {"x_threshold", "theta_threshold_deg", "reward", "solved_reward", "x_cost", "x_dot_cost"})
-      if (!source.keysUnder(reader.key(key)).empty())
-        throw ConfigError(
-            source.describe(reader.key(key)) + " is not allowed with task/kind " + toString(task.kind) +
-            " (CartPole-v1's: the Suite's tasks never end on the cart or the angle, and score by their own reward)");
-  }
-  reader.read("x_threshold", task.x_threshold);
-  reader.read("theta_threshold_deg", task.theta_threshold_deg);
-  reader.read("max_episode_steps", task.max_episode_steps, 1, std::numeric_limits<int>::max());
-  // Trained on the Suite's whole episodes (an evaluation or a robot may run others).
-  if (isSuiteTask(task.kind) && task.max_episode_steps != kSuiteEpisodeSteps)
-    reader.fail("max_episode_steps", std::to_string(task.max_episode_steps),
-                "the Suite's episodes are " + std::to_string(kSuiteEpisodeSteps) + " steps (task/kind " +
-                    toString(task.kind) + ")");
-  readEnum(reader, "reward", task.reward, rewardSchemeFromString);
-  std::string solved_reward;
-  reader.read("solved_reward", solved_reward);
-  if (!solved_reward.empty())
-  {
-    try
-    {
-      task.solved_reward = rewardSchemeFromString(solved_reward);
-    }
-    catch (const std::invalid_argument& e)
-    {
-      reader.fail("solved_reward", "'" + solved_reward + "'", e.what());
-    }
-  }
-  reader.read("x_cost", task.x_cost);
-  reader.read("x_dot_cost", task.x_dot_cost);
-  reader.read("solved_mean_return", task.solved_mean_return);
-  reader.read("solved_window", task.solved_window, 1, 1000000);
-  reader.refuseUnknown();
-  reader.check(task.validate());
+  taskSection().read(source, task);
   return task;
 }
 
 AgentParams readAgent(const ParameterSource& source)
 {
   AgentParams agent;
-  SectionReader reader(source, "learning");
-  reader.read("gamma", agent.gamma);
-  reader.read("actions", agent.actions);
-  readEnum(reader, "features", agent.features, featureKindFromString);
-  reader.readDimensions("bins", agent.discretiser.bins, true);
-  reader.read("tilings", agent.tilings, 1, kMaxTilings);
-  reader.readDimensions("tiles", agent.tiles, true);
-  reader.read("previous_action", agent.previous_action);
-  reader.readDimensions("lower_bounds", agent.discretiser.lower, false);
-  reader.readDimensions("upper_bounds", agent.discretiser.upper, false);
-  readSchedule(reader, "epsilon", agent.epsilon);
-  readSchedule(reader, "alpha", agent.alpha);
-  reader.read("state_names", agent.state_names);
-  reader.refuseUnknown();
-  reader.check(agent.validate());
+  learningSection().read(source, agent);
   return agent;
 }
 
 TrainingLimits readLimits(const ParameterSource& source)
 {
   TrainingLimits limits;
-  SectionReader reader(source, "training");
-  reader.read("max_episodes", limits.max_episodes, 1);
-  reader.read("stop_when_solved", limits.stop_when_solved);
-  reader.read("progress_every", limits.progress_every, 0);
-  reader.read("suite", limits.suite);
-  if (limits.suite.empty())
-    reader.fail("suite", "''", "a suite file, or none");
-  reader.read("suite_every", limits.suite_every, 0);
-  reader.read("best_every", limits.best_every, 0);
-  // Looked for at evaluations only: its episodes must be some of the suite's.
-  if (limits.best_every > 0 && (limits.suite_every == 0 || limits.best_every % limits.suite_every != 0))
-    reader.fail("best_every", std::to_string(limits.best_every),
-                "0, or a multiple of training/suite_every (" + std::to_string(limits.suite_every) +
-                    "): the best is looked for at evaluations of the suite");
-  std::string until = limits.until == TrainUntil::Solved ? "solved" : "suite_passes";
-  reader.readChoice("until", until, {"solved", "suite_passes"});
-  limits.until = until == "solved" ? TrainUntil::Solved : TrainUntil::SuitePasses;
-  if (limits.until == TrainUntil::SuitePasses && (limits.suite_every == 0 || limits.suite == "none"))
-    reader.fail("until", "suite_passes",
-                "needs training/suite_every > 0 and a training/suite: the suite is evaluated during training");
-  reader.refuseUnknown();
+  trainingSection().read(source, limits);
   return limits;
 }
 
@@ -348,7 +345,7 @@ TrainingConfig readTrainingConfig(const ParameterSource& source)
 
 bool holdsTrainingConfig(const ParameterSource& source)
 {
-  for (const char* section : {"physics", "perturbations", "task", "learning", "training"})
+  for (const std::string& section : sectionNames())
   {
     if (!source.keysUnder(section).empty())
       return true;
@@ -361,165 +358,15 @@ std::string exactText(double value)
   return shortestText(value);
 }
 
-namespace
-{
-
-template <typename Container>
-void emitNumbers(YAML::Emitter& out, const Container& values)
-{
-  out << YAML::Flow << YAML::BeginSeq;
-  for (const auto value : values)
-    out << exactText(static_cast<double>(value));
-  out << YAML::EndSeq;
-}
-
-void emitSchedule(YAML::Emitter& out, const char* name, const ScheduleParams& schedule)
-{
-  out << YAML::Key << name << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "schedule" << YAML::Value << toString(schedule.type);
-  for (const auto& [key, value] : {std::pair<const char*, double>{"start", schedule.start},
-                                   {"min", schedule.min},
-                                   {"decay_episodes", schedule.decay_episodes},
-                                   {"decay_rate", schedule.decay_rate},
-                                   {"log_divisor", schedule.log_divisor}})
-    out << YAML::Key << key << YAML::Value << exactText(value);
-  out << YAML::EndMap;
-}
-
-void emitNumber(YAML::Emitter& out, const char* key, double value)
-{
-  out << YAML::Key << key << YAML::Value << exactText(value);
-}
-
-// The physics section: only the keys the engine takes (readPhysics refuses the others beside it).
-void emitPhysics(YAML::Emitter& out, const TrainingConfig& config)
-{
-  const CartPoleParams& physics = config.physics;
-  const EngineParams& engine = config.engine;
-  out << YAML::Key << "physics" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "engine" << YAML::Value << engine.name;
-  for (const EngineKey& key : engineOf(engine).keys)
-  {
-    if (key.omitted_at_default && key.number != nullptr && physics.*key.number == CartPoleParams().*key.number)
-      continue;
-    if (key.number != nullptr)
-      emitNumber(out, key.name.c_str(), physics.*key.number);
-    else if (key.choice != nullptr)
-      out << YAML::Key << key.name << YAML::Value << toString(physics.*key.choice);
-    else
-      out << YAML::Key << key.name << YAML::Value << YAML::DoubleQuoted << engine.*key.text;
-  }
-  emitNumber(out, "force_mag", physics.force_mag);
-  emitNumber(out, "tau", physics.tau);
-  emitNumber(out, "start_state_bound", config.start_state_bound);
-  out << YAML::EndMap;
-}
-
-void emitPerturbations(YAML::Emitter& out, const PerturbationParams& p)
-{
-  out << YAML::Key << "perturbations" << YAML::Value << YAML::BeginMap;
-  for (const PerturbationKey& key : perturbationKeys())
-  {
-    out << YAML::Key << key.name << YAML::Value;
-    switch (key.form)
-    {
-      case PerturbationKey::Form::Steps:
-        if (p.*key.low == p.*key.high)
-          out << p.*key.low;
-        else
-          emitNumbers(out, std::array<unsigned, 2>{{p.*key.low, p.*key.high}});
-        break;
-      case PerturbationKey::Form::Dimensions:
-        emitNumbers(out, p.*key.dimensions);
-        break;
-      case PerturbationKey::Form::Factors:
-        emitNumbers(out, std::array<double, 2>{{(p.*key.factors).low, (p.*key.factors).high}});
-        break;
-      case PerturbationKey::Form::Number:
-        out << exactText(p.*key.number);
-        break;
-    }
-  }
-  out << YAML::EndMap;
-}
-}  // namespace
-
 std::string trainingConfigText(const TrainingConfig& config)
 {
-  YAML::Emitter out;
-  out << YAML::BeginMap;
-
-  emitPhysics(out, config);
-  emitPerturbations(out, config.perturbations);
-
-  const TaskParams& task = config.task;
-  out << YAML::Key << "task" << YAML::Value << YAML::BeginMap;
-  // The kind only when not the default, so that the tables of configs without it stay as they were;
-  // the Suite's kinds end and score by their own rules (readTask refuses CartPole-v1's keys beside them).
-  if (isSuiteTask(task.kind))
-  {
-    out << YAML::Key << "kind" << YAML::Value << toString(task.kind);
-  }
-  else
-  {
-    emitNumber(out, "x_threshold", task.x_threshold);
-    emitNumber(out, "theta_threshold_deg", task.theta_threshold_deg);
-  }
-  out << YAML::Key << "max_episode_steps" << YAML::Value << task.max_episode_steps;
-  if (!isSuiteTask(task.kind))
-    out << YAML::Key << "reward" << YAML::Value << toString(task.reward);
-  // Only when set, so that the tables of configs without them stay as they were.
-  if (task.solved_reward)
-    out << YAML::Key << "solved_reward" << YAML::Value << toString(*task.solved_reward);
-  if (task.reward == RewardScheme::AliveQuadratic)
-  {
-    emitNumber(out, "x_cost", task.x_cost);
-    emitNumber(out, "x_dot_cost", task.x_dot_cost);
-  }
-  emitNumber(out, "solved_mean_return", task.solved_mean_return);
-  out << YAML::Key << "solved_window" << YAML::Value << task.solved_window;
-  out << YAML::EndMap;
-
-  const AgentParams& agent = config.agent;
-  out << YAML::Key << "learning" << YAML::Value << YAML::BeginMap;
-  emitNumber(out, "gamma", agent.gamma);
-  out << YAML::Key << "actions" << YAML::Value;
-  emitNumbers(out, agent.actions);
-  out << YAML::Key << "features" << YAML::Value << toString(agent.features);
-  out << YAML::Key << "bins" << YAML::Value;
-  emitNumbers(out, agent.discretiser.bins);
-  out << YAML::Key << "tilings" << YAML::Value << agent.tilings;
-  out << YAML::Key << "tiles" << YAML::Value;
-  emitNumbers(out, agent.tiles);
-  out << YAML::Key << "previous_action" << YAML::Value << agent.previous_action;
-  out << YAML::Key << "lower_bounds" << YAML::Value;
-  emitNumbers(out, agent.discretiser.lower);
-  out << YAML::Key << "upper_bounds" << YAML::Value;
-  emitNumbers(out, agent.discretiser.upper);
-  emitSchedule(out, "epsilon", agent.epsilon);
-  emitSchedule(out, "alpha", agent.alpha);
-  if (!agent.state_names.empty())
-  {
-    out << YAML::Key << "state_names" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-    for (const std::string& name : agent.state_names)
-      out << YAML::DoubleQuoted << name;
-    out << YAML::EndSeq;
-  }
-  out << YAML::EndMap;
-
-  const TrainingLimits& limits = config.limits;
-  out << YAML::Key << "training" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "max_episodes" << YAML::Value << limits.max_episodes;
-  out << YAML::Key << "stop_when_solved" << YAML::Value << limits.stop_when_solved;
-  out << YAML::Key << "progress_every" << YAML::Value << limits.progress_every;
-  out << YAML::Key << "suite" << YAML::Value << YAML::DoubleQuoted << limits.suite;
-  out << YAML::Key << "suite_every" << YAML::Value << limits.suite_every;
-  out << YAML::Key << "best_every" << YAML::Value << limits.best_every;
-  out << YAML::Key << "until" << YAML::Value << (limits.until == TrainUntil::Solved ? "solved" : "suite_passes");
-  out << YAML::EndMap;
-
-  out << YAML::EndMap;
-  return std::string(out.c_str()) + "\n";
+  return yamlText([&config](ParameterSink& sink) {
+    physicsSection().write(sink, PhysicsSection{config.physics, config.engine, config.start_state_bound});
+    perturbationsSection().write(sink, config.perturbations);
+    taskSection().write(sink, config.task);
+    learningSection().write(sink, config.agent);
+    trainingSection().write(sink, config.limits);
+  });
 }
 
 }  // namespace cartpole_qlearning

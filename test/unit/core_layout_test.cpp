@@ -24,7 +24,8 @@ namespace text_match = cartpole_qlearning::test::text_match;
 const fs::path kSource = CARTPOLE_SOURCE_DIR;
 
 // From the bottom (CMakeLists.txt's CORE_LAYERS): a layer may include its own and those before it.
-const std::vector<std::string> kLayers = {"common", "io", "simulation", "learning", "protocol", "application"};
+const std::vector<std::string> kLayers = {"common",   "config",   "io",         "simulation",
+                                          "learning", "protocol", "application"};
 
 std::size_t layerRank(const std::string& layer)
 {
@@ -99,6 +100,8 @@ TEST(CoreLayoutTest, ALayerMayIncludeItsOwnAndTheLayersBelowOnly)
   EXPECT_TRUE(isHeaderAtOrBelow("learning", "simulation/cartpole_dynamics.h"));
   EXPECT_FALSE(isHeaderAtOrBelow("learning", "protocol/lockstep_protocol.h"));
   EXPECT_FALSE(isHeaderAtOrBelow("common", "io/file_access.h"));
+  EXPECT_TRUE(isHeaderAtOrBelow("io", "config/parameter_source.h"));
+  EXPECT_FALSE(isHeaderAtOrBelow("config", "io/yaml_parameters.h"));
   EXPECT_FALSE(isHeaderAtOrBelow("application", "ros/start_up.h"));
   EXPECT_FALSE(isHeaderAtOrBelow("learning", "learning/no_such_header.h"));
 }
@@ -214,6 +217,7 @@ TEST(CoreLayoutTest, TheLayoutTableListsTheTreeAsItIs)
   };
   const Row rows[] = {
       {"`include/cartpole_qlearning/common/`, `src/common/`", {include / "common", kSource / "src" / "common"}, true},
+      {"`include/cartpole_qlearning/config/`, `src/config/`", {include / "config", kSource / "src" / "config"}, true},
       {"`include/cartpole_qlearning/io/`, `src/io/`", {include / "io", kSource / "src" / "io"}, true},
       {"`include/cartpole_qlearning/simulation/`, `src/simulation/`",
        {include / "simulation", kSource / "src" / "simulation"},

@@ -1,7 +1,11 @@
-// Reading and validating the physics, task, learning and training parameters. One reader
-// serves both the YAML file (train_headless) and the ROS parameter server (the nodes), so a
+// The configuration: the physics, perturbations, task, learning and training sections, each a table
+// of its keys (config/config_section.h) that reads, checks, refuses unknown keys and writes. One
+// reader serves both the YAML file (train_headless) and the ROS parameter server (the nodes), so a
 // key means the same thing, and is checked the same way, wherever it is set.
 #pragma once
+
+#include "cartpole_qlearning/config/config_section.h"
+#include "cartpole_qlearning/io/yaml_parameters.h"
 
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
 #include "cartpole_qlearning/learning/cartpole_task.h"
@@ -10,213 +14,20 @@
 #include "cartpole_qlearning/simulation/physics_engine.h"
 #include "cartpole_qlearning/learning/q_learning_agent.h"
 
-#include <algorithm>
 #include <array>
-#include <cmath>
 #include <cstdint>
-#include <memory>
-#include <set>
-#include <sstream>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace cartpole_qlearning
 {
-// A bad key or value. The message names the key, the value and what is allowed.
-class ConfigError : public std::runtime_error
+// The state's four values as one list key (bins, bounds, noise): exactly 4 numbers, whole ones in
+// [1, kMaxBinsPerDimension] when `whole`.
+template <typename T>
+void readDimensions(SectionReader& reader, const std::string& name, std::array<T, kStateDimensions>& values, bool whole)
 {
-public:
-  using std::runtime_error::runtime_error;
-};
-
-// Where parameters come from. Keys are slash-separated paths such as "learning/gamma".
-// Each get() returns false when the key is absent and throws ConfigError when it is present
-// with a value of the wrong type.
-class ParameterSource
-{
-public:
-  virtual ~ParameterSource() = default;
-  virtual bool get(const std::string& key, double& value) const = 0;
-  virtual bool get(const std::string& key, std::int64_t& value) const = 0;
-  virtual bool get(const std::string& key, bool& value) const = 0;
-  virtual bool get(const std::string& key, std::string& value) const = 0;
-  virtual bool get(const std::string& key, std::vector<double>& value) const = 0;
-  virtual bool get(const std::string& key, std::vector<std::string>& value) const = 0;
-  // Every leaf key present below a section ("learning" -> "learning/gamma", "learning/epsilon/min", ...).
-  virtual std::vector<std::string> keysUnder(const std::string& section) const = 0;
-  // Where the parameters come from, for messages ("config/cartpole.yaml", "/cartpole").
-  virtual std::string origin() const = 0;
-  // The folder a relative path in these parameters is relative to (physics/model): a file's own
-  // folder; empty: the working folder.
-  virtual std::string folder() const
-  {
-    return "";
-  }
-  // A key as messages name it ("config/cartpole.yaml: learning/gamma", "parameter /cartpole/learning/gamma").
-  virtual std::string describe(const std::string& key) const
-  {
-    return origin() + ": " + key;
-  }
-};
-
-// Reads the keys of one section, remembers which keys it knows, and refuses the others, so
-// that a misspelt key stops the run instead of being silently ignored.
-class SectionReader
-{
-public:
-  SectionReader(const ParameterSource& source, std::string section) : source_(source), section_(std::move(section)) {}
-
-  template <typename T>
-  void read(const std::string& name, T& value)
-  {
-    known_.insert(key(name));
-    source_.get(key(name), value);
-  }
-
-  void read(const std::string& name, unsigned& value, std::int64_t min, std::int64_t max)
-  {
-    std::int64_t v = value;
-    read(name, v);
-    if (v < min || v > max)
-      fail(name, std::to_string(v),
-           "must be a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
-    value = static_cast<unsigned>(v);
-  }
-
-  // A finite number, > min (strict) or >= min.
-  void readAtLeast(const std::string& name, double& value, double min, bool strict)
-  {
-    read(name, value);
-    if (!(std::isfinite(value) && (strict ? value > min : value >= min)))
-      fail(name, numberText(value), std::string("must be finite and ") + (strict ? "> " : ">= ") + numberText(min));
-  }
-
-  // A duration in seconds in [min, max] ((min, max] when strict): the message names the unit, so
-  // that milliseconds typed as seconds (decision_period: 20) read as what they are.
-  void readSeconds(const std::string& name, double& value, double min, double max, bool strict)
-  {
-    read(name, value);
-    if (!(std::isfinite(value) && (strict ? value > min : value >= min) && value <= max))
-      fail(name, numberText(value),
-           std::string("must be in ") + (strict ? "(" : "[") + numberText(min) + ", " + numberText(max) +
-               "] seconds (20 ms is 0.02)");
-  }
-
-  // One of the allowed strings.
-  void readChoice(const std::string& name, std::string& value, const std::vector<std::string>& allowed)
-  {
-    read(name, value);
-    if (std::find(allowed.begin(), allowed.end(), value) != allowed.end())
-      return;
-    std::string list;
-    for (const std::string& a : allowed)
-      list += (list.empty() ? "" : ", ") + a;
-    fail(name, "'" + value + "'", "allowed: " + list);
-  }
-
-  void read(const std::string& name, std::uint64_t& value, std::int64_t min)
-  {
-    std::int64_t v = static_cast<std::int64_t>(value);
-    read(name, v);
-    if (v < min)
-      fail(name, std::to_string(v), "must be a whole number >= " + std::to_string(min));
-    value = static_cast<std::uint64_t>(v);
-  }
-
-  // A list of exactly kStateDimensions values.
-  template <typename T>
-  void readDimensions(const std::string& name, std::array<T, kStateDimensions>& values, bool whole)
-  {
-    std::vector<double> list;
-    known_.insert(key(name));
-    if (!source_.get(key(name), list))
-      return;
-    if (list.size() != kStateDimensions)
-      fail(name, listText(list), "must list 4 values: x, x_dot, theta, theta_dot");
-    for (std::size_t i = 0; i < kStateDimensions; ++i)
-    {
-      // Checked before the conversion: a value out of the type's range would be undefined.
-      if (whole && (list[i] != std::floor(list[i]) || list[i] < 1 || list[i] > kMaxBinsPerDimension))
-        fail(name, listText(list), "must be whole numbers in [1, " + std::to_string(kMaxBinsPerDimension) + "]");
-      values[i] = static_cast<T>(list[i]);
-    }
-  }
-
-  // A key read by other means (a value of a form the sources do not offer): not unknown.
-  void know(const std::string& name)
-  {
-    known_.insert(key(name));
-  }
-
-  // Refuses a key under this section that no read() asked for.
-  void refuseUnknown() const
-  {
-    for (const std::string& k : source_.keysUnder(section_))
-    {
-      if (known_.count(k) == 0)
-        throw ConfigError(source_.origin() + ": unknown key " + k + " (known keys" +
-                          (section_.empty() ? std::string() : " of " + section_) + ": " + knownText() + ")");
-    }
-  }
-
-  // Turns a validate() message, which names the field relative to this section, into a ConfigError.
-  void check(const std::string& error) const
-  {
-    if (!error.empty())
-      throw ConfigError(source_.origin() + ": " + section_ + "/" + error);
-  }
-
-  [[noreturn]] void fail(const std::string& name, const std::string& value, const std::string& allowed) const
-  {
-    throw ConfigError(source_.describe(key(name)) + " = " + value + " is not allowed (" + allowed + ")");
-  }
-
-  // The key of a name in this section ("learning" + "gamma" -> "learning/gamma"; no section: the name).
-  std::string key(const std::string& name) const
-  {
-    return section_.empty() ? name : section_ + "/" + name;
-  }
-
-  static std::string numberText(double value)
-  {
-    std::ostringstream out;
-    out << value;
-    return out.str();
-  }
-
-  static std::string listText(const std::vector<double>& list)
-  {
-    std::ostringstream out;
-    out << "[";
-    for (std::size_t i = 0; i < list.size(); ++i)
-      out << (i ? ", " : "") << list[i];
-    out << "]";
-    return out.str();
-  }
-
-private:
-  std::string knownText() const
-  {
-    std::string text;
-    for (const std::string& k : known_)
-      text += (text.empty() ? "" : ", ") + k.substr(section_.empty() ? 0 : section_.size() + 1);
-    return text;
-  }
-
-  const ParameterSource& source_;
-  std::string section_;
-  std::set<std::string> known_;
-};
-
-// A YAML document as a parameter source. Throws ConfigError when the file cannot be read or parsed.
-std::unique_ptr<ParameterSource> loadYamlParameters(const std::string& path);
-// The folder a config file's relative paths are relative to: the file's own ("config/x.yaml" ->
-// "config", "x.yaml" -> ".", "/x.yaml" -> "/"). The nodes use it on the launch's config_file.
-std::string configFolder(const std::string& path);
-// (folder: what folder() answers; loadYamlParameters gives the file's.)
-std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin,
-                                                     const std::string& folder = "");
+  reader.readList(name, values, "x, x_dot, theta, theta_dot", whole ? kMaxBinsPerDimension : 0);
+}
 
 // Refuses top-level keys other than the sections physics, perturbations, task, learning and training (for a
 // file that holds only those; the parameter server holds other names beside them).
@@ -268,6 +79,25 @@ struct TrainingConfig
   AgentParams agent;
   TrainingLimits limits;
 };
+
+// The physics section's values (TrainingConfig holds them apart).
+struct PhysicsSection
+{
+  CartPoleParams physics;
+  EngineParams engine;
+  double start_state_bound = 0.05;
+};
+
+// Each section's table of keys, in the order a table's trained_with writes them. The physics
+// section's engine keys are the engines' own (engine_registry.h: each written only beside its
+// engine), the perturbations' are perturbationKeys() (perturbations.h).
+const ConfigSection<PhysicsSection>& physicsSection();
+const ConfigSection<PerturbationParams>& perturbationsSection();
+const ConfigSection<TaskParams>& taskSection();
+const ConfigSection<AgentParams>& learningSection();
+const ConfigSection<TrainingLimits>& trainingSection();
+// Every key of the five sections ("physics/engine", ..., "training/until"): what docs/configuration.md lists.
+std::vector<std::string> configKeys();
 
 // Each reader starts from the defaults, overrides what the source sets, validates, and throws
 // ConfigError naming the key on a bad value or an unknown key in its section.

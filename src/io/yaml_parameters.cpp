@@ -1,6 +1,7 @@
-// The YAML adapter of ParameterSource (training_config.h): a config file, a suite file's sections,
-// or YAML text in a test, read as slash-separated keys.
-#include "cartpole_qlearning/learning/training_config.h"
+// The YAML adapter of the config layer: a config file, a suite file, or YAML text in a test, read
+// as slash-separated keys; and the writer of a table's trained_with.
+#include "cartpole_qlearning/io/yaml_parameters.h"
+#include "cartpole_qlearning/io/number_text.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -82,6 +83,25 @@ public:
         throw ConfigError(origin_ + ": " + key + "[" + std::to_string(i) + "] = '" + text(node[i]) +
                           "' is not allowed (must be a string)");
       value.push_back(node[i].Scalar());
+    }
+    return true;
+  }
+
+  bool getEntries(const std::string& key, std::vector<std::unique_ptr<ParameterSource>>& entries) const override
+  {
+    const YAML::Node node = find(key);
+    if (!node)
+      return false;
+    if (!node.IsSequence())
+      throw ConfigError(origin_ + ": " + key + " must be a list");
+    entries.clear();
+    for (std::size_t i = 0; i < node.size(); ++i)
+    {
+      if (node[i].IsMap())
+        entries.push_back(
+            std::make_unique<YamlParameters>(node[i], origin_ + ": " + key + "[" + std::to_string(i) + "]", folder_));
+      else
+        entries.push_back(nullptr);
     }
     return true;
   }
@@ -176,22 +196,38 @@ private:
 };
 }  // namespace
 
-std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin,
-                                                     const std::string& folder)
+namespace
 {
-  YAML::Node root;
+YAML::Node parsed(const std::string& text, const std::string& origin)
+{
   try
   {
-    root = YAML::Load(text);
+    return YAML::Load(text);
   }
   catch (const YAML::Exception& e)
   {
     throw ConfigError(origin + ": not valid YAML: " + e.what());
   }
+}
+}  // namespace
+
+std::unique_ptr<ParameterSource> parseYamlParameters(const std::string& text, const std::string& origin,
+                                                     const std::string& folder)
+{
+  YAML::Node root = parsed(text, origin);
   if (root.IsNull())
     root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap())
     throw ConfigError(origin + ": must be a YAML mapping of sections (physics, task, learning, training)");
+  return std::make_unique<YamlParameters>(root, origin, folder);
+}
+
+std::unique_ptr<ParameterSource> parseYamlMap(const std::string& text, const std::string& origin,
+                                              const std::string& folder, const std::string& root_rule)
+{
+  const YAML::Node root = parsed(text, origin);
+  if (!root.IsMap())
+    throw ConfigError(origin + ": " + root_rule);
   return std::make_unique<YamlParameters>(root, origin, folder);
 }
 
@@ -209,6 +245,101 @@ std::string configFolder(const std::string& path)
 {
   const std::size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? "." : path.substr(0, slash + (slash == 0));
+}
+
+namespace
+{
+// Opens and closes the maps that the keys' paths name, in the order the keys come.
+class YamlSink : public ParameterSink
+{
+public:
+  void number(const std::string& key, double value) override
+  {
+    at(key) << shortestText(value);
+  }
+  void whole(const std::string& key, std::uint64_t value) override
+  {
+    at(key) << value;
+  }
+  void flag(const std::string& key, bool value) override
+  {
+    at(key) << value;
+  }
+  void word(const std::string& key, const std::string& value) override
+  {
+    at(key) << value;
+  }
+  void text(const std::string& key, const std::string& value) override
+  {
+    at(key) << YAML::DoubleQuoted << value;
+  }
+  void numbers(const std::string& key, const std::vector<double>& values) override
+  {
+    YAML::Emitter& out = at(key);
+    out << YAML::Flow << YAML::BeginSeq;
+    for (const double value : values)
+      out << shortestText(value);
+    out << YAML::EndSeq;
+  }
+  void texts(const std::string& key, const std::vector<std::string>& values) override
+  {
+    YAML::Emitter& out = at(key);
+    out << YAML::Flow << YAML::BeginSeq;
+    for (const std::string& value : values)
+      out << YAML::DoubleQuoted << value;
+    out << YAML::EndSeq;
+  }
+
+  std::string finish()
+  {
+    while (!open_.empty())
+      close();
+    out_ << YAML::EndMap;
+    return std::string(out_.c_str()) + "\n";
+  }
+
+  YamlSink()
+  {
+    out_ << YAML::BeginMap;
+  }
+
+private:
+  // The emitter, ready for the value of `key`.
+  YAML::Emitter& at(const std::string& key)
+  {
+    std::vector<std::string> parts = splitKey(key);
+    const std::string name = parts.back();
+    parts.pop_back();
+    std::size_t common = 0;
+    while (common < open_.size() && common < parts.size() && open_[common] == parts[common])
+      ++common;
+    while (open_.size() > common)
+      close();
+    for (std::size_t i = common; i < parts.size(); ++i)
+    {
+      out_ << YAML::Key << parts[i] << YAML::Value << YAML::BeginMap;
+      open_.push_back(parts[i]);
+    }
+    out_ << YAML::Key << name << YAML::Value;
+    return out_;
+  }
+
+  void close()
+  {
+    out_ << YAML::EndMap;
+    open_.pop_back();
+  }
+
+  YAML::Emitter out_;
+  std::vector<std::string> open_;  // the maps open, outermost first
+};
+}  // namespace
+
+std::string yamlText(const std::function<void(ParameterSink& sink)>& write)
+{
+  YamlSink sink;
+  write(sink);
+  return sink.finish();
 }
 
 }  // namespace cartpole_qlearning
