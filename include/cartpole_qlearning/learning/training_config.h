@@ -5,7 +5,7 @@
 #pragma once
 
 #include "cartpole_qlearning/config/config_section.h"
-#include "cartpole_qlearning/io/yaml_parameters.h"
+#include "cartpole_qlearning/io/yaml_parameters.h"  // the sources and the sink the readers and writer take
 
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
 #include "cartpole_qlearning/learning/cartpole_task.h"
