@@ -153,7 +153,15 @@ TEST(TrainLaunch, ASolvedRunEndsCleanlyWithItsTableInItsNamespacesFolder)
 
 TEST(TrainLaunch, ABadParameterEndsTheLaunchInsteadOfRespawningIntoTheSameError)
 {
-  Launch run("bad", "ns:=bad max_episodes:=0");
+  // The launch's check refuses it before any node starts: exit status 1.
+  Launch checked("bad", "ns:=bad max_episodes:=0");
+  ASSERT_EQ(1, checked.waitFor(60.0)) << "the launch did not end with status 1:\n" << checked.output();
+  EXPECT_NE(std::string::npos, checked.output().find("max_episodes = 0 is not allowed")) << checked.output();
+  EXPECT_NE(std::string::npos, checked.output().find("nothing was started")) << checked.output();
+  EXPECT_EQ(std::string::npos, checked.output().find("restarting process")) << checked.output();
+  // Without the check the controller refuses it as it starts, and ends the launch rather than
+  // being respawned into the same error.
+  Launch run("bad_unchecked", "ns:=bad_unchecked max_episodes:=0 check_parameters:=false");
   ASSERT_EQ(0, run.waitFor(60.0)) << "the launch did not end:\n" << run.output();
   const std::string out = run.output();
   EXPECT_NE(std::string::npos, out.find("max_episodes = 0 is not allowed")) << out;

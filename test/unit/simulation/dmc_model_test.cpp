@@ -131,7 +131,9 @@ TEST(DmcModel, TheEquationsRailEndsStopTheCartAsTheModelsLimitDoes)
       // Within a centimetre through the impact (later the pole's inertia and the damping, which
       // differ a little, take the two apart).
       if (i < 60)
+      {
         EXPECT_NEAR(model.state()[0], ours.state()[0], 0.01) << i;
+      }
     }
     EXPECT_GT(model_furthest, 1.85);
     EXPECT_NEAR(model_furthest, ours_furthest, 0.01);
