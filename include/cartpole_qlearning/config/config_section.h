@@ -88,7 +88,10 @@ ConfigKey<Params> wholeKey(const std::string& name, const std::string& doc, Acce
             if constexpr (std::is_same_v<std::decay_t<decltype(value)>, unsigned>)
               r.read(name, value, min, max);
             else
+            {
+              (void)max;  // a std::uint64_t has no upper bound here (clang: the capture is otherwise unused)
               r.read(name, value, min);
+            }
           },
           [name, access](SectionWriter& w, const Params& p) { w.write(name, access(p)); }};
 }
