@@ -460,8 +460,7 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
                   SectionReader::numberText(settings.robot.decision_period));
   // A greedy table not told the delay finds it (DelayEstimator), when the model's steps are its
   // decisions (as a told one needs, above).
-  if (!delay_told && !run.learning &&
-      std::abs(settings.robot.decision_period - settings.training.physics.tau) <= 1e-9)
+  if (!delay_told && !run.learning && std::abs(settings.robot.decision_period - settings.training.physics.tau) <= 1e-9)
     run.predict_delay_steps = kDelayFoundFromStates;
   protocol.commands_unstamped = settings.robot.command_type != CommandType::JointState;
   // The freshness guard's bound: a few decision periods, and no less than 0.1 s (a real-time
@@ -632,8 +631,9 @@ std::string controllerStartText(const ControllerSettings& settings, const QTable
   if (settings.robots.size() > 1)
     text += settings.sync ? " in lockstep rounds" : ", each as its states come";
   if (settings.run.predict_delay_steps == kDelayFoundFromStates)
-    text += "; finding how many steps late the robot carries out its commands from how its states answer them, "
-            "then deciding for the state predicted that far ahead (~predict_delay_steps N tells it instead)";
+    text +=
+        "; finding how many steps late the robot carries out its commands from how its states answer them, "
+        "then deciding for the state predicted that far ahead (~predict_delay_steps N tells it instead)";
   else if (settings.run.predict_delay_steps > 0)
     text += "; deciding for the state predicted " + std::to_string(settings.run.predict_delay_steps) +
             (settings.run.predict_delay_steps == 1 ? " step" : " steps") + " ahead (~predict_delay_steps)";

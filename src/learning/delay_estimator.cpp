@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace cartpole_qlearning
 {
@@ -17,9 +18,7 @@ constexpr unsigned kTellingStepsNeeded = 20;
 constexpr double kClearlyBest = 0.5;
 }  // namespace
 
-DelayEstimator::DelayEstimator(const CartPoleParams& model) : model_(model), sent_(kLargestFoundDelay + 1, 0.0)
-{
-}
+DelayEstimator::DelayEstimator(const CartPoleParams& model) : model_(model), sent_(kLargestFoundDelay + 1, 0.0) {}
 
 void DelayEstimator::begin(const CartPoleState& start)
 {

@@ -71,8 +71,9 @@ TEST(LaunchFilesTest, EachLaunchChecksItsParametersWithEveryArgumentItTakes)
     const std::size_t at = command.find(itself);
     EXPECT_TRUE(at != std::string::npos && std::isspace(static_cast<unsigned char>(command[at + itself.size()])))
         << file.filename() << " checks another file: " << command;
-    EXPECT_EQ(userArguments(text), passedArguments(command)) << file.filename() << ": the arguments a user gives "
-                                                                 "and those its check is given differ";
+    EXPECT_EQ(userArguments(text), passedArguments(command)) << file.filename()
+                                                             << ": the arguments a user gives "
+                                                                "and those its check is given differ";
     ++checked;
   }
   EXPECT_EQ(5, checked) << "evaluate, robot, sim, train and try_robot.launch";
@@ -83,7 +84,8 @@ TEST(LaunchFilesTest, EachLaunchChecksItsParametersWithEveryArgumentItTakes)
 TEST(LaunchFilesTest, AnIncludedLaunchIsCheckedByTheLaunchThatIncludesIt)
 {
   const std::string text = fileText((kLaunch / "try_robot.launch").string());
-  const std::regex include(R"re(<include file="\$\(find cartpole_qlearning\)/launch/robot.launch">([\s\S]*?)</include>)re");
+  const std::regex include(
+      R"re(<include file="\$\(find cartpole_qlearning\)/launch/robot.launch">([\s\S]*?)</include>)re");
   std::smatch found;
   ASSERT_TRUE(std::regex_search(text, found, include));
   EXPECT_NE(std::string::npos, found[1].str().find(R"(<arg name="check_parameters" value="false"/>)"));

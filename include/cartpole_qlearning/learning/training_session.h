@@ -176,8 +176,8 @@ public:
   // A greedy session only (evaluate, control): each decision is made for the state `model`
   // predicts for when the command will act on a robot that answers `steps` late (DelayPredictor),
   // from the next decision (an episode under way counts zeros in flight); 0: for the state
-  // observed (the default); kDelayFoundFromStates: `steps` found for each robot from its states. Returns what is wrong (a learning session, too many steps) and
-  // changes nothing then. The task still judges the observed state.
+  // observed (the default); kDelayFoundFromStates: `steps` found for each robot from its states. Returns what is wrong
+  // (a learning session, too many steps) and changes nothing then. The task still judges the observed state.
   std::string predictDelay(const CartPoleParams& model, unsigned steps);
   unsigned predictedDelaySteps() const
   {
