@@ -34,14 +34,15 @@ def table():
     rows = [
         ("`include/cartpole_qlearning/common/`, `src/common/`",
          "core layer 1 of 7 (no ROS; each links only layers listed before it here): random numbers, "
-         "log lines as values, a wall-clock throttle: " + quoted(stems("include/cartpole_qlearning/common", "src/common"))),
+         "log lines as values, a wall-clock throttle, the settings its messages point at (named by each front end): "
+         + quoted(stems("include/cartpole_qlearning/common", "src/common"))),
         ("`include/cartpole_qlearning/config/`, `src/config/`",
          "core layer 2: settings as tables of keys, whatever holds them (a section's keys listed once drive "
          "reading, refusing unknown keys, writing and the docs check): "
          + quoted(stems("include/cartpole_qlearning/config", "src/config"))),
         ("`include/cartpole_qlearning/io/`, `src/io/`",
-         "core layer 3: files (atomic saves, confined paths, size-checked reads), YAML documents as parameter "
-         "sources and sinks: "
+         "core layer 3: files (atomic saves, confined paths, size-checked reads, files that grow a line at a time), "
+         "YAML documents as parameter sources and sinks: "
          + quoted(stems("include/cartpole_qlearning/io", "src/io"))),
         ("`include/cartpole_qlearning/simulation/`, `src/simulation/`",
          "core layer 4: the cart-pole's physics (the equations; a MuJoCo model, its own library) and what a real one does: "
@@ -61,6 +62,12 @@ def table():
          "helpers (command publisher, parameter server reader, reset caller and its service probe, "
          "start-up and loggers, launch control) private in `src/ros/`: "
          + quoted(stems("include/cartpole_qlearning/ros", "src/ros"))),
+        ("`include/cartpole_qlearning/node_settings/`, `src/node_settings/`",
+         "the nodes' settings, read without ROS (their own library, which the nodes and train_headless link): "
+         "the controller's and the sim's private parameters checked through a ParameterSource, the robot's pose "
+         "and command read once for every node, the names the core's messages give the settings "
+         "(~load_on_start, ...), the table folder under ROS_HOME: "
+         + quoted(stems("include/cartpole_qlearning/node_settings", "src/node_settings"))),
         ("`src/cli/`", "the command line: `train_headless` (the main only), its options and their rules, one file "
          "per mode and the run they share: " + quoted(stems("src/cli"))),
         ("`msg/`, `srv/`", "`EpisodeStats`, `Reset`, `SaveQTable`, `LoadQTable`"),
@@ -73,7 +80,7 @@ def table():
         ("`docs/`", "the users' pages and pictures (`docs/images/`), each picture made by the command beside it; "
          "`docs/notes/`: the developers' notes (tuning rounds, variants tried, earlier benchmark runs)"),
         ("`test/`", "`unit/<layer>/`: gtests of each core layer (`<layer>_tests`, no ROS) and of its layout; "
-         "`ros/`: the ROS layer's message conversions (no master); `cli/`: `train_headless` run as a user runs "
+         "`node_settings/`: the nodes' settings with YAML text (no master); `ros/`: the ROS layer's message conversions (no master); `cli/`: `train_headless` run as a user runs "
          "it, and its options parsed without a process; `docs/`: the pages' links and parameters; `rostest/`: the nodes' wiring (`*.test` files and their "
          "clients); `support/`: what the tests share; `data/`: their configs; `fuzz/`: fuzzers; "
          "`sanitizer/`: suppressions"),

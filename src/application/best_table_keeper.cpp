@@ -38,8 +38,12 @@ SuiteRun againstTheBest(const SuiteResult& best, std::vector<std::size_t> order)
 }  // namespace
 
 BestTableKeeper::BestTableKeeper(const TrainingConfig& config, bool learning, std::vector<std::string> suite_folders,
-                                 bool control)
-  : config_(config), learning_(learning), control_(control), suite_folders_(std::move(suite_folders))
+                                 bool control, SettingNames names)
+  : config_(config),
+    learning_(learning),
+    control_(control),
+    suite_folders_(std::move(suite_folders)),
+    names_(std::move(names))
 {
 }
 
@@ -204,7 +208,7 @@ SuiteResult BestTableKeeper::settle(TrainingSession& session, std::optional<Suit
   // for information (trained until solved), each case stops once its verdict is known: a table
   // trained to solved fails most cases within their first episodes, where running all of them took
   // most of the process's time (issue 29). The rows say where a case stopped, and
-  // `train_headless --evaluate TABLE --suite FILE` runs every episode.
+  // an evaluation by the suite (Setting::SuiteEvaluation) runs every episode.
   const bool for_information = config_.limits.until != TrainUntil::SuitePasses;
   if (!last)
     last = evaluateSuite(session.table(), config_, *suite_,
@@ -219,13 +223,12 @@ SuiteResult BestTableKeeper::settle(TrainingSession& session, std::optional<Suit
   {
     // Not this run's goal: what the table would be worth on a robot, with where to go for that,
     // rather than a FAILED beside the SOLVED that follows.
-    const std::string verdict =
-        (last->passed() ? std::string("every case passes: robust by this suite as well")
-                        : formatText("%zu of %zu cases pass: not yet a table for a real robot", last->casesPassed(),
-                                     last->cases_in_suite)) +
-        (last->complete() ? ""
-                          : " (each case stopped once decided; train_headless --evaluate TABLE --suite FILE runs "
-                            "every episode)");
+    const std::string verdict = (last->passed() ? std::string("every case passes: robust by this suite as well")
+                                                : formatText("%zu of %zu cases pass: not yet a table for a real robot",
+                                                             last->casesPassed(), last->cases_in_suite)) +
+                                (last->complete() ? ""
+                                                  : " (each case stopped once decided; " +
+                                                        names_(Setting::SuiteEvaluation) + " runs every episode)");
     log.push_back(
         {LogLine::Level::Info,
          formatText("robustness of the saved table, for information (%s, greedy, %s%llu episodes per case):\n",

@@ -115,16 +115,20 @@ void LearningCurveFile::write(const EpisodeSummary& summary, const std::string& 
   file_.append(learningCurveRow(summary, robot, wall_time) + "\n");
 }
 
-RunSettingError::RunSettingError(const std::string& name_, const std::string& value_, const std::string& why_)
-  : ConfigError("~" + name_ + " = " + value_ + " is not allowed (" + why_ + ")"), name(name_), value(value_), why(why_)
+RunSettingError::RunSettingError(Setting setting_, const SettingNames& names, const std::string& value_,
+                                 const std::string& why_)
+  : ConfigError(names(setting_) + " = " + value_ + " is not allowed (" + why_ + ")"),
+    setting(setting_),
+    value(value_),
+    why(why_)
 {
 }
 
 LearningCurve::LearningCurve(const RunSettings& settings, RunFolder& folder, std::function<double()> unix_seconds)
   : stats_csv_(settings.stats_csv),
-    silenced_by_(settings.command_line ? "--stats-csv" : "~stats_csv"),
+    names_(settings.names),
     table_dir_(settings.q_table_dir),
-    learning_(settings.learning),
+    learning_(settings.learning()),
     run_folder_(settings.run_folder),
     folder_(folder),
     unix_seconds_(std::move(unix_seconds))
@@ -142,7 +146,7 @@ void LearningCurve::openUsersFile()
   }
   catch (const FileError& e)
   {
-    throw RunSettingError("stats_csv", "'" + stats_csv_ + "'", e.what());
+    throw RunSettingError(Setting::StatsCsv, names_, "'" + stats_csv_ + "'", e.what());
   }
 }
 
@@ -175,8 +179,8 @@ void LearningCurve::open(std::uint64_t episodes, LogLines& log)
     catch (const FileError& e)
     {
       waiting_for_folder_ = false;
-      log.push_back({LogLine::Level::Error,
-                     "no learning curve for this run (" + silenced_by_ + " none silences this): " + e.what()});
+      log.push_back({LogLine::Level::Error, "no learning curve for this run (" + names_(Setting::StatsCsv) +
+                                                " none silences this): " + e.what()});
       return;
     }
   }
@@ -191,15 +195,14 @@ void LearningCurve::open(std::uint64_t episodes, LogLines& log)
   {
     opened_.reset();
     if (!stats_csv_.empty())
-      throw RunSettingError("stats_csv", "'" + stats_csv_ + "'", e.what());
-    log.push_back({LogLine::Level::Error,
-                   "no learning curve for this run (" + silenced_by_ + " none silences this): " + e.what()});
+      throw RunSettingError(Setting::StatsCsv, names_, "'" + stats_csv_ + "'", e.what());
+    log.push_back({LogLine::Level::Error, "no learning curve for this run (" + names_(Setting::StatsCsv) +
+                                              " none silences this): " + e.what()});
     return;
   }
   opened_.reset();
-  log.push_back({LogLine::Level::Info, "one row per episode goes to " + file_->path() +
-                                           " (rosrun cartpole_qlearning plot_learning_curve --follow " + file_->path() +
-                                           ")"});
+  log.push_back({LogLine::Level::Info, "one row per episode goes to " + file_->path() + " (" +
+                                           names_(Setting::CurveViewer) + " " + file_->path() + ")"});
 }
 
 void LearningCurve::write(const std::string& robot, const EpisodeSummary& summary, LogLines& log)

@@ -54,11 +54,11 @@ struct RunApplication::Parts
              settings.own_absolute_paths ? AbsolutePaths::AreTheUsersFiles : AbsolutePaths::MustLieInTheFolder),
       folder(settings, tables, std::move(clocks.calendar)),
       curve(settings, folder, std::move(clocks.unix_seconds)),
-      keeper(config, settings.learning, settings.suite_folders, settings.control),
+      keeper(config, settings.learning(), settings.suite_folders, settings.controlling(), settings.names),
       meters(config, settings, clocks.steady),
       steady(std::move(clocks.steady))
   {
-    if (settings.trace && settings.learning)
+    if (settings.trace && settings.learning())
       state_names = stateNames(config.agent);
     // Every table this run saves (the services, checkpoints, the final and shutdown saves, the
     // best table) then says what it takes to run it.
@@ -113,7 +113,7 @@ struct RunApplication::Parts
 std::string RunApplication::Parts::useTable(QTable table)
 {
   const std::string mismatch =
-      settings.learning ? session.resume(std::move(table), {}) : session.replaceTable(std::move(table));
+      settings.learning() ? session.resume(std::move(table), {}) : session.replaceTable(std::move(table));
   meters.countStepsFrom(session.lastEpisode().total_steps);
   return mismatch;
 }
@@ -122,8 +122,9 @@ void RunApplication::Parts::loadOnStart(LogLines& log)
 {
   if (settings.load_on_start.empty())
   {
-    if (!settings.learning)
-      say(log, LogLine::Level::Warn, "evaluating a table of zeros (set ~load_on_start to a trained table)");
+    if (!settings.learning())
+      say(log, LogLine::Level::Warn,
+          "evaluating a table of zeros (set " + settings.names(Setting::LoadOnStart) + " to a trained table)");
     return;
   }
   std::string path;
@@ -141,11 +142,10 @@ void RunApplication::Parts::loadOnStart(LogLines& log)
   }
   catch (const FileError& e)
   {
-    // train_headless names its option (--load or --evaluate) before the message.
-    throw ConfigError(
-        "cannot start from the table '" + settings.load_on_start + "'" +
-        (settings.command_line ? "" : " (~load_on_start, which the launch files' q_table or load argument sets)") +
-        ": " + e.what());
+    // Where the table came from, unless the front end says it before the message.
+    const std::string origin = settings.names(Setting::LoadOnStartOrigin);
+    throw ConfigError("cannot start from the table '" + settings.load_on_start + "'" +
+                      (origin.empty() ? "" : " (" + origin + ")") + ": " + e.what());
   }
   if (!settings.config_warning.empty())
     say(log, LogLine::Level::Warn, settings.config_warning);
@@ -169,6 +169,7 @@ std::string RunApplication::Parts::saveFinal(bool done_well, const char* finishe
   // as it was. The default table first: a crash between the two saves then leaves a run not yet
   // marked finished, which a respawn finishes again.
   const bool publishes = done_well && !settings.q_table_path.empty();
+  const std::string save_service = settings.names(Setting::SaveService);
   const std::string replaced = publishes ? replacedTableText(tables) : "";
   const ServiceAnswer published = publishes ? tables.serveSave(session.table(), "") : ServiceAnswer{};
   std::string saved;
@@ -178,9 +179,9 @@ std::string RunApplication::Parts::saveFinal(bool done_well, const char* finishe
   else
   {
     // The default table is the only save, if there is one.
-    saved = !settings.q_table_path.empty() ? "no run folder"
-            : settings.command_line        ? "no run folder and no --save: the table was not written"
-                                           : "no run folder and no ~q_table_path: the table was not written";
+    saved = !settings.q_table_path.empty()
+                ? "no run folder"
+                : "no run folder and no " + settings.names(Setting::TablePath) + ": the table was not written";
     saved_ok = !publishes || published.success;
   }
   final_saved = saved_ok || published.success;
@@ -190,9 +191,9 @@ std::string RunApplication::Parts::saveFinal(bool done_well, const char* finishe
   else if (!settings.q_table_path.empty())
     saved += "; the default table " + tables.resolveForService("") + " is left as it was (this run did not " +
              (config.limits.until == TrainUntil::SuitePasses ? "pass the suite" : "solve") +
-             (!settings.command_line ? ": ~save_q_table saves it there if you want it)"
-              : settings.run_folder  ? ": copy the run's table there if you want it)"
-                                     : "; with no run folder its table is not kept)");
+             (!save_service.empty() ? ": " + save_service + " saves it there if you want it)"
+              : settings.run_folder ? std::string(": copy the run's table there if you want it)")
+                                    : std::string("; with no run folder its table is not kept)"));
   return saved;
 }
 
@@ -202,13 +203,18 @@ void RunApplication::Parts::endTraining(const EpisodeSummary& s, bool passed, co
   finished = true;
   if (!saved_ok)
   {
-    // Keep the trained table alive: the user can still save it elsewhere with ~save_q_table.
+    // Keep the trained table alive: the user can still save it elsewhere through the save
+    // service; with none, the same seed trains it again.
+    const SettingNames& names = settings.names;
+    const std::string save_service = names(Setting::SaveService);
+    const std::string what_now = !save_service.empty()
+                                     ? "The node keeps running: call " + save_service + " with another path"
+                                     : "The same " + names(Setting::Seed) + " trains the same table again: give " +
+                                           names(Setting::TablePath) + ", or the table folder (" +
+                                           names(Setting::TableFolder) + "), a place that can be written";
     say(end.log, LogLine::Level::Error,
         formatText("training ended (%s, episode %llu) but the table could not be saved: %s. %s", finished_as,
-                   count(s.episode), saved.c_str(),
-                   settings.command_line ? "The same --seed trains the same table again: give --save, or the table "
-                                           "folder (ROS_HOME, --ns), a place that can be written"
-                                         : "The node keeps running: call ~save_q_table with another path"));
+                   count(s.episode), saved.c_str(), what_now.c_str()));
     return;
   }
   const bool until_suite = config.limits.until == TrainUntil::SuitePasses;
@@ -248,10 +254,10 @@ LogLines RunApplication::start(const RunIdentity& previous, int launcher)
   LogLines log = p.keeper.loadSuite();
   p.launcher = launcher;
   p.loadOnStart(log);
-  if (p.settings.control)
+  if (p.settings.controlling())
     append(log, p.keeper.judgeBeforeControl(p.session.table(), p.settings.predict_delay_steps));
   p.curve.openUsersFile();
-  if (p.settings.learning)
+  if (p.settings.learning())
     p.opened(p.folder.open(previous, launcher, p.session, log), log);
   p.curve.start(p.session.episodesEnded(), log);
   p.meters.start(p.session.lastEpisode().total_steps);
@@ -268,7 +274,7 @@ void RunApplication::checkStart()
 LogLines RunApplication::resume(const std::string& folder)
 {
   Parts& p = *parts_;
-  if (!p.settings.learning)
+  if (!p.settings.learning())
     throw ConfigError("a run is resumed to train it further, not to evaluate it");
   LogLines log = p.keeper.loadSuite();
   p.folder.selectForResume(folder);
@@ -292,7 +298,7 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
   end.robot_steps_per_second = rates.robot_steps_per_second;
 
   const bool until_suite = p.config.limits.until == TrainUntil::SuitePasses;
-  if (p.settings.learning && s.solved && p.first_solved == 0)
+  if (p.settings.learning() && s.solved && p.first_solved == 0)
   {
     p.first_solved = s.episode;
     // A run that goes on after solving says so when it happens, not only at its end.
@@ -322,7 +328,7 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
   bool saved_ok = true;
   const std::string saved = training_finished ? p.saveFinal(done_well, finished_as, saved_ok) : "";
 
-  if (p.settings.trace && p.settings.learning)
+  if (p.settings.trace && p.settings.learning())
   {
     const std::string which = p.session.robots() > 1 ? robot + "'s episode " + std::to_string(s.robot_episode) + " (" +
                                                            std::to_string(s.episode) + " in all)"
@@ -332,11 +338,11 @@ EpisodeEnd RunApplication::endEpisode(const std::string& robot, bool training_fi
   }
   p.meters.addProgress(s, end.log);
 
-  if (!p.settings.learning)
+  if (!p.settings.learning())
   {
     // Evaluation: every episode said, and after evaluation_episodes a one-line verdict. (Control:
     // an episode ends with a fall, which its ControlMeter says.)
-    if (!p.settings.control && p.meters.addEvaluationEpisode(s, end.log))
+    if (!p.settings.controlling() && p.meters.addEvaluationEpisode(s, end.log))
       p.finished = end.finished = true;
     return end;
   }
@@ -404,7 +410,7 @@ LogLines RunApplication::shutdown()
 {
   Parts& p = *parts_;
   LogLines log;
-  if (p.shut_down || !p.settings.learning || !p.settings.save_on_shutdown || p.final_saved)
+  if (p.shut_down || !p.settings.learning() || !p.settings.save_on_shutdown || p.final_saved)
     return log;
   p.shut_down = true;
   std::string message;
@@ -416,7 +422,7 @@ LogLines RunApplication::shutdown()
 
 RunIdentity RunApplication::identity() const
 {
-  if (!parts_->settings.learning || parts_->settings.run_id.empty())
+  if (!parts_->settings.learning() || parts_->settings.run_id.empty())
     return {};
   return {parts_->settings.run_id, parts_->launcher, parts_->folder.name()};
 }
@@ -433,7 +439,7 @@ bool RunApplication::finished() const
 
 EvaluationVerdict RunApplication::verdict() const
 {
-  if (parts_->settings.learning)
+  if (parts_->settings.learning())
     return {};
   return parts_->meters.verdict(parts_->session);
 }

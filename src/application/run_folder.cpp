@@ -202,10 +202,12 @@ RunOpening RunFolder::startNew(LogLines& log)
   }
   catch (const FileError& e)
   {
-    log.push_back({LogLine::Level::Error,
-                   formatText("cannot make this run's folder (%s): checkpoints will fail; %s", e.what(),
-                              settings_.command_line ? "a solved table still goes to --save's path"
-                                                     : "~save_q_table can still save the table elsewhere")});
+    const std::string save_service = settings_.names(Setting::SaveService);
+    const std::string still = save_service.empty()
+                                  ? "a solved table still goes to " + settings_.names(Setting::TablePath) + "'s path"
+                                  : save_service + " can still save the table elsewhere";
+    log.push_back({LogLine::Level::Error, formatText("cannot make this run's folder (%s): checkpoints will fail; %s",
+                                                     e.what(), still.c_str())});
   }
   log.push_back({LogLine::Level::Info, formatText("run %s: checkpoints go to %s", name_.c_str(),
                                                   tables_.resolveForService(file(kRunTableFile)).c_str())});

@@ -1,5 +1,6 @@
 #include "headless_options.h"
 
+#include "cartpole_qlearning/learning/delay_predictor.h"
 #include "cartpole_qlearning/application/table_store.h"
 
 #include <algorithm>
@@ -259,11 +260,40 @@ HeadlessCommandLine parseHeadlessOptions(const std::vector<std::string>& args)
   return line;
 }
 
+SettingNames headlessSettingNames()
+{
+  return SettingNames([](Setting setting) -> std::string {
+    switch (setting)
+    {
+      case Setting::LoadOnStart:
+        return "--load";
+      case Setting::LoadOnStartOrigin:  // said before the message: --load or --evaluate
+        return "";
+      case Setting::TablePath:
+        return "--save";
+      case Setting::TableFolder:
+        return "ROS_HOME, --ns";
+      case Setting::SaveService:  // none: a run that cannot save is trained again
+        return "";
+      case Setting::StatsCsv:
+        return "--stats-csv";
+      case Setting::Seed:
+        return "--seed";
+      case Setting::CurveViewer:
+        return "rosrun cartpole_qlearning plot_learning_curve --follow";
+      case Setting::SuiteEvaluation:
+        return "train_headless --evaluate TABLE --suite FILE";
+      default:  // the robot's settings: train_headless has no robot of its own to set
+        return plainSettingName(setting);
+    }
+  });
+}
+
 RunSettings headlessRunSettings(const HeadlessOptions& options, std::uint64_t seed, const std::string& table_dir,
                                 const std::string& config_path, const std::string& package_path)
 {
   RunSettings settings;
-  settings.learning = !options.evaluating();
+  settings.mode = options.evaluating() ? RunMode::Evaluate : RunMode::Train;
   settings.seed = seed;
   settings.name_space = options.name_space;
   settings.q_table_dir = table_dir;
@@ -271,7 +301,7 @@ RunSettings headlessRunSettings(const HeadlessOptions& options, std::uint64_t se
     settings.q_table_path = options.save_path;
   else if (options.no_run_folder)
     settings.q_table_path.clear();  // no default table either
-  else if (settings.learning)
+  else if (settings.learning())
     settings.q_table_path = defaultTableName(config_path);
   settings.load_on_start = options.evaluating() ? options.evaluate_path : options.load_path;
   settings.stats_csv = !options.stats_csv_path.empty() ? options.stats_csv_path : options.no_run_folder ? "none" : "";
@@ -282,10 +312,10 @@ RunSettings headlessRunSettings(const HeadlessOptions& options, std::uint64_t se
   settings.trace = options.trace;
   // Not told: a greedy run finds the delay from the states, as the controller does.
   settings.predict_delay_steps = options.predict_delay_given ? static_cast<unsigned>(options.predict_delay)
-                                 : settings.learning         ? 0u
+                                 : settings.learning()       ? 0u
                                                              : kDelayFoundFromStates;
   settings.own_absolute_paths = true;
-  settings.command_line = true;
+  settings.names = headlessSettingNames();
   // A relative training/suite: beside the config first, then the package's config/.
   const std::string config_folder = config_path.substr(0, config_path.find_last_of('/') + 1);
   settings.suite_folders = {config_folder.empty() ? "." : config_folder.substr(0, config_folder.size() - 1)};

@@ -3,7 +3,7 @@
 // option and every rule is a unit test (test/cli/headless_options_test.cpp).
 #pragma once
 
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/application/run_settings.h"
 #include "cartpole_qlearning/learning/policy_grid.h"
 
 #include <cstdint>
@@ -103,6 +103,10 @@ const std::vector<OptionRule>& headlessOptionRules();
 
 // args: the arguments after the program's name.
 HeadlessCommandLine parseHeadlessOptions(const std::vector<std::string>& args);
+
+// The settings the core's messages point at, named as train_headless's users type them (--save,
+// --stats-csv, ...).
+SettingNames headlessSettingNames();
 
 // The settings the controller reads from its private parameters, made from the command line.
 // table_dir: the namespace's table folder; config_path: the configuration in use (a relative

@@ -5,6 +5,7 @@
 #include "cartpole_qlearning/io/file_access.h"
 #include "cartpole_qlearning/application/table_store.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
+#include "cartpole_qlearning/node_settings/table_folder.h"
 #include "cartpole_qlearning/learning/table_config.h"
 
 #include <cstdio>

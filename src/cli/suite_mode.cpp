@@ -2,6 +2,7 @@
 
 #include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/io/file_access.h"
+#include "cartpole_qlearning/learning/delay_predictor.h"
 #include "cartpole_qlearning/learning/table_config.h"
 
 #include <cstdio>

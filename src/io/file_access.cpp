@@ -1,5 +1,7 @@
 #include "cartpole_qlearning/io/file_access.h"
 
+#include "open_folder.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
@@ -18,138 +20,13 @@
 namespace cartpole_qlearning
 {
 namespace fs = std::filesystem;
+using namespace io_internal;
 
 namespace
 {
 [[noreturn]] void refuse(const std::string& what)
 {
   throw FileError(what);
-}
-
-std::string systemError(const std::string& what, const std::string& path, int error)
-{
-  return what + " " + path + ": " + std::strerror(error);
-}
-
-// A file descriptor, closed when it goes out of scope.
-class Descriptor
-{
-public:
-  explicit Descriptor(int fd = -1) : fd_(fd) {}
-  ~Descriptor()
-  {
-    if (fd_ >= 0)
-      ::close(fd_);
-  }
-  Descriptor(Descriptor&& other) noexcept : fd_(other.fd_)
-  {
-    other.fd_ = -1;
-  }
-  Descriptor& operator=(Descriptor&& other) noexcept
-  {
-    std::swap(fd_, other.fd_);
-    return *this;
-  }
-  Descriptor(const Descriptor&) = delete;
-  Descriptor& operator=(const Descriptor&) = delete;
-  int get() const
-  {
-    return fd_;
-  }
-  // Hands the descriptor over to the caller, who closes it.
-  int release()
-  {
-    return std::exchange(fd_, -1);
-  }
-  // Closes now, reporting the error a deferred write may only show here.
-  int close()
-  {
-    const int result = ::close(fd_);
-    fd_ = -1;
-    return result;
-  }
-
-private:
-  int fd_;
-};
-
-Descriptor openDirectory(const std::string& directory, bool create)
-{
-  Descriptor fd(::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
-  if (fd.get() < 0 && errno == ENOENT && create)
-  {
-    std::error_code ec;
-    fs::create_directories(directory, ec);
-    if (ec)
-      refuse("cannot create directory " + directory + ": " + ec.message());
-    fd = Descriptor(::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
-  }
-  if (fd.get() < 0)
-    refuse(systemError("cannot open directory", directory, errno));
-  return fd;
-}
-
-// What is at `name` in the directory, for a refusal's message.
-std::string describeEntry(int directory, const std::string& name)
-{
-  struct stat status;
-  if (::fstatat(directory, name.c_str(), &status, AT_SYMLINK_NOFOLLOW) != 0)
-    return std::strerror(errno);
-  if (S_ISLNK(status.st_mode))
-    return "is a symbolic link";
-  if (S_ISDIR(status.st_mode))
-    return "is a directory";
-  if (!S_ISREG(status.st_mode))
-    return "is not a regular file";
-  return "is a file";
-}
-
-// A path below a directory, opened down to the folder that holds its last component.
-struct Located
-{
-  Descriptor folder;
-  std::string name;   // the last component
-  std::string shown;  // the whole path, for messages
-};
-
-// Opens each folder of `relative` (checked by relativePathUnder) below the open directory
-// without following links; missing folders are created when `create`.
-Located locate(Descriptor base, const std::string& base_path, const std::string& relative, bool create)
-{
-  Located located;
-  located.shown = (fs::path(base_path) / relative).string();
-  const std::string outside = " (refused: no symbolic links below " + base_path + ")";
-  std::vector<std::string> parts;
-  for (const fs::path& part : fs::path(relative))
-    parts.push_back(part.string());
-  located.folder = std::move(base);
-  fs::path walked(base_path);
-  for (std::size_t i = 0; i + 1 < parts.size(); ++i)
-  {
-    const std::string& part = parts[i];
-    walked /= part;
-    int fd = ::openat(located.folder.get(), part.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
-    if (fd < 0 && errno == ENOENT && create)
-    {
-      if (::mkdirat(located.folder.get(), part.c_str(), 0755) != 0 && errno != EEXIST)
-        refuse(systemError("cannot create directory", walked.string(), errno));
-      fd = ::openat(located.folder.get(), part.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
-    }
-    if (fd < 0)
-    {
-      const int error = errno;
-      if (error == ELOOP || error == ENOTDIR)
-      {
-        const std::string what = describeEntry(located.folder.get(), part);
-        refuse(located.shown + ": " + walked.string() + " " + what +
-               (what == "is a symbolic link" ? outside : ", not a folder"));
-      }
-      refuse(systemError("cannot open directory", walked.string(), error));
-    }
-    located.folder = Descriptor(fd);
-  }
-  located.name = parts.back();
-  return located;
 }
 
 std::string readOpenFile(const Descriptor& fd, const std::string& shown, std::uint64_t max_bytes,
@@ -383,32 +260,6 @@ std::string readFile(const std::string& path, std::uint64_t max_bytes, const Siz
   return readOpenFile(fd, path, max_bytes, size_from_head);
 }
 
-namespace
-{
-// Opens `name` in the open folder for appending; a FIFO or device planted under the name is
-// refused without blocking on it.
-Descriptor openForAppending(const Descriptor& folder, const std::string& name, const std::string& shown,
-                            bool refuse_links)
-{
-  Descriptor fd(::openat(folder.get(), name.c_str(),
-                         O_RDWR | O_APPEND | O_CREAT | O_NONBLOCK | O_CLOEXEC | (refuse_links ? O_NOFOLLOW : 0), 0644));
-  if (fd.get() < 0)
-  {
-    const int error = errno;
-    if (error == ELOOP && refuse_links)
-      refuse("cannot open " + shown + ": it is a symbolic link (refused: no symbolic links here)");
-    refuse(systemError("cannot open", shown, error));
-  }
-  struct stat status;
-  if (::fstat(fd.get(), &status) != 0)
-    refuse(systemError("cannot open", shown, errno));
-  if (!S_ISREG(status.st_mode))
-    refuse("cannot open " + shown + ": not a regular file");
-  ::fcntl(fd.get(), F_SETFL, O_APPEND);
-  return fd;
-}
-}  // namespace
-
 void writeFileAtomically(const std::string& path, const std::string& text)
 {
   // A link at the name is followed, as the shell's `>` would: the file it points to gets the
@@ -431,83 +282,6 @@ void writeFileAtomically(const std::string& path, const std::string& text)
   // not mounted fails as the shell's > would, instead of saving beside the mount point.
   replaceIn(openDirectory(folder, target.string() == path), target.filename().string(),
             target.string() == path ? path : path + " (" + target.string() + ")", text, false);
-}
-
-AppendingFile::AppendingFile(int fd, std::string path) : fd_(fd), path_(std::move(path)) {}
-
-AppendingFile::AppendingFile(AppendingFile&& other) noexcept
-  : fd_(std::exchange(other.fd_, -1)), path_(std::move(other.path_))
-{
-}
-
-AppendingFile& AppendingFile::operator=(AppendingFile&& other) noexcept
-{
-  std::swap(fd_, other.fd_);
-  std::swap(path_, other.path_);
-  return *this;
-}
-
-AppendingFile::~AppendingFile()
-{
-  if (fd_ >= 0)
-    ::close(fd_);
-}
-
-AppendingFile AppendingFile::openUnder(const std::string& directory, const std::string& path)
-{
-  const std::string relative = relativePathUnder(directory, path);
-  const std::string base = fs::absolute(directory).lexically_normal().string();
-  const Located at = locate(openDirectory(base, true), base, relative, true);
-  return AppendingFile(openForAppending(at.folder, at.name, at.shown, true).release(), at.shown);
-}
-
-AppendingFile AppendingFile::open(const std::string& path)
-{
-  const fs::path target(path);
-  if (target.filename().empty() || target.filename() == "." || target.filename() == "..")
-    refuse("cannot open " + path + ": it names a directory");
-  const std::string folder = target.has_parent_path() ? target.parent_path().string() : ".";
-  return AppendingFile(openForAppending(openDirectory(folder, true), target.filename().string(), path, false).release(),
-                       path);
-}
-
-std::string AppendingFile::read(std::uint64_t max_bytes) const
-{
-  std::string text;
-  char buffer[65536];
-  for (;;)
-  {
-    const ssize_t n = ::pread(fd_, buffer, sizeof buffer, static_cast<off_t>(text.size()));
-    if (n < 0 && errno == EINTR)
-      continue;
-    if (n < 0)
-      refuse(systemError("cannot read", path_, errno));
-    if (n == 0)
-      return text;
-    text.append(buffer, static_cast<std::size_t>(n));
-    if (text.size() > max_bytes)
-      refuse(path_ + ": more than " + std::to_string(max_bytes) + " bytes");
-  }
-}
-
-void AppendingFile::truncate(std::uint64_t size)
-{
-  if (::ftruncate(fd_, static_cast<off_t>(size)) != 0)
-    refuse(systemError("cannot shorten", path_, errno));
-}
-
-void AppendingFile::append(const std::string& text)
-{
-  std::size_t written = 0;
-  while (written < text.size())
-  {
-    const ssize_t n = ::write(fd_, text.data() + written, text.size() - written);
-    if (n < 0 && errno == EINTR)
-      continue;
-    if (n < 0)
-      refuse(systemError("cannot write", path_, errno));
-    written += static_cast<std::size_t>(n);
-  }
 }
 
 }  // namespace cartpole_qlearning

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace cartpole_qlearning
 {
@@ -14,7 +15,10 @@ double seconds(WallClock::duration d)
 }
 }  // namespace
 
-CommandWatchdog::CommandWatchdog(WallClock::duration timeout) : timeout_(timeout) {}
+CommandWatchdog::CommandWatchdog(WallClock::duration timeout, SettingNames names)
+  : timeout_(timeout), names_(std::move(names))
+{
+}
 
 CommandWatchdog::Action CommandWatchdog::stop(const std::string& why, LogLines& log)
 {
@@ -74,7 +78,8 @@ CommandWatchdog::Action CommandWatchdog::onTick(WallClock::time_point now, LogLi
 {
   if (timeout_ <= WallClock::duration::zero() || !pushing_ || !last_command_ || now - *last_command_ < timeout_)
     return Action::Nothing;
-  return stop(formatText("no command for %.3f s (~timeout %.3f s)", seconds(now - *last_command_), seconds(timeout_)),
+  return stop(formatText("no command for %.3f s (%s %.3f s)", seconds(now - *last_command_),
+                         names_(Setting::CommandTimeout).c_str(), seconds(timeout_)),
               log);
 }
 

@@ -283,6 +283,41 @@ void ControllerProtocol::requestReset(Reaction& reaction)
   fallen_states_ = 0;
 }
 
+// A state of the running episode: decided on and learnt from; at the episode's end, what comes
+// next (the training's end, a reset, the next episode at once, or a wait for a start).
+void ControllerProtocol::onEpisodeState(Reaction& reaction, const CartPoleState& state)
+{
+  const Decision decision = session_.observe(state, params_.robot);
+  reaction.learned = session_.learning();
+  if (!decision.episode_over)
+  {
+    answer(reaction, decision.effort);
+    return;
+  }
+  reaction.episode_ended = true;
+  const EpisodeSummary& summary = session_.lastEpisode();
+  if (session_.learning() && params_.limits.reached(summary.episode, summary.solved))
+  {
+    reaction.training_finished = true;
+    phase_ = Phase::Finished;
+    return;
+  }
+  if (params_.reset_service)
+  {
+    requestReset(reaction);
+    return;
+  }
+  if (params_.starts_when_up && !session_.task().isTerminal(state))
+  {
+    begin(reaction, state);  // the step limit, the pole up: the next episode goes on from here
+    return;
+  }
+  reaction.waiting_for_start = true;
+  reaction.waiting_for_pole_up = params_.starts_when_up;
+  phase_ = Phase::WaitingForPerson;
+  answer(reaction, 0.0);
+}
+
 Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& state)
 {
   reaction.kind = Reaction::Kind::New;
@@ -338,45 +373,16 @@ Reaction ControllerProtocol::onNewState(Reaction reaction, const CartPoleState& 
       }
       begin(reaction, state);
       break;
-    case Phase::InEpisode: {
-      const Decision decision = session_.observe(state, params_.robot);
-      reaction.learned = session_.learning();
-      if (!decision.episode_over)
-      {
-        answer(reaction, decision.effort);
-        break;
-      }
-      reaction.episode_ended = true;
-      const EpisodeSummary& summary = session_.lastEpisode();
-      if (session_.learning() && params_.limits.reached(summary.episode, summary.solved))
-      {
-        reaction.training_finished = true;
-        phase_ = Phase::Finished;
-        break;
-      }
-      if (params_.reset_service)
-      {
-        requestReset(reaction);
-        break;
-      }
-      if (params_.starts_when_up && !session_.task().isTerminal(state))
-      {
-        begin(reaction, state);  // the step limit, the pole up: the next episode goes on from here
-        break;
-      }
-      reaction.waiting_for_start = true;
-      reaction.waiting_for_pole_up = params_.starts_when_up;
-      phase_ = Phase::WaitingForPerson;
-      answer(reaction, 0.0);
+    case Phase::InEpisode:
+      onEpisodeState(reaction, state);
       break;
-    }
   }
   return reaction;
 }
 
 LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts& c, const std::string& robot,
                      double stamp_s, const std::function<bool()>& dropped_ready,
-                     const std::function<bool()>& restart_ready)
+                     const std::function<bool()>& restart_ready, const SettingNames& names)
 {
   using Level = LogLine::Level;
   const auto count = [](std::uint64_t n) { return static_cast<unsigned long long>(n); };
@@ -417,8 +423,8 @@ LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts&
                           "(inside the task's thresholds): someone has to stand it up",
                           robot.c_str())
              : formatText("%s: episode over; no reset service, so commanding 0 until the state is back inside "
-                          "~start_region (stand the pole up)",
-                          robot.c_str())});
+                          "%s (stand the pole up)",
+                          robot.c_str(), names(Setting::StartRegion).c_str())});
   return log;
 }
 

@@ -34,8 +34,9 @@ const std::vector<std::string>& resetServiceTypes()
 }
 
 ResetCalls::ResetCalls(std::string service, std::string type, std::string md5sum, Clock::duration give_up_after,
-                       Clock::duration retry_after)
-  : service_(std::move(service)),
+                       Clock::duration retry_after, SettingNames names)
+  : names_(std::move(names)),
+    service_(std::move(service)),
     type_(std::move(type)),
     md5sum_(std::move(md5sum)),
     give_up_after_(give_up_after),
@@ -48,13 +49,17 @@ LogLine ResetCalls::failure(const std::string& message, const ServiceFound& foun
   using Level = LogLine::Level;
   // What goes on while the calls fail: said with every failure, as it is the same for each.
   const std::string meanwhile =
-      "; retrying until it answers, and until then an episode starts only when the state is inside ~start_region";
+      "; retrying until it answers, and until then an episode starts only when the state is inside " +
+      names_(Setting::StartRegion);
+  const std::string service_setting = names_(Setting::ResetService);
+  const std::string type_setting = names_(Setting::ResetServiceType);
   if (found.kind == ServiceFound::Kind::Missing)
   {
     key = "missing";
     return {Level::Error, "reset service " + service_ + " is missing: no node advertises it. Start the node that " +
-                              "serves it, or set ~reset_service to the robot's reset service (\"\" for none: a " +
-                              "person stands the pole up)" + meanwhile};
+                              "serves it, or set " + service_setting +
+                              " to the robot's reset service (\"\" for none: a " + "person stands the pole up)" +
+                              meanwhile};
   }
   // "*" is what a server that takes any type answers (a relay): no type of its own to compare.
   const bool other_md5 = !found.md5sum.empty() && found.md5sum != "*" && found.md5sum != md5sum_;
@@ -66,11 +71,11 @@ LogLine ResetCalls::failure(const std::string& message, const ServiceFound& foun
       text += " of another definition than this controller's (md5sum " + found.md5sum + ", not " + md5sum_ +
               "): build both against the same " + type_;
     else if (std::find(resetServiceTypes().begin(), resetServiceTypes().end(), found.type) != resetServiceTypes().end())
-      text += ", not " + type_ + " as ~reset_service_type asks: set ~reset_service_type to " + found.type;
+      text += ", not " + type_ + " as " + type_setting + " asks: set " + type_setting + " to " + found.type;
     else
-      text += ", not " + type_ + " as ~reset_service_type asks, and ~reset_service_type can only be " +
-              "cartpole_qlearning/Reset, std_srvs/Empty or std_srvs/Trigger: set ~reset_service to a service of " +
-              "one of these (\"\" for none: a person stands the pole up)";
+      text += ", not " + type_ + " as " + type_setting + " asks, and " + type_setting + " can only be " +
+              "cartpole_qlearning/Reset, std_srvs/Empty or std_srvs/Trigger: set " + service_setting +
+              " to a service of " + "one of these (\"\" for none: a person stands the pole up)";
     return {Level::Error, text + meanwhile};
   }
   key = "failed";

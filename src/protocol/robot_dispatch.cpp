@@ -87,9 +87,9 @@ RobotDispatch::Orders RobotDispatch::onState(std::size_t r, Stamp stamp, const J
   const DecisionClock::Verdict decision = robot.decisions.onState(stamp);
   if (decision.slow && slow_states_warning_.ready(now))
     orders.log.push_back({LogLine::Level::Warn,
-                          formatText("joint_states on %s come further apart than ~decision_period = %g s, the step "
-                                     "the table learns",
-                                     robot.name.c_str(), params_.robot.decision_period)});
+                          formatText("joint_states on %s come further apart than %s = %g s, the step the table learns",
+                                     robot.name.c_str(), params_.names(Setting::DecisionPeriod).c_str(),
+                                     params_.robot.decision_period)});
   // A fall ends the running episode whenever it comes, not a period later.
   const bool falls =
       robot.protocol.phase() == ControllerProtocol::Phase::InEpisode && session_.task().isTerminal(state);
@@ -137,8 +137,8 @@ RobotDispatch::Orders RobotDispatch::onTick(WallClock::time_point now)
              ? formatText("no joint_states on %s for %.1f s: is its cartpole_sim running? Waiting for it",
                           robot.name.c_str(), params_.silent_after_s)
              : formatText("no joint_states on %s for %.1f s: no driver publishes them. Is the robot's driver running, "
-                          "and ~state_topic (robot.launch joint_states:=) the topic it publishes? Waiting for it",
-                          robot.name.c_str(), params_.silent_after_s)});
+                          "and %s the topic it publishes? Waiting for it",
+                          robot.name.c_str(), params_.silent_after_s, params_.names(Setting::StateTopic).c_str())});
   }
   for (const std::size_t r : rounds_.dropOuts(now))
     orders.log.push_back(
@@ -185,7 +185,7 @@ RobotDispatch::Turn RobotDispatch::serve(std::size_t r, Stamp stamp, const CartP
   turn.reaction = robot.protocol.onState(stamp, state);
   turn.log = reactionLog(
       turn.reaction, robot.protocol.counts(), robot.name, stampSeconds(stamp),
-      [&] { return dropped_state_warning_.ready(now); }, [&] { return restart_warning_.ready(now); });
+      [&] { return dropped_state_warning_.ready(now); }, [&] { return restart_warning_.ready(now); }, params_.names);
   if (turn.reaction.kind == Reaction::Kind::New)
     robot.guard.onDecision(stamp, now, turn.log);
   // An effort goes out only while the guard allows it (a repeat's answer after the bound, say).

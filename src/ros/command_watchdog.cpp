@@ -4,7 +4,8 @@
 #include "parameter_source.h"
 #include "start_up.h"
 
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/node_settings/node_setting_names.h"
+#include "cartpole_qlearning/node_settings/robot_settings.h"
 #include "cartpole_qlearning/ros/conversions.h"
 
 #include <algorithm>
@@ -39,7 +40,8 @@ CommandWatchdogNode::CommandWatchdogNode(const ros::NodeHandle& nh, const ros::N
     pnh_(pnh),
     name_(nodeLogger("command_watchdog", pnh.getNamespace())),
     watchdog_(
-        (readParameters(), std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(timeout_s_))))
+        (readParameters(), std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(timeout_s_))),
+        nodeSettingNames())
 {
   out_ = std::make_unique<CommandPublisher>(nh_, robot_.command_topic, robot_);
   // No Nagle delay on the way in: each command is one small message that the robot waits for.

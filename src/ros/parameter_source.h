@@ -2,7 +2,7 @@
 // learning keys with the same reader, defaults and checks as train_headless reads the YAML.
 #pragma once
 
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/node_settings/controller_settings.h"
 #include "cartpole_qlearning/learning/training_config.h"
 
 #include <ros/node_handle.h>

@@ -1,5 +1,6 @@
 #include "cartpole_qlearning/ros/qlearning_controller.h"
 
+#include "cartpole_qlearning/node_settings/node_setting_names.h"
 #include "cartpole_qlearning/ros/conversions.h"
 #include "command_publisher.h"
 #include "control_reporter.h"
@@ -39,8 +40,8 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   std::unique_lock<std::mutex> lock(mutex_);
   settings_ = readControllerParameters(nh_, pnh_, shutdown_by_default);
   session_ = std::make_unique<TrainingSession>(settings_.training.task, settings_.training.agent, settings_.run.seed,
-                                               settings_.run.learning, settings_.robots.size());
-  if (settings_.run.trace && settings_.run.learning)
+                                               settings_.run.learning(), settings_.robots.size());
+  if (settings_.run.trace && settings_.run.learning())
   {
     state_names_ = stateNames(settings_.training.agent);
     session_->setTrace([this](std::size_t robot, const TraceStep& step) {
@@ -55,7 +56,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   stats_pub_ = nh_.advertise<EpisodeStats>("episode_stats", 100);
   if (session_->findingDelay())
     delay_pub_ = pnh_.advertise<std_msgs::UInt32>("found_delay_steps", 1, true);
-  if (settings_.run.control)
+  if (settings_.run.controlling())
     control_ = std::make_unique<ControlReporter>(nh_, settings_.robots, settings_.training.physics.tau,
                                                  settings_.run.control_max_gap, settings_.robot.max_effort,
                                                  settings_.run.report_every, [this](const LogLines& log) { say(log); });
@@ -81,7 +82,7 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
 void QLearningControllerNode::checkParameters(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
 {
   const ControllerSettings settings = readControllerParameters(nh, pnh, true);
-  TrainingSession session(settings.training.task, settings.training.agent, settings.run.seed, settings.run.learning,
+  TrainingSession session(settings.training.task, settings.training.agent, settings.run.seed, settings.run.learning(),
                           settings.robots.size());
   RunApplication(settings.run, settings.training, session).checkStart();
 }
@@ -114,7 +115,7 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
   }
   const RobotDispatchParams dispatch{
       names,           settings_.sync,     settings_.sim_timeout, settings_.freshness_timeout,
-      settings_.robot, settings_.protocol, settings_.simulated};
+      settings_.robot, settings_.protocol, settings_.simulated,   settings_.run.names};
   dispatch_ = std::make_unique<RobotDispatch>(*session_, dispatch, WallClock::now());
 }
 
@@ -268,7 +269,7 @@ void QLearningControllerNode::startRun()
   }
   catch (const RunSettingError& e)
   {
-    refuseParameter(pnh_, e.name, e.value, e.why);
+    refuseParameter(pnh_, nodeParameterName(e.setting), e.value, e.why);
   }
   const RunIdentity identity = app_->identity();
   if (!app_->respawned() && !identity.id.empty())
@@ -369,7 +370,7 @@ void QLearningControllerNode::onReconfigure(LearningConfig& config, std::uint32_
   // What the server keeps, answers and publishes: the values in use (a refused change undone,
   // an override given as any negative number shown as -1).
   config = toConfig(session_->learningSettings());
-  say(liveTuningLog(in_use, wanted, asServerField(error), first && app_->respawned(), settings_.run.learning));
+  say(liveTuningLog(in_use, wanted, asServerField(error), first && app_->respawned(), settings_.run.learning()));
 }
 
 void QLearningControllerNode::say(const LogLines& log) const

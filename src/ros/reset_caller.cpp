@@ -3,6 +3,8 @@
 #include "cartpole_qlearning/Reset.h"
 #include "service_probe.h"
 
+#include "cartpole_qlearning/node_settings/node_setting_names.h"
+
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 #include <std_srvs/Trigger.h>
@@ -95,7 +97,7 @@ ResetCaller::ResetCaller(std::string service, std::string type, std::chrono::ste
   : service_(std::move(service)),
     type_(std::move(type)),
     log_(std::move(log)),
-    calls_(service_, type_, md5sumOf(type_), give_up_after),
+    calls_(service_, type_, md5sumOf(type_), give_up_after, std::chrono::milliseconds(200), nodeSettingNames()),
     shared_(std::make_shared<Shared>())
 {
   thread_ = std::thread(&ResetCaller::run, this);

@@ -3,6 +3,7 @@
 #include <mujoco/mujoco.h>
 
 #include <cmath>
+#include <functional>
 #include <cstddef>
 #include <cstring>
 #include <limits>
@@ -60,12 +61,58 @@ std::mutex& loadMutex()
   static std::mutex mutex;
   return mutex;
 }
+// Refuses physics/KEY = VALUE, saying why (throws EngineError).
+using Refusal = std::function<void(const std::string& key, const std::string& value, const std::string& why)>;
+
+// The joint `key` names, of the type the cart-pole needs (a slide for the cart, a hinge for the pole).
+int findJoint(const mjModel* m, const std::string& key, const std::string& name, int type, const std::string& needed,
+              const Refusal& fail)
+{
+  const int joint = mj_name2id(m, mjOBJ_JOINT, name.c_str());
+  if (joint < 0)
+    fail(key, name, "no such joint (its joints: " + jointList(m) + ")");
+  if (m->jnt_type[joint] != type)
+    fail(key, name, std::string("a ") + jointKind(m->jnt_type[joint]) + " joint; " + needed);
+  return joint;
+}
+
+// The force per unit of ctrl of the actuator, a motor on the cart's joint.
+double motorGear(const mjModel* m, const EngineParams& params, int actuator, int cart, const Refusal& fail)
+{
+  if (actuator < 0)
+    fail("actuator", params.actuator, "no such actuator (its actuators: " + actuatorList(m) + ")");
+  if (m->actuator_trntype[actuator] != mjTRN_JOINT || m->actuator_trnid[2 * actuator] != cart)
+    fail("actuator", params.actuator, "it does not act on physics/cart_joint '" + params.cart_joint + "'");
+  if (m->actuator_dyntype[actuator] != mjDYN_NONE || m->actuator_gaintype[actuator] != mjGAIN_FIXED ||
+      m->actuator_biastype[actuator] != mjBIAS_NONE)
+    fail("actuator", params.actuator, "not a motor (a force of gear x ctrl: no dynamics, a fixed gain, no bias)");
+  const double gear = m->actuator_gear[6 * actuator] * m->actuator_gainprm[mjNGAIN * actuator];
+  if (!(std::isfinite(gear) && gear != 0.0))
+    fail("actuator", params.actuator, "its gear times gain is 0: it gives no force");
+  return gear;
+}
+
+// The model's timesteps in one step of tau (the frame skip): a whole number of them.
+int wholeFrameSkip(const mjModel* m, double tau, const Refusal& fail)
+{
+  const double steps = tau / m->opt.timestep;
+  const int frame_skip = static_cast<int>(std::llround(steps));
+  if (!(std::isfinite(tau) && tau > 0.0 && frame_skip >= 1 && std::fabs(steps - frame_skip) <= 1e-9 * steps))
+  {
+    std::ostringstream why;
+    why << "not a whole number of the model's timestep " << m->opt.timestep << " s (the frame skip)";
+    std::ostringstream value;
+    value << tau;
+    fail("tau", value.str(), why.str());
+  }
+  return frame_skip;
+}
 }  // namespace
 
 MujocoEngine::MujocoEngine(const EngineParams& params, double tau) : params_(params), tau_(tau)
 {
   const std::string in_model = " in the model " + params.model;
-  const auto fail = [&](const std::string& key, const std::string& value, const std::string& why) {
+  const Refusal fail = [&](const std::string& key, const std::string& value, const std::string& why) {
     throw EngineError("physics/" + key + " = '" + value + "'" + in_model + ": " + why);
   };
   if (params.model.empty())
@@ -81,18 +128,8 @@ MujocoEngine::MujocoEngine(const EngineParams& params, double tau) : params_(par
   loaded_ = std::shared_ptr<const mjModel>(loaded, [](const mjModel* m) { mj_deleteModel(const_cast<mjModel*>(m)); });
   const mjModel* m = loaded;
 
-  const int cart = mj_name2id(m, mjOBJ_JOINT, params.cart_joint.c_str());
-  if (cart < 0)
-    fail("cart_joint", params.cart_joint, "no such joint (its joints: " + jointList(m) + ")");
-  if (m->jnt_type[cart] != mjJNT_SLIDE)
-    fail("cart_joint", params.cart_joint,
-         std::string("a ") + jointKind(m->jnt_type[cart]) + " joint; the cart's must be a slide joint");
-  const int pole = mj_name2id(m, mjOBJ_JOINT, params.pole_joint.c_str());
-  if (pole < 0)
-    fail("pole_joint", params.pole_joint, "no such joint (its joints: " + jointList(m) + ")");
-  if (m->jnt_type[pole] != mjJNT_HINGE)
-    fail("pole_joint", params.pole_joint,
-         std::string("a ") + jointKind(m->jnt_type[pole]) + " joint; the pole's must be a hinge joint");
+  const int cart = findJoint(m, "cart_joint", params.cart_joint, mjJNT_SLIDE, "the cart's must be a slide joint", fail);
+  const int pole = findJoint(m, "pole_joint", params.pole_joint, mjJNT_HINGE, "the pole's must be a hinge joint", fail);
   cart_body_ = m->jnt_bodyid[cart];
   pole_body_ = m->jnt_bodyid[pole];
   bool carried = false;
@@ -107,27 +144,8 @@ MujocoEngine::MujocoEngine(const EngineParams& params, double tau) : params_(par
   pole_dof_ = m->jnt_dofadr[pole];
 
   actuator_ = mj_name2id(m, mjOBJ_ACTUATOR, params.actuator.c_str());
-  if (actuator_ < 0)
-    fail("actuator", params.actuator, "no such actuator (its actuators: " + actuatorList(m) + ")");
-  if (m->actuator_trntype[actuator_] != mjTRN_JOINT || m->actuator_trnid[2 * actuator_] != cart)
-    fail("actuator", params.actuator, "it does not act on physics/cart_joint '" + params.cart_joint + "'");
-  if (m->actuator_dyntype[actuator_] != mjDYN_NONE || m->actuator_gaintype[actuator_] != mjGAIN_FIXED ||
-      m->actuator_biastype[actuator_] != mjBIAS_NONE)
-    fail("actuator", params.actuator, "not a motor (a force of gear x ctrl: no dynamics, a fixed gain, no bias)");
-  gear_ = m->actuator_gear[6 * actuator_] * m->actuator_gainprm[mjNGAIN * actuator_];
-  if (!(std::isfinite(gear_) && gear_ != 0.0))
-    fail("actuator", params.actuator, "its gear times gain is 0: it gives no force");
-
-  const double steps = tau / m->opt.timestep;
-  frame_skip_ = static_cast<int>(std::llround(steps));
-  if (!(std::isfinite(tau) && tau > 0.0 && frame_skip_ >= 1 && std::fabs(steps - frame_skip_) <= 1e-9 * steps))
-  {
-    std::ostringstream why;
-    why << "not a whole number of the model's timestep " << m->opt.timestep << " s (the frame skip)";
-    std::ostringstream value;
-    value << tau;
-    fail("tau", value.str(), why.str());
-  }
+  gear_ = motorGear(m, params, actuator_, cart, fail);
+  frame_skip_ = wholeFrameSkip(m, tau, fail);
 
   model_ = mj_copyModel(nullptr, m);
   data_ = mj_makeData(model_);

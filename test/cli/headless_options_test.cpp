@@ -225,7 +225,7 @@ TEST(HeadlessOptions, TheRunSettingsAreTheControllersParametersFromTheCommandLin
 {
   const HeadlessOptions training = parse("--seed 3 --save s.yaml --load l.yaml --checkpoint-every 7 --trace").options;
   const RunSettings t = headlessRunSettings(training, 3, "/tables", "/etc/c/config.yaml", "/pkg");
-  EXPECT_TRUE(t.learning);
+  EXPECT_TRUE(t.learning());
   EXPECT_EQ(3u, t.seed);
   EXPECT_EQ("/cartpole", t.name_space);
   EXPECT_EQ("/tables", t.q_table_dir);
@@ -257,7 +257,7 @@ TEST(HeadlessOptions, TheRunSettingsAreTheControllersParametersFromTheCommandLin
 
   const RunSettings evaluation =
       headlessRunSettings(parse("--evaluate t.yaml --episodes 20 --ns x").options, 0, "/t", "/c.yaml", "");
-  EXPECT_FALSE(evaluation.learning);
+  EXPECT_FALSE(evaluation.learning());
   EXPECT_EQ("t.yaml", evaluation.load_on_start);
   EXPECT_EQ(20u, evaluation.evaluation_episodes);
   EXPECT_EQ("/x", evaluation.name_space);

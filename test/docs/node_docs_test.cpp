@@ -3,7 +3,8 @@
 // that records every key asked for; the ROS layer's own reads (pnh_.getParam) are found in its
 // source. A parameter added to a reader without its line on the page, or a line left for one that
 // is gone, fails here with the names.
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/node_settings/controller_settings.h"
+#include "cartpole_qlearning/node_settings/sim_settings.h"
 
 #include "test_support.h"
 #include "text_match.h"

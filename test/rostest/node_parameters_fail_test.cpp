@@ -3,7 +3,7 @@
 // there. The node must exit non-zero (not crash, not hang) with a message naming the parameter
 // and the value. Ok cases, with valid values set the same way, prove the nodes read those
 // namespaces and stay up, so the ko cases cannot pass vacuously. Only this wiring is checked
-// here: the rules themselves are gtests of the core's readers (node_settings_test.cpp).
+// here: the rules themselves are gtests of the nodes' ROS-free readers (test/node_settings/node_settings_test.cpp).
 #include "cartpole_qlearning/simulation/physics_engines.h"
 
 #include "test_support.h"

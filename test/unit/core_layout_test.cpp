@@ -77,6 +77,23 @@ std::string readText(const fs::path& path)
   return text.str();
 }
 
+// The text without its includes of private headers beside it in its folder (#include "name.h",
+// a file of `folder`): a folder's own, as a layer's private headers in src/<layer>/ are.
+std::string withoutFolderIncludes(const std::string& text, const fs::path& folder)
+{
+  std::string kept;
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line))
+  {
+    text_match::Groups m;
+    const bool own = text_match::contains(line, R"re(^\s*#\s*include\s*"([a-z0-9_]+\.h)")re", &m) &&
+                     fs::is_regular_file(folder / m[1]);
+    kept += (own ? "" : line) + "\n";
+  }
+  return kept;
+}
+
 TEST(CoreLayoutTest, TheCheckRefusesRosHeadersAndGeneratedMessages)
 {
   const auto core = [](const std::string& name) { return name == "learning/q_table.h"; };
@@ -119,7 +136,7 @@ TEST(CoreLayoutTest, NoCoreFileIncludesAHeaderFromOutsideTheCoreOrFromALayerAbov
         ASSERT_TRUE(entry.is_regular_file()) << entry.path() << ": a layer's folder holds files only";
         ++files;
         const auto allowed = [&layer](const std::string& name) { return isHeaderAtOrBelow(layer, name); };
-        for (const std::string& line : foreignIncludes(readText(entry.path()), allowed))
+        for (const std::string& line : foreignIncludes(withoutFolderIncludes(readText(entry.path()), folder), allowed))
         {
           // The MuJoCo engine, its own library (physics_engines.h), alone includes MuJoCo's headers.
           if (entry.path().filename() == "mujoco_engine.cpp" &&
@@ -137,6 +154,111 @@ TEST(CoreLayoutTest, NoCoreFileIncludesAHeaderFromOutsideTheCoreOrFromALayerAbov
   for (const fs::path& folder : {kSource / "src", kSource / "include" / "cartpole_qlearning"})
     for (const fs::directory_entry& entry : fs::directory_iterator(folder))
       EXPECT_FALSE(entry.is_regular_file()) << entry.path() << " lies outside the layers' folders";
+}
+
+TEST(CoreLayoutTest, TheNodesSettingsIncludeNoRosHeader)
+{
+  // The nodes' settings (src/node_settings/) are read without ROS, for their tests to run with YAML
+  // text and no master: they may include the whole core and their own headers, nothing of ROS.
+  const fs::path include = kSource / "include" / "cartpole_qlearning";
+  const auto allowed = [&include](const std::string& name) {
+    const std::string folder = name.substr(0, name.find('/'));
+    return (layerRank(folder) < kLayers.size() || folder == "node_settings") && fs::is_regular_file(include / name);
+  };
+  std::size_t files = 0;
+  for (const fs::path& folder : {kSource / "src" / "node_settings", include / "node_settings"})
+  {
+    ASSERT_TRUE(fs::is_directory(folder)) << folder;
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+    {
+      ++files;
+      // The folder's private headers ("settings_parts.h") are its own.
+      for (const std::string& line : foreignIncludes(withoutFolderIncludes(readText(entry.path()), folder), allowed))
+        ADD_FAILURE() << entry.path().string() << " " << line << ": the nodes' settings include no ROS header";
+    }
+  }
+  EXPECT_GT(files, 5u);
+}
+
+// The string literals of a C++ text, comments left out ("a" "b" are two; escapes kept as written).
+std::vector<std::string> stringLiterals(const std::string& text)
+{
+  std::vector<std::string> literals;
+  for (std::size_t i = 0; i < text.size(); ++i)
+  {
+    if (text.compare(i, 2, "//") == 0)
+      i = std::min(text.find('\n', i), text.size());
+    else if (text.compare(i, 2, "/*") == 0)
+      i = std::min(text.find("*/", i + 2), text.size()) + 1;
+    else if (text[i] == '\'')
+      for (++i; i < text.size() && text[i] != '\''; ++i)
+        i += text[i] == '\\' ? 1 : 0;
+    else if (text.compare(i, 2, "R\"") == 0)
+    {
+      const std::size_t open = text.find('(', i);
+      const std::string close = ")" + text.substr(i + 2, open - i - 2) + "\"";
+      const std::size_t end = text.find(close, open);
+      literals.push_back(text.substr(open + 1, end - open - 1));
+      i = end + close.size() - 1;
+    }
+    else if (text[i] == '"')
+    {
+      std::string literal;
+      for (++i; i < text.size() && text[i] != '"'; ++i)
+      {
+        if (text[i] == '\\')
+          literal += text[i++];
+        literal += text[i];
+      }
+      literals.push_back(literal);
+    }
+  }
+  return literals;
+}
+
+// What in a string names a setting as one front end's users type it: a private parameter
+// ("~max_effort"; "~/" is a home), a launch argument ("joint_states:=") or an option ("--save").
+std::vector<std::string> frontEndNames(const std::string& literal)
+{
+  std::vector<std::string> found;
+  for (const text_match::Groups& m : text_match::allMatches(
+           literal, R"re((^|[^A-Za-z0-9_])(~[a-z][a-z0-9_/]*|[a-z][a-z0-9_]*:=|--[a-z][a-z0-9-]*))re"))
+    found.push_back(m[2]);
+  return found;
+}
+
+TEST(CoreLayoutTest, TheNameCheckFindsParametersLaunchArgumentsAndOptions)
+{
+  EXPECT_EQ(stringLiterals("f(\"a\", 'b', \"c\\\"d\"); // \"e\"\n/* \"f\" */ R\"x(g)x\""),
+            (std::vector<std::string>{"a", "c\\\"d", "g"}));
+  EXPECT_EQ(frontEndNames("set ~load_on_start to a table"), std::vector<std::string>{"~load_on_start"});
+  EXPECT_EQ(frontEndNames("(robot.launch joint_states:=)"), std::vector<std::string>{"joint_states:="});
+  EXPECT_EQ(frontEndNames("give --save, or --ns"), (std::vector<std::string>{"--save", "--ns"}));
+  EXPECT_TRUE(frontEndNames("~/tables, ~, a--b, --> 3, 5 -- 6, x := y").empty());
+}
+
+TEST(CoreLayoutTest, NoCoreStringNamesAParameterALaunchArgumentOrAnOption)
+{
+  // The core takes values and says what it did with them; which parameter or option set a value
+  // is the front end's to say (common/setting_names.h: the core asks it by Setting).
+  std::size_t literals = 0;
+  for (const std::string& layer : kLayers)
+  {
+    for (const fs::path& folder : {kSource / "src" / layer, kSource / "include" / "cartpole_qlearning" / layer})
+    {
+      for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+      {
+        for (const std::string& literal : stringLiterals(readText(entry.path())))
+        {
+          ++literals;
+          for (const std::string& name : frontEndNames(literal))
+            ADD_FAILURE() << entry.path().string() << ": \"" << literal << "\" names " << name
+                          << ": name the Setting instead (common/setting_names.h), for the front end to spell";
+        }
+      }
+    }
+  }
+  EXPECT_GT(literals, 1000u) << "the core's strings were not found under " << kSource;
 }
 
 // What in a file's text names a particular engine (its kind, or its name as a string): only the
@@ -230,6 +352,9 @@ TEST(CoreLayoutTest, TheLayoutTableListsTheTreeAsItIs)
        true},
       {"`include/cartpole_qlearning/application/`, `src/application/`",
        {include / "application", kSource / "src" / "application"},
+       true},
+      {"`include/cartpole_qlearning/node_settings/`, `src/node_settings/`",
+       {include / "node_settings", kSource / "src" / "node_settings"},
        true},
       {"`include/cartpole_qlearning/ros/`, `src/ros/`", {include / "ros", kSource / "src" / "ros"}, true},
       {"`src/cli/`", {kSource / "src" / "cli"}, true},

@@ -6,7 +6,8 @@
 // ends training.
 #pragma once
 
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/application/run_settings.h"
+#include "cartpole_qlearning/common/setting_names.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/application/run_folder.h"
 #include "cartpole_qlearning/common/log_line.h"
@@ -26,9 +27,10 @@ public:
   // config: training/suite, suite_every, best_every, until and progress_every (the cadence of the
   // lines for tables not kept); the physics the suite's cases vary.
   // learning: false (evaluating) keeps no suite, unless control (a table about to drive a robot:
-  // judgeBeforeControl). suite_folders: where a relative suite is looked for, in order.
+  // judgeBeforeControl). suite_folders: where a relative suite is looked for, in order. names:
+  // how the front end names its settings (the command a complete evaluation takes).
   BestTableKeeper(const TrainingConfig& config, bool learning, std::vector<std::string> suite_folders,
-                  bool control = false);
+                  bool control = false, SettingNames names = {});
 
   // Finds and reads the suite (training, unless training/suite is none). Throws ConfigError when
   // training evaluates it (suite_every > 0); else says that the run ends without a verdict.
@@ -81,6 +83,7 @@ private:
   bool learning_;
   bool control_;
   std::vector<std::string> suite_folders_;
+  SettingNames names_;
   std::unique_ptr<RobustnessSuite> suite_;  // none: no verdict (training/suite none, or not found)
   std::string suite_path_;
   std::optional<BestTable> best_;

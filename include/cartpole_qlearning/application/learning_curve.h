@@ -10,9 +10,10 @@
 // happens to it on a respawn (it goes on) or a loaded table (it starts over).
 #pragma once
 
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/application/run_settings.h"
 #include "cartpole_qlearning/application/run_folder.h"
 #include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/io/appending_file.h"
 #include "cartpole_qlearning/io/file_access.h"
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/learning/training_session.h"
@@ -63,14 +64,15 @@ private:
   AppendingFile file_;
 };
 
-// A setting the run cannot work with (a ~stats_csv that cannot be written): a ConfigError that
-// keeps the parameter's name (without "~"), its value and why, so that the node names the
-// parameter as it names its others. what(): "~NAME = VALUE is not allowed (WHY)".
+// A setting the run cannot work with (a learning curve's file that cannot be written): a
+// ConfigError that keeps which setting, its value and why, so that each front end names the
+// setting as it names its others. what(): "NAME = VALUE is not allowed (WHY)", NAME as `names`
+// says it.
 class RunSettingError : public ConfigError
 {
 public:
-  RunSettingError(const std::string& name, const std::string& value, const std::string& why);
-  std::string name;
+  RunSettingError(Setting setting, const SettingNames& names, const std::string& value, const std::string& why);
+  Setting setting;
   std::string value;
   std::string why;
 };
@@ -100,7 +102,7 @@ private:
   void open(std::uint64_t episodes, LogLines& log);
 
   std::string stats_csv_;
-  std::string silenced_by_;  // the setting whose "none" asks for no curve, as the user names it
+  SettingNames names_;  // how the front end names the settings (the curve file's, whose "none" asks for none)
   std::string table_dir_;
   bool learning_;
   bool run_folder_;

@@ -16,7 +16,7 @@
 
 #include "cartpole_qlearning/application/best_table_keeper.h"
 #include "cartpole_qlearning/application/learning_curve.h"
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/application/run_settings.h"
 #include "cartpole_qlearning/application/run_folder.h"
 #include "cartpole_qlearning/application/run_meters.h"
 #include "cartpole_qlearning/application/table_store.h"

@@ -6,7 +6,7 @@
 // replaced only by a solved run or an explicit save (RunApplication decides which).
 #pragma once
 
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/application/run_settings.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/application/table_store.h"
 #include "cartpole_qlearning/common/log_line.h"

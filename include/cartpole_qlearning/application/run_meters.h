@@ -3,7 +3,7 @@
 // evaluation's episodes and verdict. The clock is injected, so that tests drive it.
 #pragma once
 
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/application/run_settings.h"
 #include "cartpole_qlearning/common/log_line.h"
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/learning/training_session.h"

@@ -30,11 +30,6 @@ void saveQTableUnder(const QTable& table, const std::string& directory, const st
 QTable loadQTableFile(const std::string& path, std::uint64_t max_bytes = kMaxFileBytes);
 QTable loadQTableUnder(const std::string& directory, const std::string& path, std::uint64_t max_bytes = kMaxFileBytes);
 
-// Where a controller in this ROS namespace keeps its tables unless told otherwise, and where
-// train_headless saves a relative --save path: $ROS_HOME/cartpole_qlearning<namespace>
-// ($ROS_HOME defaults to ~/.ros), e.g. ~/.ros/cartpole_qlearning/cartpole for "/cartpole".
-std::string defaultTableDirectory(const std::string& name_space);
-
 // The document's text and its parse, separately (save and load are these plus file handling).
 std::string formatQTable(const QTable& table);
 QTable parseQTable(const std::string& text);

@@ -16,6 +16,7 @@
 #pragma once
 
 #include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/common/setting_names.h"
 #include "cartpole_qlearning/protocol/lockstep_protocol.h"
 
 #include <cstddef>
@@ -35,8 +36,8 @@ public:
 
   // timeout: 0 when no command came for this long while the robot may be pushed; zero: no timeout
   // (a lockstep sim, which holds no command and waits for each one): only a lost controller and
-  // the watchdog's own end send 0.
-  explicit CommandWatchdog(WallClock::duration timeout);
+  // the watchdog's own end send 0. names: how the front end names the timeout, for what is said.
+  explicit CommandWatchdog(WallClock::duration timeout, SettingNames names = {});
 
   // A command from the controller, its effort as the robot takes it. A command that comes while
   // the controller's publishers are known to be gone (one still in flight when it died) is
@@ -60,6 +61,7 @@ private:
   Action stop(const std::string& why, LogLines& log);
 
   WallClock::duration timeout_;
+  SettingNames names_;
   bool pushing_ = false;
   std::optional<WallClock::time_point> last_command_;
   std::size_t publishers_ = 0;

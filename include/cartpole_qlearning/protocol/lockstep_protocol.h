@@ -69,6 +69,7 @@
 #include "cartpole_qlearning/simulation/cartpole_dynamics.h"
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/common/setting_names.h"
 #include "cartpole_qlearning/learning/training_session.h"
 
 #include <chrono>
@@ -282,6 +283,7 @@ public:
 
 private:
   Reaction onNewState(Reaction reaction, const CartPoleState& state);
+  void onEpisodeState(Reaction& reaction, const CartPoleState& state);
   void begin(Reaction& reaction, const CartPoleState& state);
   void answer(Reaction& reaction, double effort);
   // Asks for a reset and awaits its start.
@@ -313,9 +315,10 @@ private:
 
 // What the controller says about a state that was not simply answered: robot names the robot
 // (its joint_states topic), stamp_s is the state's stamp [s]. A dropped state and a restart are
-// said only when dropped_ready() and restart_ready() (the node's throttles) allow it.
+// said only when dropped_ready() and restart_ready() (the node's throttles) allow it. names: how
+// the front end names the start region.
 LogLines reactionLog(const Reaction& reaction, const ControllerProtocol::Counts& counts, const std::string& robot,
                      double stamp_s, const std::function<bool()>& dropped_ready,
-                     const std::function<bool()>& restart_ready);
+                     const std::function<bool()>& restart_ready, const SettingNames& names = {});
 
 }  // namespace cartpole_qlearning

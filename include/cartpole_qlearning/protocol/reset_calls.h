@@ -35,6 +35,7 @@
 #pragma once
 
 #include "cartpole_qlearning/common/log_line.h"
+#include "cartpole_qlearning/common/setting_names.h"
 
 #include <chrono>
 #include <cstdint>
@@ -96,9 +97,11 @@ public:
 
   // service: the service's name, for what is said; type and md5sum: the type the calls are made
   // with (~reset_service_type) and its md5sum, to tell a service of another type; give_up_after:
-  // see resetGiveUpAfter(); retry_after: how long a failing robot is left alone between calls.
+  // see resetGiveUpAfter(); retry_after: how long a failing robot is left alone between calls;
+  // names: how the front end names the settings a failure points at (the reset service, its type,
+  // the start region).
   ResetCalls(std::string service, std::string type, std::string md5sum, Clock::duration give_up_after,
-             Clock::duration retry_after = std::chrono::milliseconds(200));
+             Clock::duration retry_after = std::chrono::milliseconds(200), SettingNames names = {});
 
   // A reset is wanted.
   Orders request(Clock::time_point now);
@@ -139,6 +142,7 @@ private:
   // What to say about a failed call, and the key that tells whether it was said already.
   LogLine failure(const std::string& message, const ServiceFound& found, std::string& key) const;
 
+  SettingNames names_;
   std::string service_;
   std::string type_;
   std::string md5sum_;

@@ -41,6 +41,7 @@ struct RobotDispatchParams
   // The robots are cartpole_sims (their reset service is a cartpole_sim's): what the silence
   // warning asks about; else a robot's driver.
   bool simulated = true;
+  SettingNames names;  // how the front end names the settings the warnings point at
 };
 
 class RobotDispatch

@@ -9,7 +9,7 @@
 #include "cartpole_qlearning/Reset.h"
 #include "cartpole_qlearning/simulation/cartpole_simulation.h"
 #include "cartpole_qlearning/protocol/lockstep_protocol.h"
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/node_settings/sim_settings.h"
 #include "cartpole_qlearning/protocol/robot_interface.h"
 #include "cartpole_qlearning/common/wall_throttle.h"
 

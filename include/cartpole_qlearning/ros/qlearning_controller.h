@@ -18,7 +18,7 @@
 #include "cartpole_qlearning/LoadQTable.h"
 #include "cartpole_qlearning/SaveQTable.h"
 #include "cartpole_qlearning/learning/training_config.h"
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/node_settings/controller_settings.h"
 #include "cartpole_qlearning/application/run_application.h"
 #include "cartpole_qlearning/common/wall_throttle.h"
 #include "cartpole_qlearning/learning/training_session.h"

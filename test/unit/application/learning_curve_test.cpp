@@ -3,6 +3,7 @@
 // or an episode; a file that is not a curve, or cannot be opened, is refused and left alone. And
 // a run's curve: where it goes, when it opens.
 #include "cartpole_qlearning/application/learning_curve.h"
+#include "cartpole_qlearning/node_settings/node_setting_names.h"
 
 #include "test_support.h"
 
@@ -206,6 +207,7 @@ protected:
   {
     LearningCurveFileTest::SetUp();
     settings_.q_table_dir = dir_.string();
+    settings_.names = nodeSettingNames();
     tables_ = std::make_unique<TableStore>(dir_.string(), "q_table.yaml", AbsolutePaths::MustLieInTheFolder);
   }
   // The run's folder, opened as at the start of training.
@@ -280,7 +282,7 @@ TEST_F(LearningCurveTest, AUsersFileIsOpenedBeforeTheRunAndOneThatIsNotACurveSto
   }
   catch (const RunSettingError& e)
   {
-    EXPECT_EQ("stats_csv", e.name);
+    EXPECT_EQ("stats_csv", nodeParameterName(e.setting));
     EXPECT_EQ("'notes.txt'", e.value);
   }
   EXPECT_EQ("my notes\n", text("notes.txt"));
@@ -299,7 +301,7 @@ TEST_F(LearningCurveTest, NoneOrAnEvaluationWritesNoCurve)
   none.start(0, log);
   none.write("", episode(1), log);
   settings_.stats_csv = "";
-  settings_.learning = false;
+  settings_.mode = RunMode::Evaluate;
   LearningCurve evaluation(settings_, folder, [] { return 0.0; });
   evaluation.start(0, log);
   evaluation.write("", episode(1), log);

@@ -8,6 +8,8 @@
 #include "cartpole_qlearning/learning/training_config.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
 #include "cartpole_qlearning/application/run_application.h"
+#include "cartpole_qlearning/node_settings/node_setting_names.h"
+#include "headless_options.h"
 
 #include "test_support.h"
 #include "text_match.h"
@@ -41,6 +43,7 @@ protected:
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     settings_.q_table_dir = dir_.string();
+    settings_.names = nodeSettingNames();
     settings_.run_id = "run_host_1_2";
     settings_.suite_folders = {CARTPOLE_CONFIG_DIR};
     // Episodes of 5 steps; solved when the last 2 episodes balanced (return 5 each).
@@ -68,7 +71,7 @@ protected:
   {
     Run run;
     run.session =
-        std::make_unique<TrainingSession>(config_.task, config_.agent, settings_.seed, settings_.learning, robots_);
+        std::make_unique<TrainingSession>(config_.task, config_.agent, settings_.seed, settings_.learning(), robots_);
     run.app = std::make_unique<RunApplication>(settings_, config_, *run.session, clocks_);
     run.started = run.app->start(previous, launcher);
     return run;
@@ -256,7 +259,7 @@ TEST_F(RunApplicationTest, AFolderThatCannotBeMadeIsSaidAtTheStart)
 
 TEST_F(RunApplicationTest, TrainHeadlessRunsNameItsOptionsNotTheNodesParameters)
 {
-  settings_.command_line = true;
+  settings_.names = headlessSettingNames();
   std::ofstream(dir_ / "runs") << "not a folder";
   Run run = startRun();
   EXPECT_NE(std::string::npos, log(run.started, "cannot make this run's folder")
@@ -494,7 +497,7 @@ TEST_F(RunApplicationTest, AStatsCsvOfTheUsersOwnIsOpenedAtTheStartOrRefused)
   }
   catch (const RunSettingError& e)
   {
-    EXPECT_EQ("stats_csv", e.name);
+    EXPECT_EQ("stats_csv", nodeParameterName(e.setting));
     EXPECT_EQ("'notes.txt'", e.value);
     EXPECT_EQ(0u, std::string(e.what()).rfind("~stats_csv = 'notes.txt' is not allowed (", 0)) << e.what();
   }
@@ -721,7 +724,7 @@ TEST_F(RunApplicationTest, TheShutdownSaveIsIntoTheRunsFolderWhenTrainingAndNotS
 
 TEST_F(RunApplicationTest, EvaluationGivesItsVerdictAfterItsEpisodesAndWritesNothing)
 {
-  settings_.learning = false;
+  settings_.mode = RunMode::Evaluate;
   settings_.evaluation_episodes = 3;
   Run run = startRun();
   EXPECT_EQ(LogLine::Level::Warn,
@@ -749,7 +752,7 @@ TEST_F(RunApplicationTest, EvaluationGivesItsVerdictAfterItsEpisodesAndWritesNot
 
 TEST_F(RunApplicationTest, AnEvaluationOfASuiteCaseSaysTheCaseAndItsVerdict)
 {
-  settings_.learning = false;
+  settings_.mode = RunMode::Evaluate;
   settings_.evaluation_episodes = 2;
   settings_.evaluation_case = "case one_step_late of robust_suite.yaml";
   for (const auto& [pass, verdict] :
@@ -768,7 +771,7 @@ TEST_F(RunApplicationTest, AnEvaluationOfASuiteCaseSaysTheCaseAndItsVerdict)
 
 TEST_F(RunApplicationTest, EvaluationWithoutEpisodeCountNeverEnds)
 {
-  settings_.learning = false;
+  settings_.mode = RunMode::Evaluate;
   settings_.evaluation_episodes = 0;
   Run run = startRun();
   for (int i = 0; i < 5; ++i)
@@ -905,7 +908,7 @@ TEST_F(RunApplicationTest, LoadOnStartTakesATableOrStopsTheStart)
             log(run.started, "loaded").text);
   EXPECT_EQ(2u, run.session->episodesEnded());  // training goes on from its counts
   // Evaluation counts its own episodes.
-  settings_.learning = false;
+  settings_.mode = RunMode::Evaluate;
   Run evaluation = startRun();
   EXPECT_EQ(0u, evaluation.session->episodesEnded());
   EXPECT_FALSE(says(evaluation.started, "table of zeros"));
@@ -1353,7 +1356,7 @@ TEST_F(RunApplicationTest, ATableThatContradictsTheConfigurationIsRefusedNamingB
   settings_.config_origin = "config/mine.yaml";
   for (const bool learning : {true, false})
   {
-    settings_.learning = learning;
+    settings_.mode = learning ? RunMode::Train : RunMode::Evaluate;
     try
     {
       startRun();
@@ -1375,7 +1378,7 @@ TEST_F(RunApplicationTest, ATableThatContradictsTheConfigurationIsRefusedNamingB
 TEST_F(RunApplicationTest, AnEvaluationSaysWhatItsTableLeavesToTheDefaults)
 {
   saveQTableFile(QTable(config_.agent.featureParams(), config_.agent.actions), (dir_ / "v2.yaml").string());
-  settings_.learning = false;
+  settings_.mode = RunMode::Evaluate;
   settings_.load_on_start = "v2.yaml";
   settings_.config_warning = "the table says no configuration";
   const Run run = startRun();
@@ -1386,13 +1389,13 @@ TEST_F(RunApplicationTest, AnEvaluationOrControlRunDecidesForThePredictedStateIt
 {
   // The node's ~predict_delay_steps and train_headless's --predict-delay reach the session through
   // the run's settings; a training run cannot take one (the settings refuse it first: a backstop).
-  settings_.learning = false;
+  settings_.mode = RunMode::Evaluate;
   settings_.predict_delay_steps = 2;
   TrainingSession greedy(config_.task, config_.agent, settings_.seed, false);
   const RunApplication evaluation(settings_, config_, greedy, clocks_);
   EXPECT_EQ(2u, greedy.predictedDelaySteps());
 
-  settings_.learning = true;
+  settings_.mode = RunMode::Train;
   TrainingSession learning(config_.task, config_.agent, settings_.seed, true);
   EXPECT_THROW(RunApplication(settings_, config_, learning, clocks_), std::invalid_argument);
   settings_.predict_delay_steps = 0;
@@ -1407,8 +1410,7 @@ TEST_F(RunApplicationTest, ATableAboutToDriveARobotIsJudgedByItsSuiteFirstAndAFa
   const QTable robust = loadQTableFile(CARTPOLE_SOURCE_DIR "/bench/robust_table.yaml");
   config_ = tableConfig(robust, "robust_table.yaml").config;
   fs::copy_file(CARTPOLE_SOURCE_DIR "/bench/robust_table.yaml", dir_ / "robust.yaml");
-  settings_.learning = false;
-  settings_.control = true;
+  settings_.mode = RunMode::Control;
   settings_.load_on_start = "robust.yaml";
   const Run passing = startRun();
   const std::string suite = std::string(CARTPOLE_CONFIG_DIR) + "/" + config_.limits.suite;
@@ -1428,6 +1430,6 @@ TEST_F(RunApplicationTest, ATableAboutToDriveARobotIsJudgedByItsSuiteFirstAndAFa
   EXPECT_EQ(0u, said.text.rfind("this table FAILS the robustness suite " + suite + ": ", 0)) << said.text;
   EXPECT_NE(std::string::npos, said.text.find("watch the robot")) << said.text;
   // Evaluating says nothing of it (its own verdict is the evaluation).
-  settings_.control = false;
+  settings_.mode = RunMode::Evaluate;
   EXPECT_FALSE(says(startRun().started, "robustness suite"));
 }

@@ -595,25 +595,6 @@ TEST_F(QTableFileTest, ATableOfOtherFeaturesIsRefusedSayingWhatDiffers)
   EXPECT_TRUE(bitIdentical(bins_live, bins_session.table().values()));
 }
 
-TEST(DefaultTableDirectory, EachNamespaceHasAFolderOfItsOwnUnderRosHome)
-{
-  // What train.launch ns:=NAME relies on: two namespaces never share (or write) each other's tables.
-  const char* before = std::getenv("ROS_HOME");
-  const std::string saved = before != nullptr ? before : "";
-  ::setenv("ROS_HOME", "/somewhere/ros_home", 1);
-  EXPECT_EQ("/somewhere/ros_home/cartpole_qlearning/cartpole", defaultTableDirectory("/cartpole"));
-  EXPECT_EQ("/somewhere/ros_home/cartpole_qlearning/first", defaultTableDirectory("/first"));
-  EXPECT_EQ("/somewhere/ros_home/cartpole_qlearning/second", defaultTableDirectory("/second"));
-  EXPECT_EQ("/somewhere/ros_home/cartpole_qlearning/fleet/robot_1", defaultTableDirectory("/fleet/robot_1"));
-  EXPECT_EQ("/somewhere/ros_home/cartpole_qlearning", defaultTableDirectory("/"));
-  ::unsetenv("ROS_HOME");
-  const char* home = std::getenv("HOME");
-  EXPECT_EQ(std::string(home != nullptr ? home : ".") + "/.ros/cartpole_qlearning/first",
-            defaultTableDirectory("/first"));
-  if (before != nullptr)
-    ::setenv("ROS_HOME", saved.c_str(), 1);
-}
-
 TEST_F(QTableFileTest, APreviousActionTableSaysSoAndAnOlderFileLoadsWithout)
 {
   FeatureParams f;

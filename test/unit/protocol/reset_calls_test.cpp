@@ -2,6 +2,8 @@
 // (milliseconds from 0).
 #include "cartpole_qlearning/protocol/reset_calls.h"
 
+#include "cartpole_qlearning/node_settings/node_setting_names.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -35,7 +37,7 @@ ResetCalls::Clock::time_point ms(std::int64_t n)
 
 ResetCalls resetCalls()
 {
-  return ResetCalls(kService, kType, kMd5, kGiveUpAfter);
+  return ResetCalls(kService, kType, kMd5, kGiveUpAfter, std::chrono::milliseconds(200), nodeSettingNames());
 }
 
 // Nothing to do: no call, no give-up, nothing said.
@@ -243,7 +245,8 @@ const ServiceFound kMissing{ServiceFound::Kind::Missing, "", ""};
 TEST(ResetCallsTest, AServiceOfAnotherTypeIsNamedOnceAsAnErrorWithTheParameterToSet)
 {
   // Told std_srvs/Trigger; the sim serves cartpole_qlearning/Reset.
-  ResetCalls reset(kService, "std_srvs/Trigger", "trigger-md5", kGiveUpAfter);
+  ResetCalls reset(kService, "std_srvs/Trigger", "trigger-md5", kGiveUpAfter, std::chrono::milliseconds(200),
+                   nodeSettingNames());
   ASSERT_TRUE(makesCall(reset.request(ms(0)), 0, true));
   const char* const wrong_type =
       "reset service /robot_1/cartpole_sim/reset serves cartpole_qlearning/Reset, not std_srvs/Trigger as "

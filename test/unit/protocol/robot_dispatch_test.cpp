@@ -5,6 +5,7 @@
 #include "cartpole_qlearning/application/headless_trainer.h"
 #include "lockstep_loopback.h"
 #include "cartpole_qlearning/protocol/robot_dispatch.h"
+#include "cartpole_qlearning/node_settings/node_setting_names.h"
 
 #include <gtest/gtest.h>
 
@@ -74,6 +75,7 @@ protected:
   {
     session_ = std::make_unique<TrainingSession>(config_.task, config_.agent, 0, true, robots);
     params_.robots = robotNames(robots);
+    params_.names = nodeSettingNames();
     params_.sync = sync;
     params_.silent_after_s = 1.0;
     params_.robot.decision_period = 0.02;

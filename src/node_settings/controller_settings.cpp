@@ -1,19 +1,20 @@
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/node_settings/controller_settings.h"
 
+#include "settings_parts.h"
+
+#include "cartpole_qlearning/application/table_store.h"
 #include "cartpole_qlearning/io/file_access.h"
 #include "cartpole_qlearning/learning/delay_predictor.h"
-#include "cartpole_qlearning/learning/q_table_file.h"
-#include "cartpole_qlearning/application/robustness_suite.h"
-#include "cartpole_qlearning/application/table_store.h"
 #include "cartpole_qlearning/learning/table_config.h"
+#include "cartpole_qlearning/node_settings/node_setting_names.h"
+#include "cartpole_qlearning/node_settings/robot_settings.h"
+#include "cartpole_qlearning/node_settings/table_folder.h"
 #include "cartpole_qlearning/protocol/reset_calls.h"
-#include "cartpole_qlearning/simulation/engine_registry.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <utility>
 
 namespace cartpole_qlearning
@@ -25,50 +26,6 @@ constexpr std::int64_t kMaxRobots = 1000;
 bool endsWith(const std::string& text, const std::string& end)
 {
   return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
-}
-
-// A value of any form as messages show it (for a key whose forms are all wrong).
-std::string anyValueText(const ParameterSource& source, const std::string& key)
-{
-  const auto quoted = [](const std::string& text) { return "'" + text + "'"; };
-  try
-  {
-    std::string text;
-    if (source.get(key, text))
-      return quoted(text);
-  }
-  catch (const ConfigError&)
-  {
-  }
-  try
-  {
-    double number = 0.0;
-    if (source.get(key, number))
-      return SectionReader::numberText(number);
-  }
-  catch (const ConfigError&)
-  {
-  }
-  try
-  {
-    bool flag = false;
-    if (source.get(key, flag))
-      return flag ? "true" : "false";
-  }
-  catch (const ConfigError&)
-  {
-  }
-  try
-  {
-    std::vector<double> numbers;
-    if (source.get(key, numbers))
-      return SectionReader::listText(numbers);
-  }
-  catch (const ConfigError&)
-  {
-  }
-  const std::vector<std::string> keys = source.keysUnder(key);
-  return keys.size() == 1 && keys.front() == key ? "a list of mixed values" : "a map";
 }
 
 std::string listText(const std::vector<std::string>& names)
@@ -127,97 +84,17 @@ void readRobots(const ParameterSource& source, SectionReader& priv, const Contro
   robots = std::move(names);
 }
 
-// ~suite and ~suite_case (the sim and the controller alike): the case, loaded with the suite's
-// episodes and seed, or nullopt when no case is named. base: the physics the cases vary.
-std::optional<std::pair<RobustnessSuite, SuiteCase>> readSuiteCase(SectionReader& priv, const TrainingConfig& base)
-{
-  std::string path;
-  std::string name;
-  priv.read("suite", path);
-  priv.read("suite_case", name);
-  if (name.empty())
-    return std::nullopt;
-  if (path.empty())
-    priv.fail("suite_case", "'" + name + "'", "needs ~suite, the suite file that holds the case");
-  const RobustnessSuite suite = loadRobustnessSuite(path, base);
-  std::string names;
-  for (const SuiteCase& c : suite.cases)
-  {
-    if (c.name == name)
-      return std::make_pair(suite, c);
-    names += (names.empty() ? "" : ", ") + c.name;
-  }
-  priv.fail("suite_case", "'" + name + "'", "the cases of " + path + ": " + names);
-}
-
-void readSign(SectionReader& priv, const std::string& name, double& sign)
-{
-  priv.read(name, sign);
-  if (sign != 1.0 && sign != -1.0)
-    priv.fail(name, SectionReader::numberText(sign), "must be 1 or -1");
-}
-
-void readFinite(SectionReader& priv, const std::string& name, double& value)
-{
-  priv.read(name, value);
-  if (!std::isfinite(value))
-    priv.fail(name, SectionReader::numberText(value), "must be finite");
-}
-
-}  // namespace
-
-void readRobotCommand(SectionReader& priv, RobotInterfaceParams& robot)
-{
-  std::string type = "joint_state";
-  priv.readChoice("command_type", type, {"joint_state", "float64", "float64_array"});
-  robot.command_type = type == "float64"         ? CommandType::Float64
-                       : type == "float64_array" ? CommandType::Float64Array
-                                                 : CommandType::JointState;
-  robot.command_joint = robot.cart_joint;
-  priv.read("command_joint", robot.command_joint);
-  if (robot.command_joint.empty())
-    priv.fail("command_joint", "''", "must name the cart's joint as the robot takes commands for it");
-  std::uint64_t index = 0;
-  std::uint64_t size = 1;
-  priv.read("command_index", index, 0);
-  priv.read("command_size", size, 1);
-  if (index >= size)
-    priv.fail("command_index", std::to_string(index), "must be < ~command_size = " + std::to_string(size));
-  robot.command_index = static_cast<std::size_t>(index);
-  robot.command_size = static_cast<std::size_t>(size);
-}
-
-namespace
-{
-// A MuJoCo model's joints are the robot's by default (the sim publishes them; ~cart_joint and
-// ~pole_joint still win): one config names them for the sim and the controller alike.
-void useModelJoints(const EngineParams& engine, RobotInterfaceParams& robot)
-{
-  if (!engineOf(engine).names_joints)
-    return;
-  robot.cart_joint = engine.cart_joint;
-  robot.pole_joint = engine.pole_joint;
-}
-
 // The robot's joints, offsets and command (robot_interface.h; docs/your_own_cartpole.md).
 void readRobotInterface(SectionReader& priv, double tau, RobotInterfaceParams& robot)
 {
-  for (const auto& [name, text] : {std::pair<const char*, std::string*>{"cart_joint", &robot.cart_joint},
-                                   {"pole_joint", &robot.pole_joint},
-                                   {"state_topic", &robot.state_topic},
-                                   {"command_topic", &robot.command_topic}})
+  readRobotPose(priv, robot);
+  for (const auto& [name, topic] : {std::pair<const char*, std::string*>{"state_topic", &robot.state_topic},
+                                    {"command_topic", &robot.command_topic}})
   {
-    priv.read(name, *text);
-    if (text->empty())
+    priv.read(name, *topic);
+    if (topic->empty())
       priv.fail(name, "''", "must not be empty");
   }
-  if (robot.cart_joint == robot.pole_joint)
-    priv.fail("pole_joint", "'" + robot.pole_joint + "'", "must differ from ~cart_joint");
-  readFinite(priv, "cart_zero", robot.cart_zero);
-  readFinite(priv, "pole_upright", robot.pole_upright);
-  readSign(priv, "cart_sign", robot.cart_sign);
-  readSign(priv, "pole_angle_sign", robot.pole_angle_sign);
-  readSign(priv, "effort_sign", robot.effort_sign);
   priv.read("velocity_smoothing", robot.velocity_smoothing);
   if (!(robot.velocity_smoothing >= 0.0 && robot.velocity_smoothing < 1.0))
     priv.fail("velocity_smoothing", SectionReader::numberText(robot.velocity_smoothing), "must be in [0, 1)");
@@ -254,7 +131,7 @@ std::vector<std::string> drivingWarnings(const ControllerSettings& settings)
     warnings.push_back("~predict_delay_steps = " + std::to_string(delay) + " predicts " +
                        SectionReader::numberText(delay * tau) + " s ahead at " + step +
                        ": a robot that late is rare; the prediction drifts from the robot the further it looks");
-  if (settings.run.control && !std::isfinite(settings.robot.max_effort))
+  if (settings.run.controlling() && !std::isfinite(settings.robot.max_effort))
   {
     double largest = 0.0;
     for (const double action : settings.training.agent.actions)
@@ -281,46 +158,34 @@ void useTablesOwnConfig(RunSettings& run, TrainingConfig& training)
   catch (const FileError& e)
   {
     // As RunApplication::start says it for a table that cannot be used.
-    throw ConfigError("cannot start from the table '" + run.load_on_start +
-                      "' (~load_on_start, which the launch files' q_table or load argument sets): " + e.what());
+    throw ConfigError("cannot start from the table '" + run.load_on_start + "' (" +
+                      run.names(Setting::LoadOnStartOrigin) + "): " + e.what());
   }
   training = own.config;
   run.config_origin = "the table's own configuration (" + path + ")";
   run.config_warning = own.defaults_used;
 }
-}  // namespace
 
-std::vector<std::string> robotNamespaces(std::size_t count)
+// A relative path under the table folder that does not leave it, else a refusal of `name`.
+void checkUnderTableFolder(SectionReader& priv, const std::string& name, const RunSettings& run,
+                           const std::string& path)
 {
-  if (count == 1)
-    return {""};
-  std::vector<std::string> names;
-  for (std::size_t i = 0; i < count; ++i)
-    names.push_back("robot_" + std::to_string(i));
-  return names;
+  try
+  {
+    relativePathUnder(run.q_table_dir, path);
+  }
+  catch (const FileError& e)
+  {
+    priv.fail(name, "'" + path + "'", e.what());
+  }
 }
 
-ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& source,
-                                          const ControllerContext& context)
+// ~q_table_dir, ~q_table_path, ~load_on_start and ~stats_csv, "~/" expanded; an evaluation of a
+// table with no configuration in `shared` takes the table's own.
+void readTablePaths(const ParameterSource& shared, SectionReader& priv, const ControllerContext& context,
+                    ControllerSettings& settings)
 {
-  ControllerSettings settings;
-  settings.training = readTrainingConfig(shared);
   RunSettings& run = settings.run;
-  run.name_space = context.name_space;
-  settings.shutdown_when_finished = context.shutdown_by_default;
-
-  run.config_origin = shared.origin();
-
-  // The same reader and checks as the shared sections; a key it does not know (a typo) stops
-  // the node instead of being ignored.
-  SectionReader priv(source, "");
-
-  std::string mode = "train";
-  priv.readChoice("mode", mode, {"train", "evaluate", "control"});
-  run.learning = mode == "train";
-  run.control = mode == "control";
-  priv.read("seed", run.seed, 0);
-
   run.q_table_dir = defaultTableDirectory(context.name_space);
   priv.read("q_table_dir", run.q_table_dir);
   if (run.q_table_dir.empty())
@@ -336,63 +201,49 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
       priv.fail(name, "'" + path + "'", e.what());
     }
   };
+  const auto read_path = [&](const std::string& name, std::string& path) {
+    priv.read(name, path);
+    expand_home(name, path);
+  };
   expand_home("q_table_dir", run.q_table_dir);
   std::string config_file;  // the launch's config (train.launch config:=), named in the namespace
   shared.get("config_file", config_file);
   run.q_table_path = defaultTableName(config_file);
-  priv.read("q_table_path", run.q_table_path);
-  expand_home("q_table_path", run.q_table_path);
+  read_path("q_table_path", run.q_table_path);
   // The node's parameters are the user's, as the launch arguments that set them: an absolute
   // ~q_table_path or ~load_on_start is followed as given. Only a service's path (its caller is
   // anyone on the graph) must stay inside ~q_table_dir (TableStore::resolveForService).
   run.own_absolute_paths = true;
   if (run.q_table_path.empty() || run.q_table_path.front() != '/')
-  {
-    try
-    {
-      relativePathUnder(run.q_table_dir, run.q_table_path);
-    }
-    catch (const FileError& e)
-    {
-      priv.fail("q_table_path", "'" + run.q_table_path + "'", e.what());
-    }
-  }
-  priv.read("load_on_start", run.load_on_start);
-  expand_home("load_on_start", run.load_on_start);
-  if (!run.learning && !run.load_on_start.empty() && !holdsTrainingConfig(shared))
+    checkUnderTableFolder(priv, "q_table_path", run, run.q_table_path);
+  read_path("load_on_start", run.load_on_start);
+  if (!run.learning() && !run.load_on_start.empty() && !holdsTrainingConfig(shared))
     useTablesOwnConfig(run, settings.training);
   // The launch files' stop_when_solved and max_episodes arrive as private parameters; they
   // override the shared training/ keys for this controller only.
   priv.read("stop_when_solved", settings.training.limits.stop_when_solved);
   priv.read("max_episodes", settings.training.limits.max_episodes, 1);
-  priv.read("stats_csv", run.stats_csv);
-  expand_home("stats_csv", run.stats_csv);
+  read_path("stats_csv", run.stats_csv);
   if (run.stats_csv != "none" && !run.stats_csv.empty() && run.stats_csv.front() != '/')
-  {
-    try
-    {
-      relativePathUnder(run.q_table_dir, run.stats_csv);
-    }
-    catch (const FileError& e)
-    {
-      priv.fail("stats_csv", "'" + run.stats_csv + "'", e.what());
-    }
-  }
-  priv.read("run_id", run.run_id);
-  // Set by the controller itself, for a respawn of it to find its run.
-  priv.know("run/id");
-  priv.know("run/launcher");
-  priv.know("run/folder");
+    checkUnderTableFolder(priv, "stats_csv", run, run.stats_csv);
+}
+
+// ~evaluation_episodes, ~suite and ~suite_case, ~max_steps, ~report_every and
+// ~predict_delay_steps: how an evaluation or control runs. Returns the engine whose joints the
+// robot has by default (a suite case's, else the training's).
+EngineParams readEvaluation(const ParameterSource& source, SectionReader& priv, ControllerSettings& settings)
+{
+  RunSettings& run = settings.run;
   priv.read("evaluation_episodes", run.evaluation_episodes, 0);
   // What the sim poses as (evaluate.launch suite_case:=NAME), for the verdict to say.
   unsigned max_steps = kEvaluationMaxSteps;
-  EngineParams robot_engine = settings.training.engine;  // whose joints the robot has by default
+  EngineParams robot_engine = settings.training.engine;
   if (const auto found = readSuiteCase(priv, settings.training))
   {
     const auto& [suite, suite_case] = *found;
     robot_engine = suite_case.engine;
     max_steps = suite.max_episode_steps;
-    if (run.learning)
+    if (run.learning())
       priv.fail("suite_case", "'" + suite_case.name + "'", "only with mode evaluate: the verdict says the case");
     if (source.keysUnder("evaluation_episodes").empty())
       run.evaluation_episodes = suite.episodes;
@@ -401,14 +252,14 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
     run.evaluation_pass = (suite_case.pass * run.evaluation_episodes + suite.episodes - 1) / suite.episodes;
   }
   priv.read("max_steps", max_steps, 1, std::numeric_limits<int>::max());
-  if ((run.learning || run.control) && !source.keysUnder("max_steps").empty())
+  if (run.mode != RunMode::Evaluate && !source.keysUnder("max_steps").empty())
     priv.fail("max_steps", std::to_string(max_steps),
-              run.control ? "not with mode control, which has no step limit: only with mode evaluate"
-                          : "only with mode evaluate: training's episodes are task/max_episode_steps long");
+              run.controlling() ? "not with mode control, which has no step limit: only with mode evaluate"
+                                : "only with mode evaluate: training's episodes are task/max_episode_steps long");
   // The Control Suite's tasks are scored over their own 1,000 steps unless told otherwise.
-  if (!run.learning && (!isSuiteTask(settings.training.task.kind) || !source.keysUnder("max_steps").empty()))
+  if (!run.learning() && (!isSuiteTask(settings.training.task.kind) || !source.keysUnder("max_steps").empty()))
     settings.training.task.max_episode_steps = max_steps;
-  if (run.control)
+  if (run.controlling())
   {
     // No step limit (a stretch ends only with a fall; 2^32 - 1 steps are 2.7 years at 50 Hz) and no verdict.
     settings.training.task.max_episode_steps = std::numeric_limits<unsigned>::max();
@@ -419,21 +270,47 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
       priv.fail("mode", "control", "needs ~load_on_start: a trained table to drive the robot with");
   }
   priv.readSeconds("report_every", run.report_every, 0.0, 3600.0, true);
-  if (!run.control && !source.keysUnder("report_every").empty())
+  if (!run.controlling() && !source.keysUnder("report_every").empty())
     priv.fail("report_every", SectionReader::numberText(run.report_every), "only with mode control");
   // A robot known to answer late: decide for the state the table's model predicts for when the command acts.
-  // Not told: found from the robot's states when greedy (below).
-  const bool delay_told = !source.keysUnder("predict_delay_steps").empty();
+  // Not told: found from the robot's states when greedy (readRobotSide).
   priv.read("predict_delay_steps", run.predict_delay_steps, 0, kMaxPredictedDelaySteps);
-  if (run.learning && run.predict_delay_steps > 0)
+  if (run.learning() && run.predict_delay_steps > 0)
     priv.fail("predict_delay_steps", std::to_string(run.predict_delay_steps),
               "only with mode evaluate or control: training learns from the states it observes");
-  priv.read("checkpoint_every", run.checkpoint_every, 0);
-  priv.read("save_on_shutdown", run.save_on_shutdown);
-  priv.read("shutdown_when_finished", settings.shutdown_when_finished);
-  priv.readSeconds("sim_timeout", settings.sim_timeout, 0.0, 3600.0, true);
-  priv.read("reset_service", settings.reset_service);
+  return robot_engine;
+}
 
+// ~freshness_timeout (and ~robot_lockstep, which turns the guard off by default), and the
+// control's clock that follows from it.
+void readFreshness(SectionReader& priv, ControllerSettings& settings)
+{
+  RunSettings& run = settings.run;
+  // The freshness guard's bound: a few decision periods, and no less than 0.1 s (a real-time
+  // machine's hiccup is not a robot gone). 0 turns it off: a lockstep sim holds no command.
+  priv.read("robot_lockstep", settings.robot_lockstep);
+  settings.freshness_timeout = settings.robot_lockstep ? 0.0 : std::max(0.1, 5.0 * settings.robot.decision_period);
+  priv.readSeconds("freshness_timeout", settings.freshness_timeout, 0.0, 10.0, false);
+  // A robot that holds its last command (every real one, a realtime sim) is pushed by it for as
+  // long as nothing replaces it: without the guard a driver that stops or freezes keeps the last
+  // push on. Only a sim that steps when answered holds nothing.
+  if (run.controlling() && settings.freshness_timeout == 0.0 && !settings.robot_lockstep)
+    priv.fail("freshness_timeout", "0",
+              "mode control drives a robot that holds its last command: the guard that commands 0 when fresh "
+              "states stop can be off only for a sim in lockstep (~robot_lockstep: true)");
+  // Control's clock: a gap between two decisions counts at most this (beyond it the guard has
+  // commanded 0, or, with the guard off, the robot was not being driven).
+  run.control_max_gap =
+      std::max({settings.freshness_timeout, 5.0 * settings.robot.decision_period, 5.0 * settings.training.physics.tau});
+}
+
+// The robot's side: its reset service, start region, joints, command and freshness guard, and
+// whether a greedy table finds the robot's delay.
+void readRobotSide(const ParameterSource& source, SectionReader& priv, const EngineParams& robot_engine,
+                   ControllerSettings& settings)
+{
+  RunSettings& run = settings.run;
+  priv.read("reset_service", settings.reset_service);
   ControllerProtocolParams& protocol = settings.protocol;
   protocol.reset_service = !settings.reset_service.empty();
   settings.simulated = endsWith(settings.reset_service, "cartpole_sim/reset") ||
@@ -460,29 +337,49 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
                   SectionReader::numberText(settings.robot.decision_period));
   // A greedy table not told the delay finds it (DelayEstimator), when the model's steps are its
   // decisions (as a told one needs, above).
-  if (!delay_told && !run.learning && std::abs(settings.robot.decision_period - settings.training.physics.tau) <= 1e-9)
+  const bool delay_told = !source.keysUnder("predict_delay_steps").empty();
+  if (!delay_told && !run.learning() &&
+      std::abs(settings.robot.decision_period - settings.training.physics.tau) <= 1e-9)
     run.predict_delay_steps = kDelayFoundFromStates;
   protocol.commands_unstamped = settings.robot.command_type != CommandType::JointState;
-  // The freshness guard's bound: a few decision periods, and no less than 0.1 s (a real-time
-  // machine's hiccup is not a robot gone). 0 turns it off: a lockstep sim holds no command.
-  priv.read("robot_lockstep", settings.robot_lockstep);
-  settings.freshness_timeout = settings.robot_lockstep ? 0.0 : std::max(0.1, 5.0 * settings.robot.decision_period);
-  priv.readSeconds("freshness_timeout", settings.freshness_timeout, 0.0, 10.0, false);
-  // A robot that holds its last command (every real one, a realtime sim) is pushed by it for as
-  // long as nothing replaces it: without the guard a driver that stops or freezes keeps the last
-  // push on. Only a sim that steps when answered holds nothing.
-  if (run.control && settings.freshness_timeout == 0.0 && !settings.robot_lockstep)
-    priv.fail("freshness_timeout", "0",
-              "mode control drives a robot that holds its last command: the guard that commands 0 when fresh "
-              "states stop can be off only for a sim in lockstep (~robot_lockstep: true)");
-  protocol.time_back_judged_by_state = run.control;
-  protocol.starts_when_up = !run.learning && !protocol.reset_service;
-  // Control's clock: a gap between two decisions counts at most this (beyond it the guard has
-  // commanded 0, or, with the guard off, the robot was not being driven).
-  run.control_max_gap =
-      std::max({settings.freshness_timeout, 5.0 * settings.robot.decision_period, 5.0 * settings.training.physics.tau});
+  readFreshness(priv, settings);
+  protocol.time_back_judged_by_state = run.controlling();
+  protocol.starts_when_up = !run.learning() && !protocol.reset_service;
   priv.readChoice("reset_service_type", settings.reset_service_type, resetServiceTypes());
   protocol.reset_starts_in_region = settings.reset_service_type != "cartpole_qlearning/Reset";
+}
+}  // namespace
+
+ControllerSettings readControllerSettings(const ParameterSource& shared, const ParameterSource& source,
+                                          const ControllerContext& context)
+{
+  ControllerSettings settings;
+  settings.training = readTrainingConfig(shared);
+  RunSettings& run = settings.run;
+  run.name_space = context.name_space;
+  run.names = nodeSettingNames();
+  settings.shutdown_when_finished = context.shutdown_by_default;
+  run.config_origin = shared.origin();
+
+  // The same reader and checks as the shared sections; a key it does not know (a typo) stops
+  // the node instead of being ignored.
+  SectionReader priv(source, "");
+  std::string mode = "train";
+  priv.readChoice("mode", mode, {"train", "evaluate", "control"});
+  run.mode = mode == "control" ? RunMode::Control : mode == "evaluate" ? RunMode::Evaluate : RunMode::Train;
+  priv.read("seed", run.seed, 0);
+  readTablePaths(shared, priv, context, settings);
+  priv.read("run_id", run.run_id);
+  // Set by the controller itself, for a respawn of it to find its run.
+  priv.know("run/id");
+  priv.know("run/launcher");
+  priv.know("run/folder");
+  const EngineParams robot_engine = readEvaluation(source, priv, settings);
+  priv.read("checkpoint_every", run.checkpoint_every, 0);
+  priv.read("save_on_shutdown", run.save_on_shutdown);
+  priv.read("shutdown_when_finished", settings.shutdown_when_finished);
+  priv.readSeconds("sim_timeout", settings.sim_timeout, 0.0, 3600.0, true);
+  readRobotSide(source, priv, robot_engine, settings);
   readRobots(source, priv, context, settings.robots);
   priv.read("sync", settings.sync);
   priv.read("trace", run.trace);
@@ -492,120 +389,9 @@ ControllerSettings readControllerSettings(const ParameterSource& shared, const P
   for (const std::string& key : context.other_keys)
     priv.know(key);
   priv.refuseUnknown();
-  protocol.limits = settings.training.limits;
-  if (!run.learning)
+  settings.protocol.limits = settings.training.limits;
+  if (!run.learning())
     settings.warnings = drivingWarnings(settings);
-  return settings;
-}
-
-SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource& source)
-{
-  SimSettings settings;
-  readPhysics(shared, settings.physics, settings.start_state_bound, settings.engine);
-
-  // The same reader and checks as the shared sections; a key it does not know (a typo such as
-  // lockstep_timout) stops the node instead of being ignored.
-  SectionReader priv(source, "");
-  std::string mode = "realtime";
-  priv.readChoice("mode", mode, {"realtime", "lockstep"});
-  settings.mode = mode == "lockstep" ? SimMode::Lockstep : SimMode::Realtime;
-  priv.read("seed", settings.seed, 0);
-  settings.perturbations = readPerturbations(shared);
-  checkPerturbationsFitEngine(shared, settings.engine, settings.perturbations);
-  // A suite case's physics, start region and perturbations replace the shared ones, as
-  // train_headless --evaluate TABLE --suite FILE runs it; its seed is the suite's unless ~seed is set.
-  TrainingConfig base;
-  base.physics = settings.physics;
-  base.start_state_bound = settings.start_state_bound;
-  base.engine = settings.engine;
-  if (const auto found = readSuiteCase(priv, base))
-  {
-    const auto& [suite, suite_case] = *found;
-    settings.suite = suite.origin;
-    settings.suite_case = suite_case.name;
-    settings.physics = suite_case.physics;
-    settings.engine = suite_case.engine;
-    settings.start_state_bound = suite_case.start_state_bound;
-    settings.perturbations = suite_case.perturbations;
-    if (source.keysUnder("seed").empty())
-      settings.seed = suite.seed;
-  }
-  priv.readSeconds("command_timeout", settings.command_timeout, 0.0, 60.0, true);
-  priv.readSeconds("lockstep_timeout", settings.lockstep_timeout, 0.0, 3600.0, true);
-  priv.readAtLeast("tf_rate", settings.tf_rate, 0.0, true);
-  settings.effort_limit = settings.physics.force_mag;
-  priv.readAtLeast("effort_limit", settings.effort_limit, 0.0, true);
-  if (settings.effort_limit > settings.physics.force_mag)
-    priv.fail("effort_limit", SectionReader::numberText(settings.effort_limit),
-              "must be <= physics/force_mag = " + SectionReader::numberText(settings.physics.force_mag));
-  // The sim's own noise keys gave way to the core's model, which train_headless shares.
-  for (const auto& [name, instead] :
-       {std::pair<const char*, const char*>{"position_noise_std", "noise_std: [x, x_dot, theta, theta_dot]"},
-        {"velocity_noise_std", "noise_std and noise_fraction: [x, x_dot, theta, theta_dot]"},
-        {"effort_noise_std",
-         "motor: [low, high] (the motor's strength per episode), push_probability and "
-         "push_force"}})
-  {
-    if (source.keysUnder(name).empty())
-      continue;
-    std::string value;
-    try
-    {
-      double number = 0.0;
-      source.get(name, number);
-      value = SectionReader::numberText(number);
-    }
-    catch (const ConfigError&)
-    {
-      value = anyValueText(source, name);
-    }
-    priv.fail(name, value,
-              std::string("replaced by the shared perturbations section, as in config/cartpole.yaml: perturbations/") +
-                  instead);
-  }
-  RobotInterfaceParams& pose = settings.pose;
-  useModelJoints(settings.engine, pose);
-  for (const auto& [name, joint] :
-       {std::pair<const char*, std::string*>{"cart_joint", &pose.cart_joint}, {"pole_joint", &pose.pole_joint}})
-  {
-    priv.read(name, *joint);
-    if (joint->empty())
-      priv.fail(name, "''", "must not be empty");
-  }
-  readFinite(priv, "cart_zero", pose.cart_zero);
-  readFinite(priv, "pole_upright", pose.pole_upright);
-  readSign(priv, "cart_sign", pose.cart_sign);
-  readSign(priv, "pole_angle_sign", pose.pole_angle_sign);
-  readSign(priv, "effort_sign", pose.effort_sign);
-  settings.publish_period = settings.physics.tau;
-  priv.read("publish_period", settings.publish_period);
-  // A stamp step of at least a microsecond; a second apart is no joint_states stream to pose as.
-  if (!source.keysUnder("publish_period").empty() &&
-      !(settings.publish_period >= 1e-6 && settings.publish_period <= 1.0))
-    priv.fail("publish_period", SectionReader::numberText(settings.publish_period), "must be in [1e-06, 1] s");
-  priv.read("group_effort_index", settings.group_effort_index, 0);
-  std::int64_t turns = 0;
-  priv.read("pole_turns", turns);
-  if (turns < -1000 || turns > 1000)
-    priv.fail("pole_turns", std::to_string(turns), "must be a whole number in [-1000, 1000]");
-  settings.pole_turns = static_cast<int>(turns);
-  priv.read("publish_velocities", settings.publish_velocities);
-  priv.read("publish_clock", settings.publish_clock);
-  priv.read("publish_tf", settings.publish_tf);
-  priv.read("track_y", settings.track_y);
-  if (!std::isfinite(settings.track_y))
-    priv.fail("track_y", SectionReader::numberText(settings.track_y), "must be finite");
-  for (const auto& [name, frame] : {std::pair<const char*, std::string*>{"world_frame", &settings.world_frame},
-                                    {"cart_frame", &settings.cart_frame},
-                                    {"pole_frame", &settings.pole_frame}})
-  {
-    priv.read(name, *frame);
-    if (frame->empty() && !source.keysUnder(name).empty())
-      priv.fail(name, "''", "frame names must not be empty");
-  }
-  priv.refuseUnknown();
-  if (settings.publish_clock && settings.mode != SimMode::Lockstep)
-    priv.fail("publish_clock", "true", "only in lockstep mode: in realtime the wall clock is the clock");
   return settings;
 }
 
@@ -619,8 +405,8 @@ std::string controllerStartText(const ControllerSettings& settings, const QTable
   // An evaluation says how long its episodes are and whose configuration it runs with: neither
   // need be the training's.
   const std::string doing =
-      settings.run.learning ? "training"
-      : settings.run.control
+      settings.run.learning() ? "training"
+      : settings.run.controlling()
           ? "controlling (greedy, no learning, no step limit: a fall commands 0 until a start) with " +
                 settings.run.config_origin
           : "evaluating (greedy, no learning) in episodes of " +

@@ -1,7 +1,10 @@
 // The nodes' private parameters, read by the core from YAML text as the nodes read them from the
 // parameter server: every rule, default and message without a master. (node_parameters_fail.test
 // checks only that a refusal stops each executable.)
-#include "cartpole_qlearning/application/node_settings.h"
+#include "cartpole_qlearning/node_settings/controller_settings.h"
+#include "cartpole_qlearning/learning/delay_predictor.h"
+#include "cartpole_qlearning/node_settings/sim_settings.h"
+#include "cartpole_qlearning/node_settings/table_folder.h"
 
 #include "cartpole_qlearning/application/headless_trainer.h"
 #include "cartpole_qlearning/application/robustness_suite.h"
@@ -12,6 +15,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -97,7 +101,7 @@ std::string simError(const std::string& priv, const std::string& shared = "")
 TEST(ControllerSettings, DefaultsAreTheDocumentedOnes)
 {
   const ControllerSettings s = readController("");
-  EXPECT_TRUE(s.run.learning);
+  EXPECT_TRUE(s.run.learning());
   EXPECT_EQ(0u, s.run.seed);
   EXPECT_EQ("/cartpole", s.run.name_space);
   EXPECT_EQ(defaultTableDirectory("/cartpole"), s.run.q_table_dir);
@@ -135,7 +139,7 @@ TEST(ControllerSettings, ReadsValidParametersAndTheSharedSections)
   const ControllerSettings s =
       readController("{mode: train, seed: 3, checkpoint_every: 0, save_on_shutdown: false, q_table_dir: /tmp/t}",
                      "learning: {gamma: 0.9, bins: [1, 1, 3, 4]}");
-  EXPECT_TRUE(s.run.learning);
+  EXPECT_TRUE(s.run.learning());
   EXPECT_EQ(3u, s.run.seed);
   EXPECT_EQ(0u, s.run.checkpoint_every);
   EXPECT_FALSE(s.run.save_on_shutdown);
@@ -148,7 +152,7 @@ TEST(ControllerSettings, ReadsValidParametersAndTheSharedSections)
       "{mode: evaluate, evaluation_episodes: 0, sim_timeout: 0.5, reset_service: '', sync: false, trace: true, "
       "run_id: abc, load_on_start: t.yaml, stats_csv: none, start_region: [1, 2, 0.1, 0.2]}",
       "learning: {gamma: 0.9}");
-  EXPECT_FALSE(e.run.learning);
+  EXPECT_FALSE(e.run.learning());
   EXPECT_EQ(0u, e.run.evaluation_episodes);
   EXPECT_EQ(0.5, e.sim_timeout);
   EXPECT_FALSE(e.protocol.reset_service);
@@ -176,8 +180,8 @@ TEST(ControllerSettings, ControlDrivesWithATableAndNoStepLimitNorVerdict)
 {
   const std::string shared = "{task: {max_episode_steps: 200}}";
   const ControllerSettings control = readController("{mode: control, load_on_start: robust.yaml}", shared);
-  EXPECT_TRUE(control.run.control);
-  EXPECT_FALSE(control.run.learning);
+  EXPECT_TRUE(control.run.controlling());
+  EXPECT_FALSE(control.run.learning());
   EXPECT_EQ(std::numeric_limits<unsigned>::max(), control.training.task.max_episode_steps);
   EXPECT_EQ(0u, control.run.evaluation_episodes);
   EXPECT_EQ(10.0, control.run.report_every);
@@ -187,7 +191,7 @@ TEST(ControllerSettings, ControlDrivesWithATableAndNoStepLimitNorVerdict)
       2.0,
       readController("{mode: control, load_on_start: t.yaml, freshness_timeout: 2.0}", shared).run.control_max_gap);
   EXPECT_EQ(2.5, readController("{mode: control, load_on_start: t.yaml, report_every: 2.5}", shared).run.report_every);
-  EXPECT_FALSE(readController("mode: evaluate", shared).run.control);
+  EXPECT_FALSE(readController("mode: evaluate", shared).run.controlling());
   // What control cannot take, each refused naming it.
   EXPECT_SAYS(controllerError("mode: control", shared),
               "mode = control is not allowed (needs ~load_on_start: a trained table to drive the robot with)");
@@ -830,6 +834,25 @@ struct TableFolder
   }
   std::string path;
 };
+TEST(DefaultTableDirectory, EachNamespaceHasAFolderOfItsOwnUnderRosHome)
+{
+  // What train.launch ns:=NAME relies on: two namespaces never share (or write) each other's tables.
+  const char* before = std::getenv("ROS_HOME");
+  const std::string saved = before != nullptr ? before : "";
+  ::setenv("ROS_HOME", "/somewhere/ros_home", 1);
+  EXPECT_EQ("/somewhere/ros_home/cartpole_qlearning/cartpole", defaultTableDirectory("/cartpole"));
+  EXPECT_EQ("/somewhere/ros_home/cartpole_qlearning/first", defaultTableDirectory("/first"));
+  EXPECT_EQ("/somewhere/ros_home/cartpole_qlearning/second", defaultTableDirectory("/second"));
+  EXPECT_EQ("/somewhere/ros_home/cartpole_qlearning/fleet/robot_1", defaultTableDirectory("/fleet/robot_1"));
+  EXPECT_EQ("/somewhere/ros_home/cartpole_qlearning", defaultTableDirectory("/"));
+  ::unsetenv("ROS_HOME");
+  const char* home = std::getenv("HOME");
+  EXPECT_EQ(std::string(home != nullptr ? home : ".") + "/.ros/cartpole_qlearning/first",
+            defaultTableDirectory("/first"));
+  if (before != nullptr)
+    ::setenv("ROS_HOME", saved.c_str(), 1);
+}
+
 }  // namespace
 
 TEST(ControllerSettings, AnEvaluationOfATableAloneRunsWithTheTablesOwnConfiguration)
