@@ -773,6 +773,9 @@ TEST(SimSettings, PosesAsAnotherCartPole)
   EXPECT_EQ(2, s.pole_turns);
   EXPECT_FALSE(s.publish_velocities);
   EXPECT_SAYS(simError("cart_sign: 0"), "cart_sign = 0 is not allowed (must be 1 or -1)");
+  // The pose is read as the controller reads a robot's (readRobotPose): one joint cannot be both.
+  EXPECT_SAYS(simError("pole_joint: cart_joint"),
+              "pole_joint = 'cart_joint' is not allowed (must differ from ~cart_joint)");
 }
 
 TEST(SimSettings, PosesAtAnotherStateRateAndEffortSign)
