@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -218,6 +219,29 @@ TEST(DocsLinksTest, EveryDocsPageLinksBackToTheReadme)
         std::any_of(links.begin(), links.end(), [&page](const std::string& l) { return leadsToTheReadme(page, l); });
     EXPECT_TRUE(back) << fs::relative(page, kSource).string() << " has no link back to the README";
   }
+}
+
+// The users' pages are read to find how to do a thing: each stays short enough to read (300 lines),
+// and none sends the reader to the project's issue tracker for its meaning ("issue 26's robot").
+// The developers' notes (docs/notes/) keep the record of tuning rounds and may run long.
+TEST(DocsLinksTest, EveryUsersPageIsShortAndNamesNoIssue)
+{
+  const std::regex issue("\\bissues? #?[0-9]+", std::regex::icase);
+  std::size_t checked = 0;
+  for (const fs::path& page : pages())
+  {
+    if (page.parent_path().filename() == "notes")
+      continue;
+    ++checked;
+    const std::string text = fileText(page);
+    const std::string name = fs::relative(page, kSource).string();
+    EXPECT_LE(std::count(text.begin(), text.end(), '\n'), 300) << name << " is over 300 lines";
+    std::smatch found;
+    EXPECT_FALSE(std::regex_search(text, found, issue)) << name << " names an issue: " << found.str();
+  }
+  EXPECT_GT(checked, 10u) << "pages found in README.md and docs/";
+  EXPECT_TRUE(std::regex_search(std::string("as issue 26 found"), issue));
+  EXPECT_FALSE(std::regex_search(std::string("a tissue 26 mm thick"), issue));
 }
 
 }  // namespace
