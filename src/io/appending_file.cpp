@@ -19,11 +19,6 @@ using namespace io_internal;
 
 namespace
 {
-[[noreturn]] void refuse(const std::string& what)
-{
-  throw FileError(what);
-}
-
 // Opens `name` in the open folder for appending; a FIFO or device planted under the name is
 // refused without blocking on it.
 Descriptor openForAppending(const Descriptor& folder, const std::string& name, const std::string& shown,

@@ -24,11 +24,6 @@ using namespace io_internal;
 
 namespace
 {
-[[noreturn]] void refuse(const std::string& what)
-{
-  throw FileError(what);
-}
-
 std::string readOpenFile(const Descriptor& fd, const std::string& shown, std::uint64_t max_bytes,
                          const SizeFromHead& size_from_head)
 {

@@ -16,13 +16,10 @@ namespace io_internal
 {
 namespace fs = std::filesystem;
 
-namespace
-{
-[[noreturn]] void refuse(const std::string& what)
+void refuse(const std::string& what)
 {
   throw FileError(what);
 }
-}  // namespace
 
 std::string systemError(const std::string& what, const std::string& path, int error)
 {

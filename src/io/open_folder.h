@@ -13,6 +13,8 @@ namespace io_internal
 {
 // "WHAT PATH: the system's reason".
 std::string systemError(const std::string& what, const std::string& path, int error);
+// Throws FileError(what): a path or file refused.
+[[noreturn]] void refuse(const std::string& what);
 
 // A file descriptor, closed when it goes out of scope.
 class Descriptor
