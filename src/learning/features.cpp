@@ -47,7 +47,7 @@ std::size_t FeatureParams::rowCount(std::size_t actions) const
 namespace
 {
 template <typename Container>
-std::string listText(const Container& values)
+std::string fullPrecisionList(const Container& values)
 {
   std::ostringstream out;
   out.precision(17);
@@ -64,7 +64,7 @@ std::string listText(const Container& values)
 
 std::string boundsText(const DiscretiserParams& d)
 {
-  return "lower " + listText(d.lower) + " upper " + listText(d.upper);
+  return "lower " + fullPrecisionList(d.lower) + " upper " + fullPrecisionList(d.upper);
 }
 }  // namespace
 
@@ -78,7 +78,8 @@ std::string FeatureParams::mismatch(const FeatureParams& other) const
   if (kind == FeatureKind::Bins)
   {
     if (discretiser.bins != other.discretiser.bins)
-      return "bins " + listText(other.discretiser.bins) + " differ from " + listText(discretiser.bins);
+      return "bins " + fullPrecisionList(other.discretiser.bins) + " differ from " +
+             fullPrecisionList(discretiser.bins);
     if (!(discretiser == other.discretiser))
       return "bin bounds " + boundsText(other.discretiser) + " differ from " + boundsText(discretiser);
     return "";
@@ -86,7 +87,7 @@ std::string FeatureParams::mismatch(const FeatureParams& other) const
   if (tilings != other.tilings)
     return "tilings " + std::to_string(other.tilings) + " differ from " + std::to_string(tilings);
   if (tiles != other.tiles)
-    return "tiles " + listText(other.tiles) + " differ from " + listText(tiles);
+    return "tiles " + fullPrecisionList(other.tiles) + " differ from " + fullPrecisionList(tiles);
   if (!(tileCoder() == other.tileCoder()))
     return "tile bounds " + boundsText(other.discretiser) + " differ from " + boundsText(discretiser);
   return "";
