@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the whole package and its tests (nodes, nodelet library, train_headless, gtests and
-# rostests, but for the six long trainings: see ARGS below) with clang's AddressSanitizer
+# rostests, but for the seven long trainings: see ARGS below) with clang's AddressSanitizer
 # (with LeakSanitizer) and UndefinedBehaviorSanitizer in a build and devel space of their own
 # beside the plain ones ($WS/build_sanitize, $WS/devel_sanitize), and runs those tests there
 # (gtests, rostests, launch file checks). Any sanitizer report, in a test or in a node that
@@ -71,9 +71,9 @@ for var in CMAKE_PREFIX_PATH LD_LIBRARY_PATH PKG_CONFIG_PATH PYTHONPATH; do stri
 # function, file and line (all that suppressions and readers need), and the build is lighter
 # (about 10 % less compile time per file measured here, and smaller objects to link).
 FLAGS="-O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
-# Not the six long trainings (CMakeLists.txt's CARTPOLE_QLEARNING_LONG_TRAININGS): in the plain
+# Not the seven long trainings (CMakeLists.txt's CARTPOLE_QLEARNING_LONG_TRAININGS): in the plain
 # run four robot profiles and config/robust.yaml each train to solved, and sim_to_sim_tests trains
-# robust.yaml's seed 1 until its suite passes; here they would go over
+# robust.yaml's seed 1 until its suite passes, train_headless_tests robust.yaml's seed 0; here they would go over
 # code that robot_profile_isaac, robot_group_command, robot_position_only, decision_period,
 # time_back, zero_effort* (Float64 commands, another state rate, offsets and signs, resets that
 # set time back) and application_tests (RunApplication: the suite judged during training, the best
