@@ -7,6 +7,9 @@
 # roslaunch started, fails the run.
 #
 # usage: bash tools/sanitize.sh [RESULTS_DIR]
+#   SANITIZE_STEPS=build: only build (scripts/test.sh builds at the lowest priority while the plain
+#   suite runs, then runs with SANITIZE_STEPS=run); run: only run what an earlier build left;
+#   both (the default): build, then run.
 #   The workspace is the one scripts/setup.sh chose (CARTPOLE_WS, or the one this clone is in);
 #   run scripts/setup.sh once first. RESULTS_DIR (default $WS/build_sanitize/sanitized_results)
 #   gets the JUnit files, each named sanitized-*.xml, and sanitized-reports.xml: one test case
@@ -36,6 +39,8 @@
 # preloaded. The instrumented executables need nothing preloaded.
 set -euo pipefail
 RESULTS=${1:-}
+STEPS=${SANITIZE_STEPS:-both}
+case "$STEPS" in build | run | both) ;; *) echo "sanitize.sh: SANITIZE_STEPS=$STEPS: build, run or both" >&2; exit 2 ;; esac
 SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 if [ -z "${CARTPOLE_WS:-}" ] && [ "$(basename "$(dirname "$SRC")")" = src ]; then
   CARTPOLE_WS="$(dirname "$(dirname "$SRC")")"
@@ -83,10 +88,13 @@ ARGS=(--build "$BUILD" -DCATKIN_DEVEL_PREFIX="$DEVEL" -DCMAKE_BUILD_TYPE=Sanitiz
   "-DCARTPOLE_WARNINGS_AS_ERRORS=${CARTPOLE_WARNINGS_AS_ERRORS:-ON}")
 [ -x /usr/bin/python3 ] && ARGS+=(-DPYTHON_EXECUTABLE=/usr/bin/python3)
 cd "$WS"
-echo "[sanitize] building the nodes, the nodelet library and every test with ASan + UBSan ($CXX) in $BUILD"
-SECONDS=0
-catkin_make "${ARGS[@]}" cartpole_sim qlearning_controller cartpole_qlearning_nodelets train_headless tests
-echo "[sanitize] built in $SECONDS s"
+if [ "$STEPS" != run ]; then
+  echo "[sanitize] building the nodes, the nodelet library and every test with ASan + UBSan ($CXX) in $BUILD"
+  SECONDS=0
+  catkin_make "${ARGS[@]}" cartpole_sim qlearning_controller cartpole_qlearning_nodelets train_headless tests
+  echo "[sanitize] built in $SECONDS s"
+fi
+[ "$STEPS" != build ] || exit 0
 
 set +u
 # shellcheck disable=SC1091
