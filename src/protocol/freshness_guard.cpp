@@ -96,6 +96,8 @@ bool FreshnessGuard::onMessage(Stamp stamp, bool valid, const std::string& publi
     ++since_decision_[static_cast<int>(*cause)];
     last_cause_ = cause;
   }
+  else
+    ++fresh_since_decision_;
   return true;
 }
 
@@ -110,6 +112,7 @@ void FreshnessGuard::onDecision(Stamp stamp, WallClock::time_point now, LogLines
   last_decided_ = stamp;
   stamped_ = stamped_ || stamp != 0;
   std::fill(std::begin(since_decision_), std::end(since_decision_), 0);
+  fresh_since_decision_ = 0;
   last_cause_.reset();
 }
 
@@ -152,7 +155,12 @@ std::string FreshnessGuard::describeStop(WallClock::time_point now) const
   switch (cause())
   {
     case Cause::Silence:
-      why = "no joint_states at all: is the robot's driver running?";
+      why = fresh_since_decision_ == 0
+                ? std::string("no joint_states at all: is the robot's driver running?")
+                : formatText(
+                      "%llu fresh joint_states came and none was decided on: the controller is waiting, for "
+                      "a reset, for the pole to come up or for the other robots of a round",
+                      static_cast<unsigned long long>(fresh_since_decision_));
       break;
     case Cause::SecondDriver:
       why = formatText("%llu from a second publisher, refused", static_cast<unsigned long long>(count));

@@ -81,6 +81,9 @@ private:
   static constexpr int kCauses = static_cast<int>(Cause::Older) + 1;
   std::uint64_t since_decision_[kCauses] = {};
   std::optional<Cause> last_cause_;
+  // Fresh states (none of the causes above) since the last decision, none decided on: a silence
+  // with these is the controller waiting (a reset, the pole to come up, a round), not the robot.
+  std::uint64_t fresh_since_decision_ = 0;
   // The publisher whose states are taken, and when it was last heard.
   std::string publisher_;
   WallClock::time_point publisher_heard_at_;

@@ -192,6 +192,20 @@ TEST(FreshnessGuard, SilenceStopsOnceAndSaysSo)
   EXPECT_EQ(0, s.stops_);
 }
 
+TEST(FreshnessGuard, FreshStatesNotDecidedOnAreNotCalledSilence)
+{
+  // A reset under way (or a pole not yet up): the robot's states keep coming, fresh, and the
+  // controller decides on none. It stops all the same, and says why without blaming the driver.
+  Script s;
+  const Stamp after = s.freshRun(kTick, 10);
+  for (int i = 0; i < 6; ++i)
+    s.message(after + static_cast<Stamp>(i) * kTick);
+  expectStopWithinBound(s, Cause::Silence, "fresh joint_states came and none was decided on");
+  EXPECT_EQ(std::string::npos, s.text().find("no joint_states at all")) << s.text();
+  s.freshRun(after + 10 * kTick, 2);
+  EXPECT_TRUE(s.pushes());
+}
+
 TEST(FreshnessGuard, NothingIsStoppedBeforeTheFirstDecision)
 {
   Script s;
