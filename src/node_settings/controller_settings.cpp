@@ -403,11 +403,16 @@ std::string controllerStartText(const ControllerSettings& settings, const QTable
                                                                      std::to_string(table.stateCount()) + " tiles"
                                                                : std::to_string(table.stateCount()) + " states";
   // An evaluation says how long its episodes are and whose configuration it runs with: neither
-  // need be the training's.
+  // need be the training's. A task that never ends on the angle has no fall to stop at.
+  const bool never_ends = isSuiteTask(settings.training.task.kind);
   const std::string doing =
       settings.run.learning() ? "training"
       : settings.run.controlling()
-          ? "controlling (greedy, no learning, no step limit: a fall commands 0 until a start) with " +
+          ? std::string(never_ends ? "controlling (greedy, no learning, no step limit; task " +
+                                         toString(settings.training.task.kind) +
+                                         " never ends on the angle: a pole down is swung up again) with "
+                                   : "controlling (greedy, no learning, no step limit: a fall commands 0 until a "
+                                     "start) with ") +
                 settings.run.config_origin
           : "evaluating (greedy, no learning) in episodes of " +
                 std::to_string(settings.training.task.max_episode_steps) + " steps with " + settings.run.config_origin;
@@ -425,6 +430,8 @@ std::string controllerStartText(const ControllerSettings& settings, const QTable
             (settings.run.predict_delay_steps == 1 ? " step" : " steps") + " ahead (~predict_delay_steps)";
   return text + "; " +
          (settings.protocol.reset_service ? "resets by ~" + settings.reset_service
+          : settings.protocol.starts_when_up && never_ends
+              ? std::string("no reset service, none needed: the task has no fall")
           : settings.protocol.starts_when_up
               ? std::string("no reset service: an episode starts when the pole is up (inside the task's "
                             "thresholds), the next at once after a step limit, and after a fall the pole stays "

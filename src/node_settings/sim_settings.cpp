@@ -113,6 +113,9 @@ SimSettings readSimSettings(const ParameterSource& shared, const ParameterSource
   settings.perturbations = readPerturbations(shared);
   checkPerturbationsFitEngine(shared, settings.engine, settings.perturbations);
   poseAsSuiteCase(source, priv, settings);
+  const TaskParams task = readTask(shared);
+  settings.task = task.kind;
+  settings.start = task.start(settings.start_state_bound);
   priv.readSeconds("command_timeout", settings.command_timeout, 0.0, 60.0, true);
   priv.readSeconds("lockstep_timeout", settings.lockstep_timeout, 0.0, 3600.0, true);
   priv.readAtLeast("tf_rate", settings.tf_rate, 0.0, true);

@@ -182,6 +182,7 @@ RobotDispatch::Turn RobotDispatch::serve(std::size_t r, Stamp stamp, const CartP
   Turn turn;
   turn.robot = r;
   turn.stamp = stamp;
+  turn.state = state;
   turn.reaction = robot.protocol.onState(stamp, state);
   turn.log = reactionLog(
       turn.reaction, robot.protocol.counts(), robot.name, stampSeconds(stamp),

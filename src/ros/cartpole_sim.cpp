@@ -45,6 +45,8 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
   {
     simulation_ = std::make_unique<CartPoleSimulation>(makeSimulation(
         settings_.physics, settings_.engine, settings_.start_state_bound, settings_.seed, settings_.perturbations));
+    // The task's starts, as train_headless draws them: a swing-up task's pole hangs.
+    simulation_->setStart(settings_.start);
   }
   catch (const EngineError& e)
   {
@@ -115,9 +117,11 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
     publishState(ros::Time::now());
   }
   const std::string engine = engineOf(settings_.engine).describe(settings_.physics, settings_.engine);
-  say(ros::console::levels::Info, "cartpole_sim: %s mode, tau %g s, %s, seed %llu, start state [%g, %g, %g, %g]%s%s",
+  say(ros::console::levels::Info,
+      "cartpole_sim: %s mode, tau %g s, %s, seed %llu, starts of task %s, start state [%g, %g, %g, %g]%s%s",
       settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau, engine.c_str(),
-      static_cast<unsigned long long>(settings_.seed), simulation_->state()[0], simulation_->state()[1],
+      static_cast<unsigned long long>(settings_.seed), toString(settings_.task).c_str(), simulation_->state()[0],
+      simulation_->state()[1],
       simulation_->state()[2], simulation_->state()[3], settings_.publish_clock ? ", publishing /clock" : "",
       own_rate ? (", joint_states every " + SectionReader::numberText(settings_.publish_period) + " s").c_str() : "");
   if (!settings_.suite_case.empty())

@@ -19,11 +19,12 @@ public:
   // robots: their namespaces ("" the learner's own); tau, max_gap, max_effort, report_every: as
   // ControlMeter takes them; say: the node's log.
   ControlReporter(ros::NodeHandle& nh, const std::vector<std::string>& robots, double tau, double max_gap,
-                  double max_effort, double report_every, std::function<void(const LogLines&)> say);
+                  double max_effort, double report_every, TaskKind task, double rail_limit,
+                  std::function<void(const LogLines&)> say);
 
   // A state of `robot` as the protocol reacted to it (fell: the episode it ended ended on the
-  // task's thresholds): the fall or the report said and published when due.
-  void onReaction(std::size_t robot, const Reaction& reaction, bool fell);
+  // task's thresholds): the fall, the swing-up or the report said and published when due.
+  void onReaction(std::size_t robot, const Reaction& reaction, bool fell, const CartPoleState& state);
   // The last lines, one per robot (the node stopping).
   LogLines summaries() const;
 

@@ -140,6 +140,11 @@ ControlStats controlStats(const ControlStatsValues& values, const std::string& r
   msg.falls = values.falls;
   msg.decisions = values.decisions;
   msg.clamped = values.clamped;
+  msg.upright_seconds = values.upright_seconds;
+  msg.swing_ups = values.swing_ups;
+  msg.last_swing_up_seconds = values.last_swing_up_seconds;
+  msg.longest_swing_up_seconds = values.longest_swing_up_seconds;
+  msg.rail_hits = values.rail_hits;
   return msg;
 }
 

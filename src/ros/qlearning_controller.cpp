@@ -59,7 +59,9 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   if (settings_.run.controlling())
     control_ = std::make_unique<ControlReporter>(nh_, settings_.robots, settings_.training.physics.tau,
                                                  settings_.run.control_max_gap, settings_.robot.max_effort,
-                                                 settings_.run.report_every, [this](const LogLines& log) { say(log); });
+                                                 settings_.run.report_every, settings_.training.task.kind,
+                                                 settings_.training.physics.rail_limit,
+                                                 [this](const LogLines& log) { say(log); });
   ros::NodeHandle services_nh(pnh_);
   services_nh.setCallbackQueue(&services_queue_);
   save_srv_ = services_nh.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);
@@ -215,7 +217,8 @@ void QLearningControllerNode::serve(const RobotDispatch::Turn& turn)
   if (reaction.episode_ended && !reaction.answer)
     robot.command.stop();
   if (control_)
-    control_->onReaction(turn.robot, reaction, reaction.episode_ended && session_->lastEpisode().terminated);
+    control_->onReaction(turn.robot, reaction, reaction.episode_ended && session_->lastEpisode().terminated,
+                         turn.state);
   if (reaction.episode_ended)
     endEpisode(robot, stamp, reaction.training_finished);
   // Reset calls run on threads of their own (ResetCaller): a blocking call from this callback would

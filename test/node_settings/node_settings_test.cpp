@@ -537,6 +537,27 @@ TEST(SimSettings, ReadsValidParametersAndThePhysics)
   EXPECT_EQ(20.0, readSim("", "physics: {force_mag: 20}").effort_limit);
 }
 
+TEST(SimSettings, StartsAsTheSharedTaskStarts)
+{
+  // CartPole-v1's: every value uniform in +-physics/start_state_bound, as before there were kinds.
+  const SimSettings v1 = readSim("", "physics: {start_state_bound: 0.1}");
+  EXPECT_EQ(TaskKind::CartPoleV1, v1.task);
+  EXPECT_EQ(CartPoleState::Constant(0.1), v1.start.spread);
+  EXPECT_EQ(CartPoleState::Zero(), v1.start.centre);
+  // A swing-up task's pole hangs: the simulation draws its starts (the first, an empty reset) there.
+  for (const char* kind : {"swingup", "swingup_sparse"})
+  {
+    const SimSettings s = readSim("", std::string("{physics: {tau: 0.01, integrator: rk4, rail_limit: 1.8}, task: {kind: ") +
+                                          kind + "}}");
+    EXPECT_EQ(1.8, s.physics.rail_limit);
+    CartPoleSimulation simulation(s.physics, s.start_state_bound, 0);
+    simulation.setStart(s.start);
+    for (int i = 0; i < 20; ++i)
+      EXPECT_LT(std::cos(simulation.resetRandom()[2]), -0.99) << kind;
+  }
+  EXPECT_SAYS(simError("", "task: {kind: swing_up}"), "task/kind = 'swing_up' is not allowed");
+}
+
 TEST(SimSettings, RefusesAnUnknownMode)
 {
   EXPECT_SAYS(simError("mode: warp"), "cartpole_sim: mode = 'warp' is not allowed (allowed: realtime, lockstep)");

@@ -22,6 +22,11 @@ struct SimSettings
   CartPoleParams physics;           // the shared physics section
   EngineParams engine;              // physics/engine and, for a MuJoCo model, its model, joints and actuator
   double start_state_bound = 0.05;  // physics/start_state_bound
+  // Where a random start (the first state, an empty reset) is drawn: the shared task section's
+  // (CartPole-v1's +-start_state_bound, the Suite's swing-ups hanging), as train_headless draws its
+  // episodes' starts.
+  StartDistribution start = StartDistribution::uniform(0.05);
+  TaskKind task = TaskKind::CartPoleV1;
   SimMode mode = SimMode::Realtime;
   std::uint64_t seed = 0;
   double command_timeout = 0.5;   // [s] realtime: an older command counts as zero

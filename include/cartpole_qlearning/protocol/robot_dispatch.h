@@ -67,6 +67,7 @@ public:
   {
     std::size_t robot = 0;
     Stamp stamp = 0;
+    CartPoleState state = CartPoleState::Zero();  // the state served, as the table sees it
     Reaction reaction;
     LogLines log;
   };
