@@ -45,9 +45,21 @@ std::string toString(TaskKind kind)
   return "unknown";
 }
 
+namespace
+{
+// cos(theta) of the pole on the circle: a turn further on is the same pole, and the same number
+// whether it comes unwrapped (the simulation's state) or wrapped into [-pi, pi] (a controller's
+// reading of a robot, robot_interface.h): remainder is exact, so both give cos the same argument and
+// a table trained on the graph is train_headless's, bit for bit.
+double poleCosine(double theta)
+{
+  return std::cos(std::fabs(theta) > M_PI ? std::remainder(theta, 2.0 * M_PI) : theta);
+}
+}  // namespace
+
 double suiteSmoothReward(const CartPoleState& state, double control)
 {
-  const double upright = (std::cos(state[2]) + 1.0) / 2.0;
+  const double upright = (poleCosine(state[2]) + 1.0) / 2.0;
   const double centred = (1.0 + gaussianNearZero(state[0], 2.0)) / 2.0;
   const double small_control = (4.0 + quadraticNearZero(control)) / 5.0;
   const double small_velocity = (1.0 + gaussianNearZero(state[3], 5.0)) / 2.0;
@@ -58,7 +70,7 @@ double suiteSparseReward(const CartPoleState& state)
 {
   // Both bounds inclusive, as tolerance's with margin 0.
   const bool centred = state[0] >= -0.25 && state[0] <= 0.25;
-  const bool upright = std::cos(state[2]) >= 0.995;
+  const bool upright = poleCosine(state[2]) >= 0.995;
   return centred && upright ? 1.0 : 0.0;
 }
 
