@@ -26,13 +26,13 @@ std::string newtons(double value)
 
 ControlMeter::ControlMeter(std::string robot, double tau, double max_gap, double max_effort, double report_every,
                            TaskKind task, double rail_limit)
-  : robot_(std::move(robot))
-  , tau_(tau)
-  , max_gap_(max_gap)
-  , max_effort_(max_effort)
-  , report_every_(report_every)
-  , never_ends_(isSuiteTask(task))
-  , rail_limit_(rail_limit)
+  : robot_(std::move(robot)),
+    tau_(tau),
+    max_gap_(max_gap),
+    max_effort_(max_effort),
+    report_every_(report_every),
+    never_ends_(isSuiteTask(task)),
+    rail_limit_(rail_limit)
 {
 }
 
@@ -70,9 +70,9 @@ void ControlMeter::measure(const CartPoleState& state, double dt, LogLines& log)
     ++stats_.falls;
     down_since_ = now;
     upright_since_.reset();
-    log.push_back(
-        {LogLine::Level::Warn, name() + ": the pole fell after " + seconds(stats_.current_seconds) +
-                                   " balanced (below the horizontal; swinging it up again); " + reportText()});
+    log.push_back({LogLine::Level::Warn, name() + ": the pole fell after " + seconds(stats_.current_seconds) +
+                                             " balanced (below the horizontal; swinging it up again); " +
+                                             reportText()});
     stats_.current_seconds = 0.0;
     return;
   }
@@ -120,8 +120,8 @@ LogLines ControlMeter::onReaction(const Reaction& reaction, bool fell, const std
     if (fell)
     {
       ++stats_.falls;
-      log.push_back({LogLine::Level::Warn,
-                     name() + ": the pole fell after " + seconds(stats_.current_seconds) + " balanced; " + reportText()});
+      log.push_back({LogLine::Level::Warn, name() + ": the pole fell after " + seconds(stats_.current_seconds) +
+                                               " balanced; " + reportText()});
     }
     stats_.current_seconds = 0.0;
   }

@@ -121,8 +121,8 @@ CartPoleSimNode::CartPoleSimNode(const ros::NodeHandle& nh, const ros::NodeHandl
       "cartpole_sim: %s mode, tau %g s, %s, seed %llu, starts of task %s, start state [%g, %g, %g, %g]%s%s",
       settings_.mode == SimMode::Lockstep ? "lockstep" : "realtime", settings_.physics.tau, engine.c_str(),
       static_cast<unsigned long long>(settings_.seed), toString(settings_.task).c_str(), simulation_->state()[0],
-      simulation_->state()[1],
-      simulation_->state()[2], simulation_->state()[3], settings_.publish_clock ? ", publishing /clock" : "",
+      simulation_->state()[1], simulation_->state()[2], simulation_->state()[3],
+      settings_.publish_clock ? ", publishing /clock" : "",
       own_rate ? (", joint_states every " + SectionReader::numberText(settings_.publish_period) + " s").c_str() : "");
   if (!settings_.suite_case.empty())
     say(ros::console::levels::Info, "cartpole_sim: posing as case %s of %s", settings_.suite_case.c_str(),

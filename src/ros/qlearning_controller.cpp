@@ -57,11 +57,10 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   if (session_->findingDelay())
     delay_pub_ = pnh_.advertise<std_msgs::UInt32>("found_delay_steps", 1, true);
   if (settings_.run.controlling())
-    control_ = std::make_unique<ControlReporter>(nh_, settings_.robots, settings_.training.physics.tau,
-                                                 settings_.run.control_max_gap, settings_.robot.max_effort,
-                                                 settings_.run.report_every, settings_.training.task.kind,
-                                                 settings_.training.physics.rail_limit,
-                                                 [this](const LogLines& log) { say(log); });
+    control_ = std::make_unique<ControlReporter>(
+        nh_, settings_.robots, settings_.training.physics.tau, settings_.run.control_max_gap,
+        settings_.robot.max_effort, settings_.run.report_every, settings_.training.task.kind,
+        settings_.training.physics.rail_limit, [this](const LogLines& log) { say(log); });
   ros::NodeHandle services_nh(pnh_);
   services_nh.setCallbackQueue(&services_queue_);
   save_srv_ = services_nh.advertiseService("save_q_table", &QLearningControllerNode::onSave, this);

@@ -547,8 +547,8 @@ TEST(SimSettings, StartsAsTheSharedTaskStarts)
   // A swing-up task's pole hangs: the simulation draws its starts (the first, an empty reset) there.
   for (const char* kind : {"swingup", "swingup_sparse"})
   {
-    const SimSettings s = readSim("", std::string("{physics: {tau: 0.01, integrator: rk4, rail_limit: 1.8}, task: {kind: ") +
-                                          kind + "}}");
+    const SimSettings s = readSim(
+        "", std::string("{physics: {tau: 0.01, integrator: rk4, rail_limit: 1.8}, task: {kind: ") + kind + "}}");
     EXPECT_EQ(1.8, s.physics.rail_limit);
     CartPoleSimulation simulation(s.physics, s.start_state_bound, 0);
     simulation.setStart(s.start);

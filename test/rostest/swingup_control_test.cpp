@@ -182,8 +182,8 @@ TEST(SwingupControl, ATableSwingsAHangingPoleUpAndKeepsControllingThroughKnocksF
                      "mode:=control load:=" + table + " robot_lockstep:=true max_effort:=10 report_every:=60",
                      "robot.launch");
   ASSERT_TRUE(spinUntil([&] { return !reports.empty() && reports.back().seconds >= 300.0; }, 240.0))
-      << reports.size() << " reports" << (reports.empty() ? "" : ", the last at " + std::to_string(reports.back().seconds))
-      << " s\n"
+      << reports.size() << " reports"
+      << (reports.empty() ? "" : ", the last at " + std::to_string(reports.back().seconds)) << " s\n"
       << launch.output();
   const ControlStats at_five_minutes = reports.back();
   EXPECT_EQ(0, launch.interrupt(30.0)) << launch.output();
@@ -208,9 +208,10 @@ TEST(SwingupControl, ATableSwingsAHangingPoleUpAndKeepsControllingThroughKnocksF
   {
     std::size_t pushing = 0;
     for (const auto& [stamp, effort] : commands)
-      pushing += effort != 0.0 && stamp >= first + minute * 60000000000ull && stamp < first + (minute + 1) * 60000000000ull
-                     ? 1
-                     : 0;
+      pushing +=
+          effort != 0.0 && stamp >= first + minute * 60000000000ull && stamp < first + (minute + 1) * 60000000000ull
+              ? 1
+              : 0;
     EXPECT_GT(pushing, 100u) << "minute " << minute + 1 << ": the controller stopped driving the cart";
   }
 
@@ -240,22 +241,24 @@ TEST(SwingupControl, ATableSwingsAHangingPoleUpAndKeepsControllingThroughKnocksF
   EXPECT_EQ(0.0, commands.back().second);
   EXPECT_TRUE(cartpole_qlearning::test::text_match::contains(
       output,
-      "control ended: upright [0-9.]+ s of [0-9.]+ s \\(cos\\(theta\\) >= 0.95\\), [0-9]+ swing-ups?.*, balanced [0-9.]+ "
+      "control ended: upright [0-9.]+ s of [0-9.]+ s \\(cos\\(theta\\) >= 0.95\\), [0-9]+ swing-ups?.*, balanced "
+      "[0-9.]+ "
       "s of [0-9.]+ s, the longest stretch [0-9.]+ s, [0-9]+ falls?, [0-9]+ hits? of the rail's ends, 0 of [0-9]+ "
       "commands beyond the motor's 10 N"))
       << output;
 
-  std::printf("five minutes of swing-up control, seed %d's table (greedy score %.1f): upright %.1f s, %llu "
-              "swing-ups (the longest %.1f s), %llu falls, %zu pushes, %llu rail hits\n",
-              seed, table_score, at_five_minutes.upright_seconds,
-              static_cast<unsigned long long>(at_five_minutes.swing_ups), at_five_minutes.longest_swing_up_seconds,
-              static_cast<unsigned long long>(at_five_minutes.falls), pushes,
-              static_cast<unsigned long long>(at_five_minutes.rail_hits));
+  std::printf(
+      "five minutes of swing-up control, seed %d's table (greedy score %.1f): upright %.1f s, %llu "
+      "swing-ups (the longest %.1f s), %llu falls, %zu pushes, %llu rail hits\n",
+      seed, table_score, at_five_minutes.upright_seconds, static_cast<unsigned long long>(at_five_minutes.swing_ups),
+      at_five_minutes.longest_swing_up_seconds, static_cast<unsigned long long>(at_five_minutes.falls), pushes,
+      static_cast<unsigned long long>(at_five_minutes.rail_hits));
   if (!swings_up)
   {
-    std::printf("the table scores %.1f < %.0f: it cannot swing the pole up yet, so the test checks the protocol "
-                "only\n",
-                table_score, kSwingsUp);
+    std::printf(
+        "the table scores %.1f < %.0f: it cannot swing the pole up yet, so the test checks the protocol "
+        "only\n",
+        table_score, kSwingsUp);
     return;
   }
   // A table that swings up: the hanging pole comes up, the pushes knock it down at least twice, and each

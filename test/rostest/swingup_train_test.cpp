@@ -63,8 +63,8 @@ std::string headlessTable()
     const CommandRun run = runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + kConfig +
                                       " --seed 2 --max-episodes " + kEpisodes + " --quiet");
     EXPECT_EQ(0, run.status) << run.output;
-    EXPECT_EQ(0u, run.lastLine().find("until=max_episodes reached=true solved=false episodes=" + kEpisodes +
-                                      " steps=8000 "))
+    EXPECT_EQ(
+        0u, run.lastLine().find("until=max_episodes reached=true solved=false episodes=" + kEpisodes + " steps=8000 "))
         << run.output;
   }
   return runTable(home);

@@ -36,9 +36,9 @@ struct ControlStatsValues
   double current_seconds = 0.0;   // the stretch going on (0 while waiting for a start, or down)
   std::uint64_t falls = 0;        // past the task's thresholds, or (never-ending tasks) a pole up gone down
   std::uint64_t decisions = 0;
-  std::uint64_t clamped = 0;       // decisions whose effort was beyond the motor's limit (clamped to it)
-  double upright_seconds = 0.0;    // with cos(theta) >= kUprightCos
-  std::uint64_t swing_ups = 0;     // never-ending tasks only
+  std::uint64_t clamped = 0;     // decisions whose effort was beyond the motor's limit (clamped to it)
+  double upright_seconds = 0.0;  // with cos(theta) >= kUprightCos
+  std::uint64_t swing_ups = 0;   // never-ending tasks only
   double last_swing_up_seconds = 0.0;
   double longest_swing_up_seconds = 0.0;
   std::uint64_t rail_hits = 0;  // arrivals at the rail's ends (none counted without a rail_limit)

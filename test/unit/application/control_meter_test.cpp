@@ -165,7 +165,7 @@ TEST(ControlMeter, ASwingUpTableIsJudgedByTheAngleSwingUpsFallsAndTimeUpright)
   ControlMeter meter("", 0.02, 0.1, 10.0, 1000.0, TaskKind::Swingup, 1.8);
   States states;
   meter.onReaction(states.decided(0.0, true), false, at(M_PI));  // hanging: the clock starts
-  for (int i = 1; i < 100; ++i)                                   // 2 s swinging, down
+  for (int i = 1; i < 100; ++i)                                  // 2 s swinging, down
     EXPECT_TRUE(meter.onReaction(states.decided(10.0), false, at(M_PI - 0.01 * i)).empty());
   // Through upright and on over the top: not held, no swing-up.
   for (int i = 0; i < 10; ++i)
