@@ -11,7 +11,8 @@ GreedyEpisodes::GreedyEpisodes(const QTable& table, const TrainingConfig& config
     features_(config.agent.featureParams(), config.agent.actions.size()),
     efforts_(table.actions()),
     predictor_(config.physics, predict_delay_steps),
-    predicting_(predict_delay_steps > 0)
+    predicting_(predict_delay_steps > 0),
+    decision_steps_(config.agent.decision_steps)
 {
 }
 
@@ -33,6 +34,9 @@ GreedyEpisode GreedyEpisodes::run(CartPoleSimulation& simulation)
     if (outcome.done())
       break;
     predictor_.observed(simulation.observation());
+    // Within a decision period the action is held (as TrainingSession holds it).
+    if (episode.steps % decision_steps_ != 0)
+      continue;
     // The action just taken is part of what a previous_action table sees of the state.
     features_.activeRows(predicting_ ? predictor_.predict(simulation.observation()) : simulation.observation(), rows_,
                          action + 1);

@@ -192,6 +192,34 @@ const ConfigSection<AgentParams>& learningSection()
         dimensionsKey("lower_bounds", "4 doubles: the bins' and tiles' lower bounds", lower),
         dimensionsKey("upper_bounds", "4 doubles: the bins' and tiles' upper bounds", upper),
     };
+    // Written only when not the default, so that the tables of configs without them stay as they were.
+    ConfigKey<A> lambda =
+        plainKey<A>("lambda", "double: Watkins's Q(lambda)'s trace decay, 0 for none", field(&A::lambda));
+    lambda.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.lambda != 0.0)
+        writer.write("lambda", agent.lambda);
+    };
+    ConfigKey<A> decision = wholeKey<A>("decision_steps", "int, steps: the physics steps each action is held for",
+                                        field(&A::decision_steps), 1, kMaxDecisionSteps);
+    decision.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.decision_steps != 1)
+        writer.write("decision_steps", agent.decision_steps);
+    };
+    ConfigKey<A> initial =
+        plainKey<A>("initial_value", "double: Q(s, a) before any learning", field(&A::initial_value));
+    initial.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.initial_value != 0.0)
+        writer.write("initial_value", agent.initial_value);
+    };
+    ConfigKey<A> warp = dimensionsKey("warp", "4 doubles: finer bins and tiles near 0, 1 for uniform", field(&A::warp));
+    warp.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.featureParams().warped())
+        writer.write("warp", agent.warp);
+    };
+    s.keys.push_back(warp);
+    s.keys.push_back(lambda);
+    s.keys.push_back(initial);
+    s.keys.push_back(decision);
     addSchedule(s.keys, "epsilon", &A::epsilon, "exploration rate");
     addSchedule(s.keys, "alpha", &A::alpha, "learning rate");
     ConfigKey<A> names = plainKey<A>("state_names", "list of strings: the table rows' names, then the fallen state's",

@@ -31,6 +31,17 @@ TileCoderParams FeatureParams::tileCoder() const
 
 std::string FeatureParams::validate() const
 {
+  for (std::size_t d = 0; d < kStateDimensions; ++d)
+  {
+    std::ostringstream out;
+    if (!(warp[d] >= 1.0 && warp[d] <= 10.0))
+      out << "warp[" << d << "] = " << warp[d] << " is not allowed (must be in [1, 10])";
+    else if (warp[d] != 1.0 && !(discretiser.upper[d] > 0.0 && discretiser.lower[d] == -discretiser.upper[d]))
+      out << "warp[" << d << "] = " << warp[d] << " is not allowed with bounds [" << discretiser.lower[d] << ", "
+          << discretiser.upper[d] << "] (a warped dimension's bounds must be symmetric about 0)";
+    if (!out.str().empty())
+      return out.str();
+  }
   return kind == FeatureKind::Tiles ? tileCoder().validate() : discretiser.validate();
 }
 
@@ -107,7 +118,8 @@ const FeatureParams& checked(const FeatureParams& params)
 FeatureMap::FeatureMap(const FeatureParams& params, std::size_t actions)
   : params_(checked(params)),
     discretiser_(params.kind == FeatureKind::Bins ? params.discretiser : DiscretiserParams()),
-    state_rows_(discretiser_.stateCount())
+    state_rows_(discretiser_.stateCount()),
+    warped_(params.warped())
 {
   if (params_.kind == FeatureKind::Tiles)
   {

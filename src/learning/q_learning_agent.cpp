@@ -77,6 +77,7 @@ FeatureParams AgentParams::featureParams() const
   params.tilings = tilings;
   params.tiles = tiles;
   params.previous_action = previous_action;
+  params.warp = warp;
   return params;
 }
 
@@ -106,6 +107,21 @@ std::string AgentParams::validate() const
   if (!(gamma >= 0.0 && gamma <= 1.0))
   {
     out << "gamma = " << gamma << " is not allowed (must be in [0, 1])";
+    return out.str();
+  }
+  if (!(lambda >= 0.0 && lambda <= 1.0))
+  {
+    out << "lambda = " << lambda << " is not allowed (must be in [0, 1])";
+    return out.str();
+  }
+  if (!std::isfinite(initial_value))
+  {
+    out << "initial_value = " << initial_value << " is not allowed (must be finite)";
+    return out.str();
+  }
+  if (decision_steps < 1 || decision_steps > kMaxDecisionSteps)
+  {
+    out << "decision_steps = " << decision_steps << " is not allowed (must be in [1, " << kMaxDecisionSteps << "])";
     return out.str();
   }
   // Names label table rows, one per state: tiles have no such rows.
@@ -144,6 +160,13 @@ QLearningAgent::QLearningAgent(const AgentParams& params, std::uint64_t seed)
     table_(params.featureParams(), params.actions),
     rng_(seed, kAgentStream)
 {
+  if (params_.initial_value != 0.0)
+  {
+    const double weight = params_.initial_value / (params_.features == FeatureKind::Tiles ? params_.tilings : 1);
+    for (std::size_t row = 0; row < table_.stateCount(); ++row)
+      for (std::size_t a = 0; a < table_.actionCount(); ++a)
+        table_.at(row, a) = weight;
+  }
 }
 
 double QLearningAgent::value(const ActiveRows& state, std::size_t action) const
@@ -206,19 +229,42 @@ double QLearningAgent::maxValue(const ActiveRows& state) const
   return best_q;
 }
 
-std::size_t QLearningAgent::selectAction(const ActiveRows& state, double epsilon)
+std::size_t QLearningAgent::selectAction(const ActiveRows& state, double epsilon, bool* explored)
 {
+  if (explored != nullptr)
+    *explored = false;
   if (rng_.uniform01() < epsilon)
-    return static_cast<std::size_t>(rng_.uniformIndex(table_.actionCount()));
+  {
+    const auto action = static_cast<std::size_t>(rng_.uniformIndex(table_.actionCount()));
+    if (explored != nullptr)
+      *explored = action != greedyAction(state);
+    return action;
+  }
   return greedyAction(state);
 }
 
 QUpdate QLearningAgent::update(const ActiveRows& state, std::size_t action, double reward, const ActiveRows& next_state,
-                               bool next_is_terminal, double alpha)
+                               bool next_is_terminal, double alpha, EligibilityTraces* traces)
 {
   QUpdate done;
   done.next_max = next_is_terminal ? 0.0 : maxValue(next_state);
   done.target = next_is_terminal ? reward : reward + params_.gamma * done.next_max;
+  if (traces != nullptr && params_.lambda > 0.0)
+  {
+    done.old_value = value(state, action);
+    traces->visit(state, action, table_.actionCount(), table_.values().size());
+    const double step = alpha / state.count * (done.target - done.old_value);
+    const std::vector<std::uint32_t>& indices = traces->indices();
+    const std::vector<double>& weights = traces->traces();
+    for (std::size_t i = 0; i < indices.size(); ++i)
+      table_.at(indices[i] / table_.actionCount(), indices[i] % table_.actionCount()) += step * weights[i];
+    done.new_value = value(state, action);
+    if (next_is_terminal)
+      traces->clear();
+    else
+      traces->decay(params_.gamma * params_.lambda);
+    return done;
+  }
   if (state.count == 1)
   {
     // Bins: one row, the arithmetic in the order it always had (a seed's table stays the same).

@@ -57,9 +57,17 @@ std::string TrainingSession::predictDelay(const CartPoleParams& model, unsigned 
   return "";
 }
 
-std::size_t TrainingSession::chooseAction(const ActiveRows& state, double epsilon)
+std::size_t TrainingSession::chooseAction(const ActiveRows& state, double epsilon, EligibilityTraces& traces)
 {
-  return learning_ ? agent_.selectAction(state, epsilon) : agent_.greedyAction(state);
+  if (!learning_)
+    return agent_.greedyAction(state);
+  if (agent_.params().lambda <= 0.0)
+    return agent_.selectAction(state, epsilon);
+  bool explored = false;
+  const std::size_t action = agent_.selectAction(state, epsilon, &explored);
+  if (explored)
+    traces.clear();
+  return action;
 }
 
 double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size_t robot)
@@ -74,10 +82,13 @@ double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size
   e.steps = 0;
   e.steps_before_table = 0;
   e.episode_return = 0.0;
+  e.held = 0;
+  e.held_reward = 0.0;
+  e.traces.clear();
   if (!predictors_.empty())
     predictors_[robot].begin(start_state);
   agent_.activeRows(decidedFor(start_state, robot), e.rows[e.current]);
-  e.action = chooseAction(e.state(), e.epsilon);
+  e.action = chooseAction(e.state(), e.epsilon, e.traces);
   const double effort = agent_.table().actions()[e.action];
   if (!predictors_.empty())
     predictors_[robot].sent(effort);
@@ -93,14 +104,30 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   e.episode_return += decision.outcome.score;
   if (!predictors_.empty())
     predictors_[robot].observed(state);
+  // Within a decision period the action is held and its rewards summed (one step a decision
+  // learns from the step's reward itself, as it always did).
+  e.held_reward = e.held == 0 ? decision.outcome.reward : e.held_reward + decision.outcome.reward;
+  ++e.held;
+  if (!decision.outcome.done() && e.held < agent_.params().decision_steps)
+  {
+    decision.action = e.action;
+    decision.effort = agent_.table().actions()[e.action];
+    if (!predictors_.empty())
+      predictors_[robot].sent(decision.effort);
+    return decision;
+  }
+  const double reward = e.held_reward;
+  const unsigned held = e.held;
+  e.held = 0;
+  e.held_reward = 0.0;
   // The action just taken: with previous_action, part of what the learner sees of this state.
   // (A predicting session does not learn: its rows are only what the next action is chosen on.)
   agent_.activeRows(decidedFor(state, robot), e.next(), e.action + 1);
   if (learning_)
   {
-    const QUpdate update =
-        agent_.update(e.state(), e.action, decision.outcome.reward, e.next(), decision.outcome.terminated, e.alpha);
-    ++agent_.table().steps;
+    const QUpdate update = agent_.update(e.state(), e.action, reward, e.next(), decision.outcome.terminated, e.alpha,
+                                         agent_.params().lambda > 0.0 ? &e.traces : nullptr);
+    agent_.table().steps += held;
     if (trace_)
     {
       TraceStep step;
@@ -109,7 +136,7 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
       // One row per state: the trace is for bins (features tiles refuse it, see traceRefusal).
       step.state = e.state().rows[0];
       step.action = e.action;
-      step.reward = decision.outcome.reward;
+      step.reward = reward;
       step.next_state = e.next().rows[0];
       step.terminal = decision.outcome.terminated;
       step.truncated = decision.outcome.truncated;
@@ -123,7 +150,7 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   if (!decision.outcome.done())
   {
     e.current ^= 1;
-    e.action = chooseAction(e.state(), e.epsilon);
+    e.action = chooseAction(e.state(), e.epsilon, e.traces);
     decision.action = e.action;
     decision.effort = agent_.table().actions()[e.action];
     if (!predictors_.empty())

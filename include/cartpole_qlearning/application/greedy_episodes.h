@@ -45,6 +45,7 @@ private:
   const std::vector<double>& efforts_;
   DelayPredictor predictor_;
   const bool predicting_;
+  const unsigned decision_steps_;
   ActiveRows rows_;
 };
 

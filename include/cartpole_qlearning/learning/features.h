@@ -7,6 +7,7 @@
 #include "cartpole_qlearning/learning/discretiser.h"
 #include "cartpole_qlearning/learning/tile_coder.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -37,7 +38,17 @@ struct FeatureParams
   // still carrying out, which the state alone does not show. The rows repeat once for "none"
   // (an episode's first state) and once per action.
   bool previous_action = false;
+  // Per dimension, a resolution that is finer near 0 (upright, at rest) than towards the bounds:
+  // a value v within bounds [-b, b] is binned or tiled at b * sign(v) * (|v| / b)^(1 / warp), so
+  // that the tile at 0 spans (1 / tiles)^warp of the range instead of 1 / tiles. 1: uniform (the
+  // default); a warped dimension needs bounds symmetric about 0. Carried by the configuration a
+  // table was trained with (its trained_with), not by the table's file.
+  std::array<double, kStateDimensions> warp{{1.0, 1.0, 1.0, 1.0}};
 
+  bool warped() const
+  {
+    return warp != std::array<double, kStateDimensions>{{1.0, 1.0, 1.0, 1.0}};
+  }
   TileCoderParams tileCoder() const;
   // Empty when the kind in use is valid, else validate()'s message of its parameters.
   std::string validate() const;
@@ -101,13 +112,34 @@ public:
   // are, so that CartPole-v1's tables stay as they were.
   void activeRows(const CartPoleState& state, ActiveRows& active, std::size_t previous = 0) const
   {
-    if (std::fabs(state[2]) > M_PI)
+    if (std::fabs(state[2]) > M_PI || warped_)
     {
-      CartPoleState wrapped = state;
-      wrapped[2] = std::remainder(state[2], 2.0 * M_PI);
-      activeRows(wrapped, active, previous);
+      CartPoleState seen = state;
+      if (std::fabs(state[2]) > M_PI)
+        seen[2] = std::remainder(state[2], 2.0 * M_PI);
+      if (warped_)
+        warp(seen);
+      codedRows(seen, active, previous);
       return;
     }
+    codedRows(state, active, previous);
+  }
+
+private:
+  // FeatureParams::warp applied to the state's values.
+  void warp(CartPoleState& state) const
+  {
+    for (std::size_t d = 0; d < kStateDimensions; ++d)
+    {
+      if (params_.warp[d] == 1.0)
+        continue;
+      const double bound = params_.discretiser.upper[d];
+      const double ratio = std::min(std::fabs(state[d]) / bound, 1.0);
+      state[d] = std::copysign(bound * std::pow(ratio, 1.0 / params_.warp[d]), state[d]);
+    }
+  }
+  void codedRows(const CartPoleState& state, ActiveRows& active, std::size_t previous) const
+  {
     const auto offset = static_cast<std::uint32_t>(params_.previous_action ? previous * state_rows_ : 0);
     if (!tile_coder_)
     {
@@ -121,12 +153,12 @@ public:
       active.rows[i] += offset;
   }
 
-private:
   FeatureParams params_;
   Discretiser discretiser_;
   std::optional<TileCoder> tile_coder_;
   std::size_t state_rows_;
   std::size_t row_count_;
+  bool warped_ = false;
 };
 
 }  // namespace cartpole_qlearning

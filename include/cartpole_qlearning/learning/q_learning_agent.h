@@ -4,6 +4,7 @@
 #pragma once
 
 #include "cartpole_qlearning/learning/discretiser.h"
+#include "cartpole_qlearning/learning/eligibility_traces.h"
 #include "cartpole_qlearning/learning/features.h"
 #include "cartpole_qlearning/learning/q_table.h"
 #include "cartpole_qlearning/common/random.h"
@@ -16,6 +17,9 @@
 
 namespace cartpole_qlearning
 {
+// The longest decision period a config may ask for: a second of the Suite's 0.01 s steps.
+constexpr unsigned kMaxDecisionSteps = 100;
+
 struct AgentParams
 {
   // What the learner sees of the state (features.h). The bins are used by bins only, the bounds
@@ -24,9 +28,19 @@ struct AgentParams
   DiscretiserParams discretiser;
   unsigned tilings = 8;
   std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
-  bool previous_action = false;               // the action taken last is part of what the learner sees
-  std::vector<double> actions{-10.0, 10.0};   // [N] the effort of each action
-  double gamma = 0.99;                        // discount, in [0, 1]
+  bool previous_action = false;  // the action taken last is part of what the learner sees
+  std::array<double, kStateDimensions> warp{{1.0, 1.0, 1.0, 1.0}};  // FeatureParams::warp
+  std::vector<double> actions{-10.0, 10.0};                         // [N] the effort of each action
+  double gamma = 0.99;                                              // discount per decision, in [0, 1]
+  // Watkins's Q(lambda) (eligibility_traces.h): in [0, 1]; 0 is one-step Q-learning, no traces.
+  double lambda = 0.0;
+  // Physics steps an action is held for (a decision period): the rewards of its steps summed
+  // into one transition, gamma applied once a decision. 1 decides every step.
+  unsigned decision_steps = 1;
+  // Q(s, a) of every state and action before any learning (each of N active rows' weights holds
+  // 1/N of it). Above the returns a task can give, it is optimism: every untried action looks
+  // better than what has been tried, and the table explores by itself. 0: today's empty table.
+  double initial_value = 0.0;
   ScheduleParams epsilon = defaultEpsilon();  // exploration rate per episode
   ScheduleParams alpha = defaultAlpha();      // learning rate per episode
   // Names of the table's rows for the trace, then the name of the terminal state (which has no
@@ -109,7 +123,9 @@ public:
 
   // With probability epsilon a uniformly drawn action, else the greedy one. Always takes one
   // draw for the coin and, when exploring, one for the action.
-  std::size_t selectAction(const ActiveRows& state, double epsilon);
+  // explored, when given: whether the action taken is not the greedy one (what ends Watkins's
+  // traces); a draw that lands on the greedy action is greedy.
+  std::size_t selectAction(const ActiveRows& state, double epsilon, bool* explored = nullptr);
   // The first action with the largest Q (ties go to the lowest index, as numpy's argmax).
   std::size_t greedyAction(const ActiveRows& state) const
   {
@@ -136,8 +152,12 @@ public:
   // active rows each of their weights moves by alpha / N of the error, so Q(s,a) moves by alpha
   // of it whatever N is (alpha keeps its meaning across bins and tilings). Returns what it did
   // (the trace).
+  // traces (with lambda > 0): Watkins's Q(lambda); the state's weights for the action are
+  // visited, the error moves every traced weight by alpha / N times its trace, and the traces
+  // then fade by gamma * lambda (cleared on a terminal state). The caller clears them when it
+  // then explores (selectAction's explored) and when an episode begins.
   QUpdate update(const ActiveRows& state, std::size_t action, double reward, const ActiveRows& next_state,
-                 bool next_is_terminal, double alpha);
+                 bool next_is_terminal, double alpha, EligibilityTraces* traces = nullptr);
   // The same for bins states given as their rows.
   QUpdate update(std::size_t state, std::size_t action, double reward, std::size_t next_state, bool next_is_terminal,
                  double alpha)

@@ -220,6 +220,11 @@ private:
     std::array<ActiveRows, 2> rows{};
     unsigned current = 0;
     std::size_t action = 0;
+    // The decision period (AgentParams::decision_steps): the steps the action has been held for
+    // and their rewards summed, the transition the next decision learns from.
+    unsigned held = 0;
+    double held_reward = 0.0;
+    EligibilityTraces traces;  // Q(lambda)'s, this episode's
     unsigned steps = 0;
     // Of steps, those taken before a table was loaded mid-episode (resume()): the loaded table's
     // step count does not hold them, so the session's total does not add them either.
@@ -232,7 +237,8 @@ private:
     ReturnWindow returns;
   };
 
-  std::size_t chooseAction(const ActiveRows& state, double epsilon);
+  // While learning with traces, an exploring choice ends them (Watkins).
+  std::size_t chooseAction(const ActiveRows& state, double epsilon, EligibilityTraces& traces);
   // The state a decision is made for: the observed one, or its prediction (predictDelay).
   CartPoleState decidedFor(const CartPoleState& observed, std::size_t robot) const
   {
