@@ -154,3 +154,106 @@ TEST(QLearningAgent, BadParametersAreRefusedWithTheirName)
   p.epsilon.min = 2.0;
   EXPECT_NE(std::string::npos, p.validate().find("epsilon/min = 2")) << p.validate();
 }
+
+TEST(QLearningAgent, TracesCarryATdErrorBackToTheStatesBeforeIt)
+{
+  AgentParams p = tutorialParams();
+  p.lambda = 0.5;
+  QLearningAgent agent(p, 0);
+  cartpole_qlearning::EligibilityTraces traces;
+  // S0 -A0-> S1 (reward 0), then S1 -A0-> S2 (reward 1), alpha 1, gamma 0.9.
+  agent.update(cartpole_qlearning::ActiveRows::single(0), 0, 0.0, cartpole_qlearning::ActiveRows::single(1), false, 1.0,
+               &traces);
+  EXPECT_DOUBLE_EQ(0.0, agent.table().at(0, 0));
+  EXPECT_DOUBLE_EQ(0.9 * 0.5, traces.trace(0 * 2 + 0));  // faded by gamma * lambda
+  agent.update(cartpole_qlearning::ActiveRows::single(1), 0, 1.0, cartpole_qlearning::ActiveRows::single(2), false, 1.0,
+               &traces);
+  // The error 1 moves Q(S1,A0) by 1 and Q(S0,A0), still traced, by its trace 0.45: one-step
+  // Q-learning would have left it at 0.
+  EXPECT_DOUBLE_EQ(1.0, agent.table().at(1, 0));
+  EXPECT_DOUBLE_EQ(0.45, agent.table().at(0, 0));
+  EXPECT_DOUBLE_EQ(0.0, agent.table().at(0, 1));  // never taken: no trace
+  EXPECT_DOUBLE_EQ(0.0, agent.table().at(1, 1));
+  // A terminal transition ends the traces.
+  agent.update(cartpole_qlearning::ActiveRows::single(2), 1, 0.0, cartpole_qlearning::ActiveRows::single(3), true, 1.0,
+               &traces);
+  EXPECT_EQ(0u, traces.size());
+}
+
+TEST(QLearningAgent, WithoutLambdaTheTracesAreNotUsed)
+{
+  QLearningAgent agent(tutorialParams(), 0);
+  cartpole_qlearning::EligibilityTraces traces;
+  agent.update(cartpole_qlearning::ActiveRows::single(0), 0, 0.0, cartpole_qlearning::ActiveRows::single(1), false, 1.0,
+               &traces);
+  agent.update(cartpole_qlearning::ActiveRows::single(1), 0, 1.0, cartpole_qlearning::ActiveRows::single(2), false, 1.0,
+               &traces);
+  EXPECT_DOUBLE_EQ(0.0, agent.table().at(0, 0));
+  EXPECT_EQ(0u, traces.size());
+}
+
+TEST(QLearningAgent, AVisitedTraceIsReplacedNotAccumulated)
+{
+  cartpole_qlearning::EligibilityTraces traces;
+  const auto s0 = cartpole_qlearning::ActiveRows::single(0);
+  traces.visit(s0, 1, 2, 8);
+  traces.decay(0.5);
+  traces.visit(s0, 1, 2, 8);
+  EXPECT_DOUBLE_EQ(1.0, traces.trace(1));
+  traces.decay(0.5);
+  traces.decay(0.5);
+  EXPECT_DOUBLE_EQ(0.25, traces.trace(1));
+  // Below the floor (0.01) a trace is dropped.
+  for (int i = 0; i < 5; ++i)
+    traces.decay(0.5);
+  EXPECT_EQ(0u, traces.size());
+  EXPECT_DOUBLE_EQ(0.0, traces.trace(1));
+}
+
+TEST(QLearningAgent, AnInitialValueIsEveryQBeforeLearning)
+{
+  AgentParams p;
+  p.features = cartpole_qlearning::FeatureKind::Tiles;
+  p.tilings = 4;
+  p.actions = {-10.0, 0.0, 10.0};
+  p.initial_value = 30.0;
+  QLearningAgent agent(p, 0);
+  cartpole_qlearning::ActiveRows rows;
+  agent.activeRows(cartpole_qlearning::CartPoleState(0.1, -0.2, 0.05, 0.3), rows);
+  for (std::size_t a = 0; a < 3; ++a)
+    EXPECT_DOUBLE_EQ(30.0, agent.value(rows, a));
+}
+
+TEST(QLearningAgent, WarpedFeaturesAreFinerNearZero)
+{
+  AgentParams p;
+  p.discretiser.bins = {{1, 1, 4, 1}};
+  p.discretiser.lower[2] = -1.0;
+  p.discretiser.upper[2] = 1.0;
+  const QLearningAgent uniform(p, 0);
+  p.warp[2] = 2.0;
+  const QLearningAgent warped(p, 0);
+  const auto row = [](const QLearningAgent& agent, double theta) {
+    cartpole_qlearning::ActiveRows rows;
+    agent.activeRows(cartpole_qlearning::CartPoleState(0.0, 0.0, theta, 0.0), rows);
+    return rows.rows[0];
+  };
+  // Uniform: [0, 0.5) is one bin. Warped by 2: 0.1 is seen at sqrt(0.1) = 0.32, 0.4 at 0.63.
+  EXPECT_EQ(row(uniform, 0.1), row(uniform, 0.4));
+  EXPECT_NE(row(warped, 0.1), row(warped, 0.4));
+  EXPECT_EQ(3u, row(warped, 0.3));   // sqrt(0.3) = 0.55
+  EXPECT_EQ(0u, row(warped, -0.3));  // and its mirror image
+  // A warped dimension's bounds must be symmetric about 0.
+  p.discretiser.lower[2] = -0.5;
+  EXPECT_NE(std::string::npos, p.validate().find("warp[2] = 2")) << p.validate();
+}
+
+TEST(QLearningAgent, LambdaAndDecisionStepsOutOfRangeAreRefused)
+{
+  AgentParams p = tutorialParams();
+  p.lambda = 1.5;
+  EXPECT_NE(std::string::npos, p.validate().find("lambda = 1.5")) << p.validate();
+  p = tutorialParams();
+  p.decision_steps = 0;
+  EXPECT_NE(std::string::npos, p.validate().find("decision_steps = 0")) << p.validate();
+}

@@ -161,6 +161,45 @@ TEST(TrainingSession, TruncationBootstrapsAndAFallDoesNot)
   EXPECT_EQ(2u, session.table().episodes);
 }
 
+TEST(TrainingSession, ADecisionPeriodHoldsTheActionAndLearnsTheSummedRewardDiscountedOnce)
+{
+  TaskParams task;
+  task.max_episode_steps = 4;
+  AgentParams agent;
+  agent.gamma = 0.5;
+  agent.decision_steps = 3;
+  agent.epsilon.type = ScheduleType::Constant;
+  agent.epsilon.start = agent.epsilon.min = 0.0;
+  agent.alpha.type = ScheduleType::Constant;
+  agent.alpha.start = agent.alpha.min = 1.0;
+  TrainingSession session(task, agent, 0);
+
+  const Discretiser& d = session.agent().discretiser();
+  const CartPoleState upright = CartPoleState::Zero();
+  QTable table(agent.discretiser, agent.actions);
+  table.at(d.index(upright), 0) = 8.0;
+  ASSERT_EQ("", session.replaceTable(table));
+
+  EXPECT_EQ(-10.0, session.beginEpisode(upright));
+  // Within the period: the same action, nothing learnt yet.
+  for (int step = 1; step <= 2; ++step)
+  {
+    const Decision decision = session.observe(upright);
+    EXPECT_FALSE(decision.episode_over);
+    EXPECT_EQ(0u, decision.action);
+    EXPECT_DOUBLE_EQ(8.0, session.table().at(d.index(upright), 0)) << "step " << step;
+  }
+  // The third step ends the period: the three rewards of 1 summed, gamma once: 3 + 0.5 * 8.
+  session.observe(upright);
+  EXPECT_DOUBLE_EQ(3.0 + 0.5 * 8.0, session.table().at(d.index(upright), 0));
+  EXPECT_EQ(3u, session.table().steps);
+  // Truncated one step into the next period: that step's reward, bootstrapped once: 1 + 0.5 * 7.
+  const Decision last = session.observe(upright);
+  EXPECT_TRUE(last.outcome.truncated);
+  EXPECT_DOUBLE_EQ(1.0 + 0.5 * 7.0, session.table().at(d.index(upright), 0));
+  EXPECT_EQ(4u, session.table().steps);
+}
+
 TEST(TrainingSession, EvaluationActsGreedilyAndLearnsNothing)
 {
   TrainingConfig config = shippedConfig();
