@@ -40,7 +40,8 @@ struct FeatureParams
   bool previous_action = false;
   // Per dimension, a resolution that is finer near 0 (upright, at rest) than towards the bounds:
   // a value v within bounds [-b, b] is binned or tiled at b * sign(v) * (|v| / b)^(1 / warp), so
-  // that the tile at 0 spans (1 / tiles)^warp of the range instead of 1 / tiles. 1: uniform (the
+  // that the tiles next to 0 are narrower (warp 2, 10 tiles: b / 25 instead of b / 5) and the
+  // outer ones wider (twice, for warp 2). 1: uniform (the
   // default); a warped dimension needs bounds symmetric about 0. Carried by the configuration a
   // table was trained with (its trained_with), not by the table's file.
   std::array<double, kStateDimensions> warp{{1.0, 1.0, 1.0, 1.0}};
