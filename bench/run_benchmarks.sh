@@ -52,6 +52,11 @@
 #        loop run just before it (the VM's speed drifts between the rounds): the median of those
 #        paired ratios is printed under the targets. (j), (k), (l) need a build with MuJoCo; the rows then
 #        say they were skipped.
+#   (m)  the Control Suite's cart-pole (issue 40): bench/run_swingup_benchmark.sh, run last, prints
+#        its own table: config/swingup.yaml's score at 100k, 200k and 500k env steps over seeds
+#        0-9 beside the published figures and the energy-based reference (bench/swingup_reference),
+#        a table run on the other engine, and 500k steps' training time on each (BENCH_SWINGUP=0:
+#        left out)
 # (a), (b1), (b2), (c) and (l) are measured in rounds, some before (d) and (e) and one after them;
 # each figure is the median over the rounds, its spread is printed beside it.
 # Every measured process runs on one CPU (taskset): a round trip costs about twice as much when
@@ -68,6 +73,7 @@
 #              BENCH_ROBUST_RUNS  launches of (i), >= 1, default 1
 #              BENCH_CPU  the CPU every measured process runs on, default 0; "none": not pinned
 #              BENCH_TRAIN_TIMEOUT  seconds a launch in (d) or (e) may take before it is stopped, default 180
+#              BENCH_SWINGUP  0: leave (m) out, default 1
 #              BENCH_KEEP_LOGS=1  keep the temporary directory (logs, Q-tables) after a good run
 # It starts its own roscore on a free port (ROS_MASTER_URI), keeps logs and Q-tables in a
 # temporary ROS_HOME, and stops every process it started when it exits.
@@ -609,5 +615,10 @@ fi
 if ((SIM_REPEATS > 0)); then
   echo
   echo "warning: the sim published $SIM_REPEATS state(s) again in (c): an answer took longer than lockstep_timeout"
+fi
+if [[ "${BENCH_SWINGUP:-1}" != 0 ]]; then
+  echo
+  echo "(m) the Control Suite's cart-pole (bench/run_swingup_benchmark.sh):"
+  BENCH_CPU="$CPU" bash "$(dirname "${BASH_SOURCE[0]}")/run_swingup_benchmark.sh" || die "run_swingup_benchmark.sh failed"
 fi
 OK=true

@@ -65,11 +65,11 @@ train()
   log="$WORK/train_${tag}_${seed}_${episodes}.log"
   "${PIN[@]}" "$TRAIN_HEADLESS" --config "$config" --seed "$seed" --max-episodes "$episodes" --checkpoint-every 0 \
     --ns "$tag" --quiet >"$log" 2>&1 || die "training $config seed $seed failed (log: $log)"
-  out=$(ls -d "$ROS_HOME/cartpole_qlearning/$tag/runs/"*"seed$seed" | tail -n 1)/q_table.yaml
+  out=$(find "$ROS_HOME/cartpole_qlearning/$tag/runs" -mindepth 1 -maxdepth 1 -name "*seed$seed" | sort | tail -n 1)/q_table.yaml
   [[ -f "$out" ]] || die "no table from $config seed $seed (log: $log)"
   mv "$out" "$WORK/${tag}_${seed}_${episodes}.yaml"
   rm -rf "$ROS_HOME/cartpole_qlearning/$tag/runs"
-  echo "$WORK/${tag}_${seed}_${episodes}.yaml $(grep -o 'train_s=[^ ]*' "$log" | tail -n 1 | cut -d= -f2)"
+  echo "$WORK/${tag}_${seed}_${episodes}.yaml $(grep -o 'train_s=[^ ]*' "$log" | tail -n 1 | cut -d= -f2 | awk '{ printf "%.2f", $1 }')"
 }
 
 # The Suite's score of TABLE (10 greedy episodes), with CONFIG's engine when one is given.
@@ -78,7 +78,7 @@ score()
   local table=$1 config=${2:-}
   local args=(--evaluate "$table" --episodes 10)
   [[ -n "$config" ]] && args+=(--config "$config")
-  "$TRAIN_HEADLESS" "${args[@]}" 2>/dev/null | grep -o 'mean_return=[^ ]*' | cut -d= -f2
+  "$TRAIN_HEADLESS" "${args[@]}" 2>/dev/null | grep -o 'mean_return=[^ ]*' | cut -d= -f2 | awk '{ printf "%.0f\n", $1 }'
 }
 
 # "mean lowest" of the numbers on stdin.
@@ -147,18 +147,18 @@ cell()
 }
 printf "| %-44s | %14s | %14s | %14s |\n" "swingup: ours, config/swingup.yaml" "$(cell "$SWINGUP" 100)" \
   "$(cell "$SWINGUP" 200)" "$(cell "$SWINGUP" 500)"
-printf "| %-44s | %14s | %14s | %14s |\n" "swingup: energy + LQR reference (bench/)" "${REF% *} (low ${REF#* })" "" ""
+printf "| %-44s | %14s | %14s | %14s |\n" "swingup: energy + LQR reference, untrained" "${REF% *} (low ${REF#* })" "the same" "the same"
 printf "| %-44s | %14s | %14s | %14s |\n" "swingup: SAC (DrQ table 1); TD-MPC2" "812; ~839" "" ""
 printf "| %-44s | %14s | %14s | %14s |\n" "swingup: DDPG; D4PG; DreamerV3; TD-MPC2" "" "" "864; 875; 852; ~876"
 printf "| %-44s | %14s | %14s | %14s |\n" "swingup_sparse: ours, swingup_sparse.yaml" "" "" "$(cell "$SPARSE" 500)"
-printf "| %-44s | %14s | %14s | %14s |\n" "swingup_sparse: energy + LQR reference" "${REF_SPARSE% *} (low ${REF_SPARSE#* })" "" ""
+printf "| %-44s | %14s | %14s | %14s |\n" "swingup_sparse: the same reference" "${REF_SPARSE% *} (low ${REF_SPARSE#* })" "the same" "the same"
 printf "| %-44s | %14s | %14s | %14s |\n" "swingup_sparse: TD-MPC2; D4PG; DDPG" "~0" "" "~845; 752; 703"
 printf "| %-44s | %14s | %14s | %14s |\n" "balance: ours, dmc_balance.yaml" "$(cell "$BALANCE" 100)" "" ""
 printf "| %-44s | %14s | %14s | %14s |\n" "balance: TD-MPC2; D4PG" "~998" "" "999"
 echo
 if [[ -z "$MUJOCO_SKIPPED" ]]; then
   echo "Sim to sim (swingup.yaml, seed $SIM_SEED, 500k steps; training pinned to one core):"
-  printf "| %-30s | %12s | %12s | %16s |\n" "trained on" "on equations" "on MuJoCo" "500k-step train_s"
+  printf "| %-30s | %12s | %12s | %16s |\n" "trained on" "on equations" "on MuJoCo" "train_s, 500k"
   printf "| %-30s | %12s | %12s | %16s |\n" "---" "---" "---" "---"
   printf "| %-30s | %12s | %12s | %16s |\n" "equations (physics/rail_limit)" "$EQ_ON_EQ" "$EQ_ON_MJ" "$EQ_S"
   printf "| %-30s | %12s | %12s | %16s |\n" "MuJoCo (mjcf/dmc_cartpole.xml)" "$MJ_ON_EQ" "$MJ_ON_MJ" "$MJ_S"
