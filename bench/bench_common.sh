@@ -1,6 +1,6 @@
 # shellcheck shell=bash
-# The process and master helpers that run_benchmarks.sh and run_fleet_benchmarks.sh share, sourced
-# by both: source "$(dirname "${BASH_SOURCE[0]}")/bench_common.sh"
+# The process and master helpers that the bench/ scripts share, sourced by each:
+# source "$(dirname "${BASH_SOURCE[0]}")/bench_common.sh"
 # Defines functions only. The sourcing script sets ME (its name, the prefix of its messages) and
 # calls make_work before it starts anything; make_work sets WORK, PIDS and OK, and cleanup reads
 # them on the way out (the script sets OK=true once it has printed everything).
@@ -113,4 +113,24 @@ start_master()
     sleep 0.1
   done
   (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null || die "roscore did not start on port $port (log: $WORK/roscore.log)"
+}
+
+# The executable NAME of package $PKG (catkin_find), or the run ends saying how to get it.
+find_exe()
+{
+  local path
+  path=$(catkin_find --first-only --libexec "$PKG" "$1" 2>/dev/null | head -n 1)
+  [[ -n "$path" && -x "$path" ]] || die "$1 not found: build the workspace (the bench/ programs need libbenchmark-dev)"
+  echo "$path"
+}
+
+# Sets PIN to the prefix that runs a command on CPU $1 (taskset -c), or to nothing for "none" or
+# "", and ends the run when that CPU cannot be used.
+pin_to_cpu()
+{
+  PIN=()
+  if [[ -n "$1" && "$1" != none ]]; then
+    PIN=(taskset -c "$1")
+    "${PIN[@]}" true 2>/dev/null || die "cannot run on CPU $1 (BENCH_CPU)"
+  fi
 }

@@ -103,20 +103,9 @@ fi
 TRAIN_TIMEOUT=${BENCH_TRAIN_TIMEOUT:-180}
 PKG=cartpole_qlearning
 CPU=${BENCH_CPU-0}
-PIN=()
-if [[ -n "$CPU" && "$CPU" != none ]]; then
-  PIN=(taskset -c "$CPU")
-  "${PIN[@]}" true 2>/dev/null || die "cannot run on CPU $CPU (BENCH_CPU)"
-fi
+pin_to_cpu "$CPU"
 
 PKG_DIR=$(rospack find "$PKG" 2>/dev/null) || die "package $PKG not found: source the workspace's devel/setup.bash"
-find_exe()
-{
-  local path
-  path=$(catkin_find --first-only --libexec "$PKG" "$1" 2>/dev/null | head -n 1)
-  [[ -n "$path" && -x "$path" ]] || die "$1 not found: build the workspace (the bench/ programs need libbenchmark-dev)"
-  echo "$path"
-}
 BARE_PING=$(find_exe bare_ping)
 BARE_PONG=$(find_exe bare_pong)
 INTRAPROCESS_PAIR=$(find_exe intraprocess_pair)

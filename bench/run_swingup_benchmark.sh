@@ -25,20 +25,9 @@ PKG=cartpole_qlearning
 SEEDS=${BENCH_SWINGUP_SEEDS:-0 1 2 3 4 5 6 7 8 9}
 SIM_SEED=${BENCH_SWINGUP_SIM_SEED:-0}
 CPU=${BENCH_CPU:-0}
-PIN=()
-if [[ "$CPU" != none ]]; then
-  PIN=(taskset -c "$CPU")
-  "${PIN[@]}" true 2>/dev/null || die "cannot run on CPU $CPU (BENCH_CPU)"
-fi
+pin_to_cpu "$CPU"
 
 PKG_DIR=$(rospack find "$PKG" 2>/dev/null) || die "package $PKG not found: source the workspace's devel/setup.bash"
-find_exe()
-{
-  local path
-  path=$(catkin_find --first-only --libexec "$PKG" "$1" 2>/dev/null | head -n 1)
-  [[ -n "$path" && -x "$path" ]] || die "$1 not found: build the workspace (the bench/ programs need libbenchmark-dev)"
-  echo "$path"
-}
 TRAIN_HEADLESS=$(find_exe train_headless)
 REFERENCE=$(find_exe swingup_reference)
 
