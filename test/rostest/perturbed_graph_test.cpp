@@ -19,6 +19,7 @@ namespace fs = std::filesystem;
 using cartpole_qlearning::test::CommandRun;
 using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::runCommand;
+using cartpole_qlearning::test::runTable;
 using cartpole_qlearning::test::TrainLaunch;
 namespace text_match = cartpole_qlearning::test::text_match;
 
@@ -41,15 +42,6 @@ CommandRun trainHeadless(const std::string& home, const std::string& args)
   return runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " " + args);
 }
 
-// The final table of the one run folder under a ROS_HOME's default namespace.
-std::string runTable(const std::string& home)
-{
-  std::vector<fs::path> runs;
-  for (const auto& entry : fs::directory_iterator(home + "/cartpole_qlearning/cartpole/runs"))
-    runs.push_back(entry.path());
-  EXPECT_EQ(1u, runs.size()) << home;
-  return runs.empty() ? "" : fileText((runs.front() / "q_table.yaml").string());
-}
 }  // namespace
 
 TEST(PerturbedGraph, TrainLaunchUnderEveryPerturbationWritesTheHeadlessTable)

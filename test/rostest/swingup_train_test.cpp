@@ -17,6 +17,7 @@ namespace fs = std::filesystem;
 using cartpole_qlearning::test::CommandRun;
 using cartpole_qlearning::test::fileText;
 using cartpole_qlearning::test::runCommand;
+using cartpole_qlearning::test::runTable;
 using cartpole_qlearning::test::TrainLaunch;
 
 namespace
@@ -26,17 +27,6 @@ const cartpole_qlearning::test::ScratchFolder kRosHome("ros_home",
 const std::string kConfig = CARTPOLE_CONFIG_DIR "/swingup.yaml";
 // A few of the Suite's 1,000-step episodes: the table learns from every one of their 8,000 steps.
 const std::string kEpisodes = "8";
-
-// The final table of the one run folder under a ROS_HOME's default namespace (a run that does not
-// solve writes no default table).
-std::string runTable(const std::string& home)
-{
-  std::vector<fs::path> runs;
-  for (const auto& entry : fs::directory_iterator(home + "/cartpole_qlearning/cartpole/runs"))
-    runs.push_back(entry.path());
-  EXPECT_EQ(1u, runs.size()) << home;
-  return runs.empty() ? "" : fileText((runs.front() / "q_table.yaml").string());
-}
 
 // The first line where two texts differ (1-based), with both versions of it.
 std::string firstDifference(const std::string& a, const std::string& b)

@@ -8,9 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include "test_support.h"
+
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace cartpole_qlearning
 {
@@ -83,6 +86,17 @@ inline int pidOf(const std::string& node)
 {
   XmlRpc::XmlRpcValue pid = callNode(node, "getPid");
   return pid.getType() == XmlRpc::XmlRpcValue::TypeInt ? static_cast<int>(pid) : -1;
+}
+
+// The final table of the one run folder under ROS_HOME `home`'s default namespace (a run that does not
+// solve writes no default table, only its run folder's); "" and a failure when there is not one.
+inline std::string runTable(const std::string& home)
+{
+  std::vector<std::filesystem::path> runs;
+  for (const auto& entry : std::filesystem::directory_iterator(home + "/cartpole_qlearning/cartpole/runs"))
+    runs.push_back(entry.path());
+  EXPECT_EQ(1u, runs.size()) << home;
+  return runs.empty() ? "" : fileText((runs.front() / "q_table.yaml").string());
 }
 
 }  // namespace test
