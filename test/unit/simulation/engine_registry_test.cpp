@@ -50,8 +50,10 @@ TEST(EngineRegistry, MakesTheEquationsAndSaysWhatTheyAllow)
 {
   CartPoleParams physics;
   physics.integrator = Integrator::Rk4;
-  const EngineDescription& equations = engineOf(EngineParams());
-  const auto engine = equations.make(physics, EngineParams());
+  // (A named EngineParams: GCC 14 warns of a reference returned for a temporary argument.)
+  const EngineParams defaults;
+  const EngineDescription& equations = engineOf(defaults);
+  const auto engine = equations.make(physics, defaults);
   ASSERT_NE(nullptr, dynamic_cast<EquationsEngine*>(engine.get()));
   EXPECT_EQ(physics.tau, engine->tau());
   EXPECT_EQ("integrator rk4", equations.describe(physics, EngineParams()));
