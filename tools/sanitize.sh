@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the whole package and its tests (nodes, nodelet library, train_headless, gtests and
-# rostests, but for the seven long trainings: see ARGS below) with clang's AddressSanitizer
-# (with LeakSanitizer) and UndefinedBehaviorSanitizer in a build and devel space of their own
+# rostests, but for the seven long trainings and five rostests: see ARGS below) with clang's
+# AddressSanitizer (with LeakSanitizer) and UndefinedBehaviorSanitizer in a build and devel space of their own
 # beside the plain ones ($WS/build_sanitize, $WS/devel_sanitize), and runs those tests there
 # (gtests, rostests, launch file checks). Any sanitizer report, in a test or in a node that
 # roslaunch started, fails the run.
@@ -83,8 +83,16 @@ FLAGS="-O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefin
 # time_back, zero_effort* (Float64 commands, another state rate, offsets and signs, resets that
 # set time back) and application_tests (RunApplication: the suite judged during training, the best
 # table kept) already take under the sanitizers, for minutes of CI's time.
+# Nor the rostests whose point lies outside the package's C++ (CMakeLists.txt's
+# CARTPOLE_QLEARNING_SKIPPED_ROSTESTS): launch_inputs (which parameters roslaunch leaves on the
+# master between launches), rviz_picture, docs_pictures and plot_learning_curve (RViz's picture,
+# the Python plots); and control_robot (whether a table holds five minutes, the longest rostest
+# here: 143 s of 630), whose control code command_watchdog and swingup_control take under the
+# sanitizers. The nodes they start start in every other rostest here.
+SKIPPED_ROSTESTS="launch_inputs.test;rviz_picture.test;docs_pictures.test;plot_learning_curve.test;control_robot.test"
 ARGS=(--build "$BUILD" -DCATKIN_DEVEL_PREFIX="$DEVEL" -DCMAKE_BUILD_TYPE=Sanitize "-DCMAKE_CXX_FLAGS=$FLAGS"
   -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE -DCARTPOLE_QLEARNING_LONG_TRAININGS=OFF
+  "-DCARTPOLE_QLEARNING_SKIPPED_ROSTESTS=$SKIPPED_ROSTESTS"
   "-DCARTPOLE_WARNINGS_AS_ERRORS=${CARTPOLE_WARNINGS_AS_ERRORS:-ON}")
 [ -x /usr/bin/python3 ] && ARGS+=(-DPYTHON_EXECUTABLE=/usr/bin/python3)
 cd "$WS"
