@@ -1,5 +1,7 @@
 #include "cartpole_qlearning/application/run_folder.h"
 
+#include "cartpole_qlearning/io/yaml_count.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -101,10 +103,10 @@ RunRecord parseRunRecord(const std::string& text)
     };
     record.run_id = get("run_id").as<std::string>();
     record.name_space = get("namespace").as<std::string>();
-    record.seed = get("seed").as<std::uint64_t>();
+    record.seed = yamlCount(get("seed"));
     record.started = get("started").as<std::string>();
-    record.episodes = get("episodes").as<std::uint64_t>();
-    record.steps = get("steps").as<std::uint64_t>();
+    record.episodes = yamlCount(get("episodes"));
+    record.steps = yamlCount(get("steps"));
     record.recent_returns = get("recent_returns").as<std::vector<double>>();
     record.finished = get("finished").as<std::string>();
     if (root["robustness"])
@@ -113,8 +115,8 @@ RunRecord parseRunRecord(const std::string& text)
     {
       if (!best.IsMap() || !best["episode"] || !best["worst_balanced"] || !best["robustness"])
         refuse("best must be a map with episode, worst_balanced and robustness");
-      record.best_episode = best["episode"].as<std::uint64_t>();
-      record.best_worst_balanced = best["worst_balanced"].as<std::uint64_t>();
+      record.best_episode = yamlCount(best["episode"]);
+      record.best_worst_balanced = yamlCount(best["worst_balanced"]);
       record.best_robustness = best["robustness"].as<std::string>();
     }
   }

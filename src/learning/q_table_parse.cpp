@@ -3,6 +3,7 @@
 #include "q_table_document.h"
 
 #include "cartpole_qlearning/io/number_text.h"
+#include "cartpole_qlearning/io/yaml_count.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -71,7 +72,7 @@ std::uint64_t readCount(const YAML::Node& node, const std::string& where)
 {
   try
   {
-    return node.as<std::uint64_t>();
+    return yamlCount(node);
   }
   catch (const YAML::Exception&)
   {

@@ -190,6 +190,22 @@ TEST_F(QTableFileTest, GarbageAndOtherYamlAreRefused)
   }
 }
 
+// yaml-cpp before 0.7 (Debian 11, Noetic's Ubuntu 20.04) reads "-1" as the largest count.
+TEST_F(QTableFileTest, ANegativeCountIsRefusedOnEveryYamlCpp)
+{
+  TrainingSession session(TaskParams(), AgentParams(), 0);
+  const std::vector<double> live = session.table().values();
+  saveQTableFile(awkwardTable(), path("t.yaml"));
+  std::string text = readFile(path("t.yaml"));
+  const std::size_t episodes = text.find("\nepisodes: ") + 1;
+  ASSERT_NE(std::string::npos, episodes - 1);
+  text.replace(episodes, text.find('\n', episodes) - episodes, "episodes: -1");
+  write(path("t.yaml"), text);
+  const std::string error = loadInto(session, path("t.yaml"));
+  EXPECT_NE(std::string::npos, error.find("episodes is not a whole number >= 0")) << error;
+  EXPECT_TRUE(bitIdentical(live, session.table().values()));
+}
+
 TEST_F(QTableFileTest, WrongVersionIsRefusedWithTheVersion)
 {
   saveQTableFile(awkwardTable(), path("t.yaml"));
