@@ -646,5 +646,6 @@ TEST(NodeLogger, EveryInstanceHasALoggerOfItsOwnUnderItsType)
   ros::console::notifyLoggerLevelsChanged();
   for (const std::string name : {"/a/cartpole_sim", "/b/cartpole_sim"})
     logLine(nodeLogger("cartpole_sim", name), LogLine::Level::Warn, name);
-  EXPECT_EQ(std::vector<std::string>{"/b/cartpole_sim"}, lines->texts) << "the first sim's logger is set to errors only";
+  EXPECT_EQ(std::vector<std::string>{"/b/cartpole_sim"}, lines->texts)
+      << "the first sim's logger is set to errors only";
 }
