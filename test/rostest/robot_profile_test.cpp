@@ -23,6 +23,7 @@ using cartpole_qlearning::EpisodeStats;
 using cartpole_qlearning::test::pidOf;
 using cartpole_qlearning::test::privateParam;
 using cartpole_qlearning::test::spinUntil;
+using cartpole_qlearning::test::spinWhileProgressing;
 using cartpole_qlearning::test::TrainLaunch;
 namespace text_match = cartpole_qlearning::test::text_match;
 
@@ -47,7 +48,8 @@ TEST(RobotProfile, TrainsUntilSolvedThenTheTableIsEvaluated)
 
   // Training: robot.launch's controller ends itself at the first solved episode (stop_when_solved), having saved
   // the default table.
-  ASSERT_TRUE(spinUntil([&] { return !stats.empty() && stats.back().solved; }, 240.0))
+  ASSERT_TRUE(spinWhileProgressing([&] { return !stats.empty() && stats.back().solved; }, [&] { return stats.size(); },
+                                   30.0, 400.0))
       << robot << ": not solved; episodes seen: " << stats.size()
       << (stats.empty() ? "" : ", the last mean return " + std::to_string(stats.back().mean_return_100));
   const EpisodeStats solved = stats.back();
