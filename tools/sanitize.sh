@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the whole package and its tests (nodes, nodelet library, train_headless, gtests and
-# rostests, but for the seven long trainings and five rostests: see ARGS below) with clang's
+# rostests, but for the seven long trainings and seven rostests: see ARGS below) with clang's
 # AddressSanitizer (with LeakSanitizer) and UndefinedBehaviorSanitizer in a build and devel space of their own
 # beside the plain ones ($WS/build_sanitize, $WS/devel_sanitize), and runs those tests there
 # (gtests, rostests, launch file checks). Any sanitizer report, in a test or in a node that
@@ -88,8 +88,13 @@ FLAGS="-O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefin
 # master between launches), rviz_picture, docs_pictures and plot_learning_curve (RViz's picture,
 # the Python plots); and control_robot (whether a table holds five minutes, the longest rostest
 # here: 143 s of 630), whose control code command_watchdog and swingup_control take under the
-# sanitizers. The nodes they start start in every other rostest here.
+# sanitizers. The nodes they start start in every other rostest here. Nor two trainings over the
+# graph whose node code controller_train takes here, their difference being the core's (gtests
+# take it here): controller_train_tiles (tile coding) and swingup_train (the swing-up task, whose
+# sim and controller paths swingup_control takes); 127 s of the sanitized suite's 1521
+# test-seconds, measured on 7d4ac99.
 SKIPPED_ROSTESTS="launch_inputs.test;rviz_picture.test;docs_pictures.test;plot_learning_curve.test;control_robot.test"
+SKIPPED_ROSTESTS+=";controller_train_tiles.test;swingup_train.test"
 ARGS=(--build "$BUILD" -DCATKIN_DEVEL_PREFIX="$DEVEL" -DCMAKE_BUILD_TYPE=Sanitize "-DCMAKE_CXX_FLAGS=$FLAGS"
   -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE -DCARTPOLE_QLEARNING_LONG_TRAININGS=OFF
   "-DCARTPOLE_QLEARNING_SKIPPED_ROSTESTS=$SKIPPED_ROSTESTS"
@@ -141,8 +146,10 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:$common"
 # ManagerDoesNotEndTraining: it checks roslaunch's respawn of a killed manager and the nodelets'
 # reload into the new one, a matter of process supervision and time; under ASan beside CI's
 # fuzzers the reload took more than its 60 s twice in a row (the kill -9 of a plain controller,
-# whose nodes are instrumented, stays).
-export GTEST_FILTER="-FileAccessTest.AProcessKilledMidSaveLeavesTheOldFileOrTheNewOneWhole:TrainLaunch.Kill9OfTheNodeletManagerDoesNotEndTraining"
+# whose nodes are instrumented, stays). Nor TrainLaunch.ASolvedRunEndsCleanly...: which folder
+# train.launch's namespaces give the table, a launch file's matter (36 s under ASan); the nodes'
+# clean end after solving is controller_train's here too.
+export GTEST_FILTER="-FileAccessTest.AProcessKilledMidSaveLeavesTheOldFileOrTheNewOneWhole:TrainLaunch.Kill9OfTheNodeletManagerDoesNotEndTraining:TrainLaunch.ASolvedRunEndsCleanlyWithItsTableInItsNamespacesFolder"
 echo "[sanitize] running the gtests and rostests under ASan + UBSan; reports go to $LOGS"
 # Every test of the package (gtests, rostests, the launch file checks), as one make goal: the
 # top-level Makefile of CMake runs goals named on the command line one after the other
