@@ -89,10 +89,11 @@ std::vector<std::string> ControllerTrainTest::joint_names_;
 
 TEST_F(ControllerTrainTest, SolvesSavesTheHeadlessTableAndTheTableBalances)
 {
-  // 1. Training over ROS reaches solved (mean return of the last 100 >= 475): about 30 s under
-  //    ASan, the machine's pace (an episode at least every 30 s) up to the .test's time limit.
+  // 1. Training over ROS reaches solved (mean return of the last 100 >= 475): 25-40 s under ASan
+  //    in CI's runs, here at the machine's pace (an episode at least every 30 s) for up to 400 s,
+  //    which leaves the steps below the rest of the .test's time limit.
   ASSERT_TRUE(spinWhileProgressing([] { return !stats_.empty() && stats_.back().solved; }, [] { return stats_.size(); },
-                                   30.0, 500.0))
+                                   30.0, 400.0))
       << "no solved episode; episodes seen: " << stats_.size();
   const EpisodeStats& solved = stats_.back();
   EXPECT_GE(solved.mean_return_100, 475.0);

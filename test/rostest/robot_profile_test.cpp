@@ -49,7 +49,7 @@ TEST(RobotProfile, TrainsUntilSolvedThenTheTableIsEvaluated)
   // Training: robot.launch's controller ends itself at the first solved episode (stop_when_solved), having saved
   // the default table.
   ASSERT_TRUE(spinWhileProgressing([&] { return !stats.empty() && stats.back().solved; }, [&] { return stats.size(); },
-                                   30.0, 400.0))
+                                   30.0, 340.0))
       << robot << ": not solved; episodes seen: " << stats.size()
       << (stats.empty() ? "" : ", the last mean return " + std::to_string(stats.back().mean_return_100));
   const EpisodeStats solved = stats.back();

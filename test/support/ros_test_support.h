@@ -44,17 +44,20 @@ inline bool spinUntil(const std::function<bool()>& done, double timeout_s)
 }
 
 // Spins until done() holds, for as long as progress() (a count: episodes seen) keeps growing:
-// false once it has stood still for stall_s or cap_s has passed in all (wall clock both). For a
-// training over the graph, whose pace is the machine's: lockstep waits on the scheduler twice a
-// step, and a machine that runs three tests beside a compiler made one six times slower (CI on
-// c5a9f2c: 221 of 259 episodes in 200 s under ASan), nothing being wrong; a stall is.
+// false once it has stood still for stall_s (three times that before it first moves: the nodes
+// start meanwhile) or cap_s has passed in all (wall clock both). For a training over the graph,
+// whose pace is the machine's: lockstep waits on the scheduler twice a step, and a machine
+// running three tests beside a compiler slowed one that takes 25-40 s under ASan past 200 s
+// (CI on c5a9f2c: 221 of its 259 episodes), nothing being wrong; a stall is.
 inline bool spinWhileProgressing(const std::function<bool()>& done, const std::function<std::size_t()>& progress,
                                  double stall_s, double cap_s)
 {
   const ros::WallTime cap = ros::WallTime::now() + ros::WallDuration(cap_s);
   std::size_t seen = progress();
   ros::WallTime moved = ros::WallTime::now();
-  while (ros::ok() && ros::WallTime::now() < cap && (ros::WallTime::now() - moved).toSec() < stall_s)
+  bool moved_once = false;
+  while (ros::ok() && ros::WallTime::now() < cap &&
+         (ros::WallTime::now() - moved).toSec() < (moved_once ? stall_s : 3.0 * stall_s))
   {
     ros::spinOnce();
     if (done())
@@ -63,6 +66,7 @@ inline bool spinWhileProgressing(const std::function<bool()>& done, const std::f
     {
       seen = progress();
       moved = ros::WallTime::now();
+      moved_once = true;
     }
     ros::WallDuration(0.001).sleep();
   }
