@@ -68,8 +68,15 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   services_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &services_queue_);
   services_spinner_->start();
   setUpRobots(state_queue);
-  watchdog_ =
-      nh_.createSteadyTimer(ros::WallDuration(dispatch_->tickSeconds()), &QLearningControllerNode::onWatchdog, this);
+  // The watchdog on the states' queue (a nodelet's: the lockstep thread's, not the manager's), as
+  // the executable serves both on one: nodelet 1.10.0 (Debian 11) pauses a nodelet's own queues
+  // while it loads and drops what a timer adds meanwhile, after which that timer never fires again
+  // (ros/nodelet_core#106, fixed in 1.10.1); the guard would never stop a robot it cannot see.
+  ros::NodeHandle watchdog_nh(nh_);
+  if (state_queue != nullptr)
+    watchdog_nh.setCallbackQueue(state_queue);
+  watchdog_ = watchdog_nh.createSteadyTimer(ros::WallDuration(dispatch_->tickSeconds()),
+                                            &QLearningControllerNode::onWatchdog, this);
   std::string served;
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
