@@ -52,6 +52,13 @@ for release in "${releases[@]}"; do
     inner+="; start=\$(date +%s); bash scripts/$command.sh; rc=\$?"
     inner+="; echo \"[releases] $command.sh exit \$rc after \$((\$(date +%s) - start)) s\""
   done
+  # The root goes when its commands end: what a failure needs looking at is printed into the log
+  # first (the first three sanitizer reports; the end of the fuzzers' logs, where a crash is
+  # described, and of each test log).
+  inner+="; for f in \$(ls ~/cartpole_ws/build_sanitize/sanitizer_logs/* 2>/dev/null | head -n 3); do"
+  inner+=" echo \"[releases] --- \$f\"; head -n 60 \"\$f\"; done"
+  inner+="; for f in /tmp/cartpole_fuzz.*/*.log ~/cartpole_ws/test.log ~/cartpole_ws/sanitize.log; do"
+  inner+=" [ -f \"\$f\" ] && { echo \"[releases] --- the end of \$f\"; tail -n 40 \"\$f\"; }; done"
   log="$LOGS/$release.log"
   echo "[releases] $release: ${commands[*]/%/.sh} in a fresh root (log: $log)"
   DEBIAN_RELEASE=$release bash "$FRESH" "$inner" >"$log" 2>&1
