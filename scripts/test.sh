@@ -47,22 +47,27 @@ fi
 # time with no load limit (catkin_make's default, -jN -lN, ran about one at a time with the two
 # cores half idle: a rostest mostly waits on its nodes); TEST_JOBS=1 runs them one by one.
 catkin_make run_tests -DCMAKE_BUILD_TYPE=Release "-DCARTPOLE_WARNINGS_AS_ERRORS=$CARTPOLE_WARNINGS_AS_ERRORS" "-j${TEST_JOBS:-3}" >>"$CARTPOLE_WS/test.log" 2>&1 || true
-# The README's own check: its commands in order, in a fresh copy of the tree, home and
-# workspace, with a master of its own (tools/first_hour.sh); one case per command. Then the
-# fuzzers of test/fuzz/ (table file and config parsers, ASan + UBSan), 30 s each; a crash is a
-# failed test. Both run beside the sanitized suite (they share nothing with it: other home,
-# workspace, master and ports), which overlaps one's builds with the other's waits.
-# FIRST_HOUR=0 and FUZZ_SECONDS=0 skip them.
-echo "[test] beside the sanitized suite: the README's and docs' commands in a fresh home (tools/first_hour.sh, about 5 minutes; log in $CARTPOLE_WS/first_hour.log), then fuzzing the table file and config parsers (${FUZZ_SECONDS:-30} s each; log in $CARTPOLE_WS/fuzz.log)"
-(
-  if [ "${FIRST_HOUR:-1}" != 0 ]; then
-    bash "$CARTPOLE_SRC/tools/first_hour.sh" build/test_results/cartpole_qlearning >"$CARTPOLE_WS/first_hour.log" 2>&1 || true
-  fi
+# The README's own check: its commands in order, in a fresh home with a master of its own
+# (tools/first_hour.sh); one case per command. It runs beside the sanitized build's end and its
+# suite (it shares nothing with them: other home, master and ports), which overlaps one's work
+# with the other's waits. Then the fuzzers of test/fuzz/ (table file and config parsers, ASan +
+# UBSan, built by the sanitized build), 30 s each beside the sanitized suite; a crash is a failed
+# test. FIRST_HOUR=0 and FUZZ_SECONDS=0 skip them.
+echo "[test] beside the sanitized half: the README's and docs' commands in a fresh home (tools/first_hour.sh, about 5 minutes; log in $CARTPOLE_WS/first_hour.log), and fuzzing the table file and config parsers (${FUZZ_SECONDS:-30} s each; log in $CARTPOLE_WS/fuzz.log)"
+first_hour_pid=""
+if [ "${FIRST_HOUR:-1}" != 0 ]; then
+  # Its train.sh builds in this workspace (nothing left to build), not a second one from scratch.
+  FIRST_HOUR_WORKSPACE="$CARTPOLE_WS" bash "$CARTPOLE_SRC/tools/first_hour.sh" build/test_results/cartpole_qlearning >"$CARTPOLE_WS/first_hour.log" 2>&1 &
+  first_hour_pid=$!
+fi
+fuzz_pid=""
+start_fuzzers() { # the fuzzers the sanitized build made, if it did (else fuzz.sh compiles them)
   if [ "${FUZZ_SECONDS:-30}" -gt 0 ]; then
-    bash "$CARTPOLE_SRC/tools/fuzz.sh" "${FUZZ_SECONDS:-30}" build/test_results/cartpole_qlearning >"$CARTPOLE_WS/fuzz.log" 2>&1 || true
+    FUZZERS_BUILT="$CARTPOLE_WS/devel_sanitize/lib/cartpole_qlearning" \
+      bash "$CARTPOLE_SRC/tools/fuzz.sh" "${FUZZ_SECONDS:-30}" build/test_results/cartpole_qlearning >"$CARTPOLE_WS/fuzz.log" 2>&1 &
+    fuzz_pid=$!
   fi
-) &
-beside_pid=$!
+}
 # The whole suite again (every gtest and rostest, the nodes and the nodelet library), built with
 # AddressSanitizer, LeakSanitizer and UndefinedBehaviorSanitizer in build_sanitize/ and
 # devel_sanitize/. Its results join these as sanitized/sanitized-*.xml, with one case per
@@ -71,21 +76,30 @@ if [ "${SANITIZE:-1}" != 0 ]; then
   echo "[test] the whole suite again under ASan + UBSan: the end of its build, then its run; log in $CARTPOLE_WS/sanitize.log"
   sanitized=build/test_results/cartpole_qlearning/sanitized
   SECONDS=0
-  if ! wait "$sanitize_build_pid" ||
-    ! SANITIZE_STEPS=run bash "$CARTPOLE_SRC/tools/sanitize.sh" "$CARTPOLE_WS/$sanitized" >>"$CARTPOLE_WS/sanitize.log" 2>&1; then
+  if wait "$sanitize_build_pid"; then
+    start_fuzzers
+    SANITIZE_STEPS=run bash "$CARTPOLE_SRC/tools/sanitize.sh" "$CARTPOLE_WS/$sanitized" >>"$CARTPOLE_WS/sanitize.log" 2>&1 || sanitize_failed=1
+  else
+    start_fuzzers
+    sanitize_failed=1
+  fi
+  if [ -n "${sanitize_failed:-}" ]; then
     grep -E "error|Error" "$CARTPOLE_WS/sanitize.log" | head -n 20
     tail -n 10 "$CARTPOLE_WS/sanitize.log"
     failed_case "$sanitized/sanitized-build-failed.xml" sanitized_build build_asan_ubsan "the sanitized build failed; see $CARTPOLE_WS/sanitize.log"
   fi
   grep -E "^\[sanitize\] (built|ran|[0-9]+ sanitizer report)" "$CARTPOLE_WS/sanitize.log" || true
   echo "[test] ASan + UBSan suite: $SECONDS s"
+else
+  start_fuzzers
 fi
 
 SECONDS=0
-wait "$beside_pid" || true
+[ -z "$first_hour_pid" ] || wait "$first_hour_pid" || true
+[ -z "$fuzz_pid" ] || wait "$fuzz_pid" || true
 echo "[test] waited $SECONDS s more for first_hour.sh and the fuzzers"
 if [ "${FUZZ_SECONDS:-30}" -gt 0 ]; then
-  grep -E "^\[fuzz\] .*(ok|FOUND|compiled)" "$CARTPOLE_WS/fuzz.log" || true
+  grep -E "^\[fuzz\] .*(ok|FOUND|compiled|built already)" "$CARTPOLE_WS/fuzz.log" || true
   if ! ls build/test_results/cartpole_qlearning/fuzz-*.xml >/dev/null 2>&1; then
     tail -n 20 "$CARTPOLE_WS/fuzz.log"
     failed_case build/test_results/cartpole_qlearning/fuzz-aborted.xml fuzz fuzz_script "the fuzzers did not run; see $CARTPOLE_WS/fuzz.log"

@@ -19,49 +19,63 @@ SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 source "$SRC/tools/llvm_toolchain.sh"
 llvm_toolchain || true
 CXX=${FUZZ_CXX:-$CLANGXX}
-command -v "$CXX" >/dev/null || { echo "fuzz.sh: $CXX not found (Debian: scripts/setup.sh installs the release's clang-N and its runtimes)" >&2; exit 2; }
 WORK=${FUZZ_WORK:-$(mktemp -d "${TMPDIR:-/tmp}/cartpole_fuzz.XXXXXX")}
 mkdir -p "$WORK"
 
-# The core layers the parsers live in and rest on (the table file and the config readers are
-# learning's; the config reader asks the engines' registry), as CMakeLists.txt lists them for
-# their libraries. (-ldl: the registry's MuJoCo loader, whose dlopen is libdl's before glibc 2.34.)
-mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_\(common\|config\|io\|simulation\|engines\|learning\)/,/)$/p' "$SRC/CMakeLists.txt" |
-  grep -o 'src/[a-z_]*/[a-z_]*\.cpp')
-# Line tables only (as tools/sanitize.sh): a report's frames still name function, file and line,
-# for about 10 % less compile time.
-# shellcheck disable=SC2054 # the commas belong to -fsanitize=...
-COMPILE=(-std=c++17 -O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
-  -I "$SRC/include" -isystem /usr/include/eigen3)
-# The core is compiled once, for every target (with coverage hooks: fuzzer-no-link), two sources at
-# a time; each target then compiles its own file and links with libFuzzer's main.
-OBJECTS="$WORK/core_objects"
-mkdir -p "$OBJECTS"
-echo "[fuzz] compiling ${#CORE[@]} core sources once (ASan + UBSan, coverage for libFuzzer)"
-SECONDS=0
-compile_one() { "$CXX" "${COMPILE[@]}" -fsanitize=fuzzer-no-link -c "$SRC/$1" -o "$OBJECTS/$(basename "$1" .cpp).o"; }
-running=0
-failed=0
-for source in "${CORE[@]}"; do
-  compile_one "$source" &
-  if ((++running >= $(nproc))); then
-    wait -n || failed=1
-    running=$((running - 1))
-  fi
-done
-while ((running > 0)); do
-  wait -n || failed=1
-  running=$((running - 1))
-done
-((failed == 0)) || { echo "fuzz.sh: the core does not compile with $CXX" >&2; exit 2; }
-echo "[fuzz] compiled in $SECONDS s"
 # shellcheck disable=SC2206 # FUZZ_TARGETS is a space-separated list: split on purpose
 TARGETS=(${FUZZ_TARGETS:-q_table config})
+# Each target's executable: built already (FUZZERS_BUILT), or compiled here.
+declare -A FUZZER
+TO_BUILD=()
 for target in "${TARGETS[@]}"; do
-  echo "[fuzz] building $target"
-  "$CXX" "${COMPILE[@]}" -fsanitize=fuzzer "$SRC/test/fuzz/${target}_fuzzer.cpp" "$OBJECTS"/*.o -lyaml-cpp -ldl \
-    -o "$WORK/${target}_fuzzer"
+  if [[ -n "${FUZZERS_BUILT:-}" && -x "$FUZZERS_BUILT/${target}_fuzzer" ]]; then
+    FUZZER[$target]="$FUZZERS_BUILT/${target}_fuzzer"
+    echo "[fuzz] $target: built already (${FUZZER[$target]})"
+  else
+    FUZZER[$target]="$WORK/${target}_fuzzer"
+    TO_BUILD+=("$target")
+  fi
 done
+if ((${#TO_BUILD[@]} > 0)); then
+  command -v "$CXX" >/dev/null || { echo "fuzz.sh: $CXX not found (Debian: scripts/setup.sh installs the release's clang-N and its runtimes)" >&2; exit 2; }
+  # The core layers the parsers live in and rest on (the table file and the config readers are
+  # learning's; the config reader asks the engines' registry), as CMakeLists.txt lists them for
+  # their libraries. (-ldl: the registry's MuJoCo loader, whose dlopen is libdl's before glibc 2.34.)
+  mapfile -t CORE < <(sed -n '/^add_library(${PROJECT_NAME}_\(common\|config\|io\|simulation\|engines\|learning\)/,/)$/p' "$SRC/CMakeLists.txt" |
+    grep -o 'src/[a-z_]*/[a-z_]*\.cpp')
+  # Line tables only (as tools/sanitize.sh): a report's frames still name function, file and line,
+  # for about 10 % less compile time.
+  # shellcheck disable=SC2054 # the commas belong to -fsanitize=...
+  COMPILE=(-std=c++17 -O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
+    -I "$SRC/include" -isystem /usr/include/eigen3)
+  # The core is compiled once, for every target (with coverage hooks: fuzzer-no-link), two sources at
+  # a time; each target then compiles its own file and links with libFuzzer's main.
+  OBJECTS="$WORK/core_objects"
+  mkdir -p "$OBJECTS"
+  echo "[fuzz] compiling ${#CORE[@]} core sources once (ASan + UBSan, coverage for libFuzzer)"
+  SECONDS=0
+  compile_one() { "$CXX" "${COMPILE[@]}" -fsanitize=fuzzer-no-link -c "$SRC/$1" -o "$OBJECTS/$(basename "$1" .cpp).o"; }
+  running=0
+  failed=0
+  for source in "${CORE[@]}"; do
+    compile_one "$source" &
+    if ((++running >= $(nproc))); then
+      wait -n || failed=1
+      running=$((running - 1))
+    fi
+  done
+  while ((running > 0)); do
+    wait -n || failed=1
+    running=$((running - 1))
+  done
+  ((failed == 0)) || { echo "fuzz.sh: the core does not compile with $CXX" >&2; exit 2; }
+  echo "[fuzz] compiled in $SECONDS s"
+  for target in "${TO_BUILD[@]}"; do
+    echo "[fuzz] building $target"
+    "$CXX" "${COMPILE[@]}" -fsanitize=fuzzer "$SRC/test/fuzz/${target}_fuzzer.cpp" "$OBJECTS"/*.o -lyaml-cpp -ldl \
+      -o "${FUZZER[$target]}"
+  done
+fi
 # The targets run side by side (each on one core, for the same bounded time); their exit statuses
 # are kept in files and read afterwards.
 echo "[fuzz] running ${TARGETS[*]} side by side for $SECONDS_EACH s (logs in $WORK)"
@@ -71,7 +85,7 @@ for target in "${TARGETS[@]}"; do
   cp -n "$SRC/test/fuzz/corpus/$target/"* "$corpus/" 2>/dev/null || true
   (
     rc=0
-    cd "$WORK" && ASAN_OPTIONS=detect_leaks=1 "$WORK/${target}_fuzzer" -max_total_time="$SECONDS_EACH" \
+    cd "$WORK" && ASAN_OPTIONS=detect_leaks=1 "${FUZZER[$target]}" -max_total_time="$SECONDS_EACH" \
       -max_len=65536 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 "$corpus" >"$WORK/$target.log" 2>&1 || rc=$?
     echo "$rc" >"$WORK/$target.status"
   ) &

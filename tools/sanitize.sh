@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the whole package and its tests (nodes, nodelet library, train_headless, gtests and
-# rostests, but for the seven long trainings and seven rostests: see ARGS below) with clang's
+# rostests, but for the seven long trainings and seven rostests: see ARGS below), and the fuzzers
+# of test/fuzz/ for tools/fuzz.sh (FUZZERS_BUILT=$WS/devel_sanitize/lib/cartpole_qlearning), with clang's
 # AddressSanitizer (with LeakSanitizer) and UndefinedBehaviorSanitizer in a build and devel space of their own
 # beside the plain ones ($WS/build_sanitize, $WS/devel_sanitize), and runs those tests there
 # (gtests, rostests, launch file checks). Any sanitizer report, in a test or in a node that
@@ -96,7 +97,7 @@ FLAGS="-O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefin
 SKIPPED_ROSTESTS="launch_inputs.test;rviz_picture.test;docs_pictures.test;plot_learning_curve.test;control_robot.test"
 SKIPPED_ROSTESTS+=";controller_train_tiles.test;swingup_train.test"
 ARGS=(--build "$BUILD" -DCATKIN_DEVEL_PREFIX="$DEVEL" -DCMAKE_BUILD_TYPE=Sanitize "-DCMAKE_CXX_FLAGS=$FLAGS"
-  -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE -DCARTPOLE_QLEARNING_LONG_TRAININGS=OFF
+  -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE -DCARTPOLE_QLEARNING_LONG_TRAININGS=OFF -DCARTPOLE_QLEARNING_FUZZERS=ON
   "-DCARTPOLE_QLEARNING_SKIPPED_ROSTESTS=$SKIPPED_ROSTESTS"
   "-DCARTPOLE_WARNINGS_AS_ERRORS=${CARTPOLE_WARNINGS_AS_ERRORS:-ON}")
 [ -x /usr/bin/python3 ] && ARGS+=(-DPYTHON_EXECUTABLE=/usr/bin/python3)
@@ -104,7 +105,7 @@ cd "$WS"
 if [ "$STEPS" != run ]; then
   echo "[sanitize] building the nodes, the nodelet library and every test with ASan + UBSan ($CXX) in $BUILD"
   SECONDS=0
-  catkin_make "${ARGS[@]}" cartpole_sim qlearning_controller cartpole_qlearning_nodelets train_headless tests
+  catkin_make "${ARGS[@]}" cartpole_sim qlearning_controller cartpole_qlearning_nodelets train_headless q_table_fuzzer config_fuzzer tests
   echo "[sanitize] built in $SECONDS s"
 fi
 [ "$STEPS" != build ] || exit 0
