@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/application/run_folder.h"
 
 #include "cartpole_qlearning/io/yaml_count.h"
+#include "cartpole_qlearning/io/yaml_load.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -90,7 +91,7 @@ RunRecord parseRunRecord(const std::string& text)
   RunRecord record;
   try
   {
-    const YAML::Node root = YAML::Load(text);
+    const YAML::Node root = loadYaml(text);
     if (!root.IsMap() || !root["format"] || root["format"].as<std::string>() != kFormatName)
       refuse("not a run record (format is not '" + std::string(kFormatName) + "')");
     if (!root["version"] || root["version"].as<int>() != kVersion)

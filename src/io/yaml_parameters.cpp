@@ -2,6 +2,7 @@
 // as slash-separated keys; and the writer of a table's trained_with.
 #include "cartpole_qlearning/io/yaml_parameters.h"
 #include "cartpole_qlearning/io/number_text.h"
+#include "cartpole_qlearning/io/yaml_load.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -202,7 +203,7 @@ YAML::Node parsed(const std::string& text, const std::string& origin)
 {
   try
   {
-    return YAML::Load(text);
+    return loadYaml(text);
   }
   catch (const YAML::Exception& e)
   {

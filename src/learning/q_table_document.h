@@ -24,7 +24,7 @@ std::string checksumOf(const QTable& table);
 // Throws FileError(what): the file is refused.
 [[noreturn]] void refuse(const std::string& what);
 // The text as YAML, or a refusal saying it is not.
-YAML::Node loadYaml(const std::string& text);
+YAML::Node loadTableYaml(const std::string& text);
 // root[key], or a refusal naming the missing key.
 const YAML::Node required(const YAML::Node& root, const char* key);
 // A finite number, read back exactly as the writer wrote it; `where` names it in a refusal.

@@ -30,7 +30,7 @@ std::uint64_t claimedFileBytes(const std::string& head)
   if (values_at == std::string::npos)
     refuse("no 'values:' line in its first " + std::to_string(head.size()) +
            " bytes: not a Q-table file of a format this build reads");
-  const YAML::Node root = loadYaml(head.substr(0, values_at + 1));
+  const YAML::Node root = loadTableYaml(head.substr(0, values_at + 1));
   if (!root.IsMap())
     refuse("not a Q-table file (expected a YAML mapping with 'format: " + std::string(kFormatName) + "')");
   const char* const rows_key = root["rows"] ? "rows" : "states";

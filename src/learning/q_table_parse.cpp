@@ -4,6 +4,7 @@
 
 #include "cartpole_qlearning/io/number_text.h"
 #include "cartpole_qlearning/io/yaml_count.h"
+#include "cartpole_qlearning/io/yaml_load.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -80,11 +81,11 @@ std::uint64_t readCount(const YAML::Node& node, const std::string& where)
   }
 }
 
-YAML::Node loadYaml(const std::string& text)
+YAML::Node loadTableYaml(const std::string& text)
 {
   try
   {
-    return YAML::Load(text);
+    return loadYaml(text);
   }
   catch (const YAML::Exception& e)
   {
@@ -186,7 +187,7 @@ Document readHeader(const std::string& text)
   {
     try
     {
-      doc.root = loadYaml(text.substr(0, doc.values_at + 1));
+      doc.root = loadTableYaml(text.substr(0, doc.values_at + 1));
     }
     catch (const FileError&)
     {
@@ -195,7 +196,7 @@ Document readHeader(const std::string& text)
     doc.rows_apart = doc.rows_apart && doc.root.IsMap() && !doc.root["values"];
   }
   if (!doc.rows_apart)
-    doc.root = loadYaml(text);
+    doc.root = loadTableYaml(text);
   const YAML::Node& root = doc.root;
   if (!root.IsMap())
     refuse("not a Q-table file (expected a YAML mapping with 'format: " + std::string(kFormatName) + "')");
@@ -263,7 +264,7 @@ std::vector<double> readValues(Document& doc, const std::string& text, std::size
   if (values)
     return std::move(*values);
   if (doc.rows_apart)
-    doc.root = loadYaml(text);
+    doc.root = loadTableYaml(text);
   const YAML::Node rows = required(doc.root, "values");
   if (!rows.IsSequence())
     refuse("values is not a list of rows");

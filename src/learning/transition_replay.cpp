@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/learning/transition_replay.h"
 
 #include "cartpole_qlearning/io/file_access.h"
+#include "cartpole_qlearning/io/yaml_load.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -34,7 +35,7 @@ public:
     YAML::Node root;
     try
     {
-      root = YAML::Load(text);
+      root = loadYaml(text);
     }
     catch (const YAML::ParserException& e)
     {
