@@ -94,8 +94,20 @@ FLAGS="-O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize=address,undefin
 # take it here): controller_train_tiles (tile coding) and swingup_train (the swing-up task, whose
 # sim and controller paths swingup_control takes); 127 s of the sanitized suite's 1521
 # test-seconds, measured on 7d4ac99.
+# Nor seven whose point is a launch file's, a scenario's or roscpp's, their node code taken here
+# by others and their core code by the gtests here (318 of the sanitized suite's 951 rostest-
+# seconds, CI on 02eac0a): table_alone (which config and horizon robot.launch and evaluate.launch
+# give a table; the nodes' evaluation runs in robot_group_command, robot_position_only and
+# swingup_control), perturbed_graph (the perturbations are the core's simulation; train.launch's
+# suite_case argument), train_launch (train.launch's ends, run folders and respawn; training over
+# the graph runs in controller_train, as nodelets in robots_train_nodelet and live_tuning_nodelet),
+# controller_train_mujoco (the MuJoCo engine is the core's, mujoco_tests here), robots_train (the
+# same learner as robots_train_nodelet, in processes), fleet_hosts (ROS_IP addressing, roscpp's) and
+# decision_period (rates timed by hztest; the decision period is the protocol's robot_dispatch).
 SKIPPED_ROSTESTS="launch_inputs.test;rviz_picture.test;docs_pictures.test;plot_learning_curve.test;control_robot.test"
 SKIPPED_ROSTESTS+=";controller_train_tiles.test;swingup_train.test"
+SKIPPED_ROSTESTS+=";table_alone.test;perturbed_graph.test;train_launch.test;controller_train_mujoco.test;robots_train.test"
+SKIPPED_ROSTESTS+=";fleet_hosts.test;decision_period.test"
 ARGS=(--build "$BUILD" -DCATKIN_DEVEL_PREFIX="$DEVEL" -DCMAKE_BUILD_TYPE=Sanitize "-DCMAKE_CXX_FLAGS=$FLAGS"
   -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=TRUE -DCARTPOLE_QLEARNING_LONG_TRAININGS=OFF -DCARTPOLE_QLEARNING_FUZZERS=ON
   "-DCARTPOLE_QLEARNING_SKIPPED_ROSTESTS=$SKIPPED_ROSTESTS"
@@ -143,14 +155,8 @@ export LSAN_OPTIONS="suppressions=$SRC/test/sanitizer/lsan.supp:print_suppressio
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:$common"
 # Not run here: FileAccessTest.AProcessKilledMidSave... checks that a save killed midway leaves a
 # whole file, not memory safety; the plain run keeps it. (Its kills now wait for a save under way,
-# so it would pass here too, in about 10 s instead of 5.) Nor TrainLaunch.Kill9OfTheNodelet-
-# ManagerDoesNotEndTraining: it checks roslaunch's respawn of a killed manager and the nodelets'
-# reload into the new one, a matter of process supervision and time; under ASan beside CI's
-# fuzzers the reload took more than its 60 s twice in a row (the kill -9 of a plain controller,
-# whose nodes are instrumented, stays). Nor TrainLaunch.ASolvedRunEndsCleanly...: which folder
-# train.launch's namespaces give the table, a launch file's matter (36 s under ASan); a sanitizer
-# report at the nodes' exit after training is still caught in controller_train.
-export GTEST_FILTER="-FileAccessTest.AProcessKilledMidSaveLeavesTheOldFileOrTheNewOneWhole:TrainLaunch.Kill9OfTheNodeletManagerDoesNotEndTraining:TrainLaunch.ASolvedRunEndsCleanlyWithItsTableInItsNamespacesFolder"
+# so it would pass here too, in about 10 s instead of 5.)
+export GTEST_FILTER="-FileAccessTest.AProcessKilledMidSaveLeavesTheOldFileOrTheNewOneWhole"
 echo "[sanitize] running the gtests and rostests under ASan + UBSan; reports go to $LOGS"
 # Every test of the package (gtests, rostests, the launch file checks), as one make goal: the
 # top-level Makefile of CMake runs goals named on the command line one after the other
