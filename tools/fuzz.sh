@@ -31,6 +31,14 @@ for target in "${TARGETS[@]}"; do
   if [[ -n "${FUZZERS_BUILT:-}" && -x "$FUZZERS_BUILT/${target}_fuzzer" ]]; then
     FUZZER[$target]="$FUZZERS_BUILT/${target}_fuzzer"
     echo "[fuzz] $target: built already (${FUZZER[$target]})"
+    # The core's libraries beside it (the devel space's lib/), not the plain build's of the same
+    # names that a sourced workspace puts on LD_LIBRARY_PATH, which the loader would take first:
+    # uninstrumented, they gave libFuzzer 24 edges to explore instead of a thousand.
+    libs=$(cd "$FUZZERS_BUILT/.." && pwd)
+    export LD_LIBRARY_PATH="$libs${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    core=$(ldd "${FUZZER[$target]}" | grep -o '/[^ ]*libcartpole_qlearning_learning\.so' || true)
+    [[ "$core" == "$libs/"* ]] ||
+      { echo "fuzz.sh: ${FUZZER[$target]} would load the core from '${core:-nowhere}', not from $libs" >&2; exit 2; }
   else
     FUZZER[$target]="$WORK/${target}_fuzzer"
     TO_BUILD+=("$target")
