@@ -48,19 +48,21 @@ void DelayEstimator::observed(const CartPoleState& state)
     last_ = state;
     return;
   }
-  double lowest = std::numeric_limits<double>::infinity();
-  double highest = -lowest;
+  // The command that acted over the last step, were the robot d steps late, and the state it led to
+  // (every hypothesis steps from the same state: one sine and cosine for all).
+  std::array<double, kLargestFoundDelay + 1> acted{};
+  for (unsigned d = 0; d <= kLargestFoundDelay; ++d)
+    acted[d] = sentBefore(d);
+  std::array<CartPoleState, kLargestFoundDelay + 1> predicted;
+  model_.stepEach(*last_, acted.data(), acted.size(), predicted.data());
   for (unsigned d = 0; d <= kLargestFoundDelay; ++d)
   {
-    // The command that acted over the last step, were the robot d steps late.
-    const double acted = sentBefore(d);
-    lowest = std::min(lowest, acted);
-    highest = std::max(highest, acted);
-    const CartPoleState miss = state - model_.step(*last_, acted);
+    const CartPoleState miss = state - predicted[d];
     misses_[d] = kForget * misses_[d] + miss[1] * miss[1] + miss[3] * miss[3];
   }
+  const auto [lowest, highest] = std::minmax_element(acted.begin(), acted.end());
   last_ = state;
-  if (highest - lowest >= 0.4 * model_.params().force_mag)
+  if (*highest - *lowest >= 0.4 * model_.params().force_mag)
     ++telling_steps_;
   if (telling_steps_ < kTellingStepsNeeded)
     return;

@@ -75,6 +75,11 @@ public:
   // across the library boundary was a good part of it.
   CartPoleState step(const CartPoleState& state, double force) const;
 
+  // step(state, forces[i]) into out[i] for each of n forces from one state, the same bits, with
+  // the pole's sine and cosine worked out once where the integrator allows (Euler's two kinds, the
+  // cart within the rail): DelayEstimator steps every delay it weighs from the same state.
+  void stepEach(const CartPoleState& state, const double* forces, std::size_t n, CartPoleState* out) const;
+
   // The force clamped to +-force_mag.
   double clampForce(double force) const
   {
@@ -86,8 +91,11 @@ private:
   CartPoleState rk4Step(const CartPoleState& state, double force) const;
   // The derivative with the rail's stop acting (the cart past an end).
   CartPoleState derivativeAtEnd(const CartPoleState& state, double force) const;
-  // The derivative without the rail's ends.
+  // The derivative without the rail's ends; the second with cos and sin of the state's theta given.
   CartPoleState freeDerivative(const CartPoleState& state, double force) const;
+  CartPoleState freeDerivative(const CartPoleState& state, double force, double costheta, double sintheta) const;
+  // An Euler step (either kind, by the integrator) from the state and its derivative.
+  CartPoleState eulerStep(const CartPoleState& state, const CartPoleState& d) const;
 
   CartPoleParams params_;
 };
@@ -101,13 +109,16 @@ inline CartPoleState CartPoleDynamics::derivative(const CartPoleState& state, do
 
 inline CartPoleState CartPoleDynamics::freeDerivative(const CartPoleState& state, double force) const
 {
+  return freeDerivative(state, force, std::cos(state[2]), std::sin(state[2]));
+}
+
+inline CartPoleState CartPoleDynamics::freeDerivative(const CartPoleState& state, double force, double costheta,
+                                                      double sintheta) const
+{
   // Written in Gymnasium's order of operations so that Euler steps agree with it to the last bits.
   const double total_mass = params_.mass_pole + params_.mass_cart;
   const double polemass_length = params_.mass_pole * params_.half_length;
-  const double theta = state[2];
   const double theta_dot = state[3];
-  const double costheta = std::cos(theta);
-  const double sintheta = std::sin(theta);
   if (params_.cart_friction != 0.0 || params_.pole_friction != 0.0)
   {
     // Barto, Sutton and Anderson's equations with their friction terms (kept apart, so that the
@@ -134,8 +145,27 @@ inline CartPoleState CartPoleDynamics::step(const CartPoleState& state, double f
   // RK4 (four derivatives) out of line: the Euler steps then stay small enough to be inlined.
   if (params_.integrator == Integrator::Rk4)
     return rk4Step(state, force);
+  return eulerStep(state, derivative(state, force));
+}
+
+inline void CartPoleDynamics::stepEach(const CartPoleState& state, const double* forces, std::size_t n,
+                                       CartPoleState* out) const
+{
+  if (params_.integrator == Integrator::Rk4 || (params_.rail_limit > 0.0 && std::fabs(state[0]) > params_.rail_limit))
+  {
+    for (std::size_t i = 0; i < n; ++i)
+      out[i] = step(state, forces[i]);
+    return;
+  }
+  const double costheta = std::cos(state[2]);
+  const double sintheta = std::sin(state[2]);
+  for (std::size_t i = 0; i < n; ++i)
+    out[i] = eulerStep(state, freeDerivative(state, forces[i], costheta, sintheta));
+}
+
+inline CartPoleState CartPoleDynamics::eulerStep(const CartPoleState& state, const CartPoleState& d) const
+{
   const double tau = params_.tau;
-  const CartPoleState d = derivative(state, force);
   if (params_.integrator == Integrator::Euler)
     return CartPoleState(state[0] + tau * state[1], state[1] + tau * d[1], state[2] + tau * state[3],
                          state[3] + tau * d[3]);
