@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """Trains one table per seed with train_headless and a config that runs the robustness suite
 (e.g. config/robust.yaml), and prints a Markdown table: per seed, the episodes and steps to the
-table it saved, the wall time, and the suite's per-case counts; then the median and worst seed
+table it saved, the run's training seconds (train_s of its result line: the saved table's final
+verdict apart), and the suite's per-case counts; then the median and worst seed
 of each column. The figures of docs/robust_tables.md come from one run of it:
 
   python3 tools/robust_seeds.py --config config/robust.yaml --seeds 0-19   (or --seeds 1,17,19)
 
---jobs N runs N seeds at a time (default 1; each row's wall time is then that of a loaded machine).
+--jobs N runs N seeds at a time (default 1; each row's train_s is then that of a loaded machine).
+On one core, as train_s is quoted in the docs: taskset -c 1 python3 tools/robust_seeds.py ... --jobs 1
 
 train_headless is found on PATH, else by catkin_find (source devel/setup.bash), or given with
 --train-headless.
@@ -19,7 +21,6 @@ import shutil
 import statistics
 import subprocess
 import sys
-import time
 
 
 def seeds(text):
@@ -60,10 +61,9 @@ def main():
         parser.error('--jobs %d: at least 1' % args.jobs)
 
     def train(seed):
-        start = time.time()
         out = subprocess.run([args.train_headless, '--config', args.config, '--seed', str(seed), '--no-run-folder'],
                              capture_output=True, text=True).stdout
-        wall = time.time() - start
+        train_s = re.search(r' train_s=([0-9.]+) ', out)
         end = re.search(r'^(SUITE PASSED|suite NOT passed|SOLVED|NOT solved)\S* .*?after (\d+) episodes, (\d+) steps',
                         out, re.M)
         verdict = [l for l in out.splitlines() if re.search(r': (PASSED|FAILED)$', l) and ' at episode ' not in l]
@@ -78,11 +78,11 @@ def main():
             cases = re.findall(r'^(\w+) +(\d+)/(\d+) +\d+ ', out, re.M)
             passed = bool(summary) and summary.group(1) == summary.group(2)
             said = summary.group(0) if summary else ''
-        if not end or not cases:
+        if not end or not cases or not train_s:
             sys.exit('seed %d: no verdict in the output:\n%s' % (seed, out))
         print('seed %d: %s' % (seed, said), file=sys.stderr, flush=True)
         return dict(seed=seed, passed=passed, episodes=int(end.group(2)),
-                    steps=int(end.group(3)), wall=wall, cases=[(n, int(b)) for n, b, _ in cases])
+                    steps=int(end.group(3)), train_s=float(train_s.group(1)), cases=[(n, int(b)) for n, b, _ in cases])
 
     # A seed without a verdict stops the whole run at once (sys.exit in a worker thread would only
     # surface after every queued seed had trained): the seeds not started are cancelled.
@@ -95,17 +95,17 @@ def main():
                 future.cancel()
             raise
     names = [n for n, _ in rows[0]['cases']]
-    print('| seed | passes | episodes | steps | wall s | ' + ' | '.join(names) + ' |')
+    print('| seed | passes | episodes | steps | train_s | ' + ' | '.join(names) + ' |')
     print('| --- ' * (5 + len(names)) + '|')
     for r in rows:
         print('| %d | %s | %d | %d | %.1f | %s |' % (r['seed'], 'yes' if r['passed'] else '**no**', r['episodes'],
-                                                    r['steps'], r['wall'], ' | '.join(str(b) for _, b in r['cases'])))
+                                                    r['steps'], r['train_s'], ' | '.join(str(b) for _, b in r['cases'])))
     median = lambda key: statistics.median(r[key] for r in rows)
     print('| median | %d of %d | %.10g | %.10g | %.1f | %s |' % (
-        sum(r['passed'] for r in rows), len(rows), median('episodes'), median('steps'), median('wall'),
+        sum(r['passed'] for r in rows), len(rows), median('episodes'), median('steps'), median('train_s'),
         ' | '.join('%.10g' % statistics.median(r['cases'][i][1] for r in rows) for i in range(len(names)))))
     print('| worst | | %d | %d | %.1f | %s |' % (
-        max(r['episodes'] for r in rows), max(r['steps'] for r in rows), max(r['wall'] for r in rows),
+        max(r['episodes'] for r in rows), max(r['steps'] for r in rows), max(r['train_s'] for r in rows),
         ' | '.join(str(min(r['cases'][i][1] for r in rows)) for i in range(len(names)))))
 
 

@@ -1062,7 +1062,7 @@ TEST_F(RunApplicationTest, AtMaxEpisodesTheBestTableSeenIsSavedAndTheDefaultTabl
 
 TEST_F(RunApplicationTest, JudgedEveryEpisodeTheTablesNotKeptAreSaidOnceEachProgressStretchAndCounted)
 {
-  // robust.yaml judges after every episode: thousands of verdicts a run. A table that can beat
+  // Judged after every episode, a run has thousands of verdicts (robust.yaml's every 8th: hundreds). A table that can beat
   // the best has a line of its own; of those that cannot (or, between best_every's evaluations,
   // do not pass) one line in each stretch of progress_every episodes and one at the end, and
   // every line says how many others there were since the last: every verdict is accounted for.
