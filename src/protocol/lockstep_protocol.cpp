@@ -226,9 +226,13 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
     // The reset asked for was served, yet a lockstep sim waits on a fallen state: something moved
     // it after the reset (a hand on cart_effort, a stray command) and the reset's start was never
     // seen. Nothing would answer it; ask again. The second repeat, not the first: a repeat of the
-    // fall sent before the reset may still be in flight.
-    if (phase_ == Phase::AwaitingReset && reset_served_ && session_.task().isTerminal(state) && !inStartRegion(state) &&
-        ++fallen_repeats_ >= 2)
+    // fall sent before the reset may still be in flight. Never the fall that asked for the reset:
+    // the sim repeated it until the reset came, every repeat_after, and a controller that took
+    // long over the episode's end (a whole verdict on a loaded machine) reads them all after the
+    // reset's answer. Asking again there reset the sim twice, and lockstep training was no
+    // longer train_headless's.
+    if (phase_ == Phase::AwaitingReset && reset_served_ && stamp != reset_asked_by_ &&
+        session_.task().isTerminal(state) && !inStartRegion(state) && ++fallen_repeats_ >= 2)
     {
       requestReset(reaction);
       return reaction;
@@ -277,6 +281,7 @@ Reaction ControllerProtocol::onState(Stamp stamp, const CartPoleState& state)
 void ControllerProtocol::requestReset(Reaction& reaction)
 {
   reaction.request_reset = true;
+  reset_asked_by_ = reaction.stamp;
   phase_ = Phase::AwaitingReset;
   reset_served_ = false;
   fallen_repeats_ = 0;

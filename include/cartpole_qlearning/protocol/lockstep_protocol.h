@@ -308,7 +308,10 @@ private:
   bool reset_failing_ = false;  // the last reset failed, none has succeeded since
   bool reset_served_ = false;   // AwaitingReset: the reset asked for came back done
   int fallen_repeats_ = 0;      // repeats of a fallen state since then
-  int fallen_states_ = 0;       // new fallen states since then
+  // The state whose fall asked for the reset: its repeats are never a fall after the reset (a
+  // controller busy at the episode's end, a whole verdict, finds several of them queued).
+  std::optional<Stamp> reset_asked_by_;
+  int fallen_states_ = 0;  // new fallen states since then
   static constexpr int kFallenStatesBeforeAskingAgain = 50;
   Counts counts_;
 };

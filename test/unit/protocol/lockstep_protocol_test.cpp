@@ -858,6 +858,28 @@ TEST_F(ControllerProtocolTest, AFallAfterTheResetWasServedThatTheSimWaitsOnAsksF
   EXPECT_EQ(1u, session_.episodesEnded());
 }
 
+TEST_F(ControllerProtocolTest, TheFallThatAskedForTheResetRepeatedUntilItWasServedAsksForNoOther)
+{
+  // The controller judges the table at the episode's end before it calls the reset: a whole
+  // verdict takes seconds on a loaded machine (Debian 11's root, load 7), and the lockstep sim
+  // repeats its fallen state every half second meanwhile. Those repeats are read after the
+  // reset's answer. Asking again there reset the sim twice: the next start was another draw, and
+  // train.launch's table was no longer train_headless's (robust_train.test).
+  ControllerProtocol controller(session_, params_);
+  controller.onState(tick(1), kUpright);
+  ASSERT_TRUE(controller.onState(tick(2), kFallen).request_reset);
+  controller.onResetOutcome(true);
+  for (int i = 0; i < 6; ++i)
+  {
+    const Reaction queued = controller.onState(tick(2), kFallen);
+    EXPECT_EQ(Reaction::Kind::Repeat, queued.kind);
+    EXPECT_FALSE(queued.request_reset) << "repeat " << i << " of the fall that asked for the reset";
+    EXPECT_FALSE(queued.answer);
+  }
+  EXPECT_TRUE(controller.onState(tick(3), kSmall).episode_began) << "the reset's start";
+  EXPECT_EQ(1u, session_.episodesEnded());
+}
+
 TEST_F(ControllerProtocolTest, ARealtimeRobotFelledAfterItsResetWasServedIsResetAgainAfterFiftyFallenStates)
 {
   // Realtime: the felled robot sends new states, each fallen. Before the reset's answer none of
