@@ -2,7 +2,7 @@
 """Trains one table per seed with train_headless and a config that runs the robustness suite
 (e.g. config/robust.yaml), and prints a Markdown table: per seed, the episodes and steps to the
 table it saved, the run's training seconds (train_s of its result line: the saved table's final
-verdict apart), and the suite's per-case counts; then the median and worst seed
+verdict apart) and the CPU seconds of its whole process, and the suite's per-case counts; then the median and worst seed
 of each column. The figures of docs/robust_tables.md come from one run of it:
 
   python3 tools/robust_seeds.py --config config/robust.yaml --seeds 0-19   (or --seeds 1,17,19)
@@ -15,6 +15,7 @@ train_headless is found on PATH, else by catkin_find (source devel/setup.bash), 
 Nothing is written (--no-run-folder).
 """
 import argparse
+import os
 import concurrent.futures
 import re
 import shutil
@@ -61,8 +62,14 @@ def main():
         parser.error('--jobs %d: at least 1' % args.jobs)
 
     def train(seed):
-        out = subprocess.run([args.train_headless, '--config', args.config, '--seed', str(seed), '--no-run-folder'],
-                             capture_output=True, text=True).stdout
+        # Reaped here (os.wait4) for the run's own CPU time: train_s is wall time, which a busy
+        # machine stretches; the two agree on a quiet core.
+        proc = subprocess.Popen([args.train_headless, '--config', args.config, '--seed', str(seed), '--no-run-folder'],
+                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        out = proc.stdout.read()
+        proc.stdout.close()
+        _, _, usage = os.wait4(proc.pid, 0)
+        proc.returncode = 0
         train_s = re.search(r' train_s=([0-9.]+) ', out)
         end = re.search(r'^(SUITE PASSED|suite NOT passed|SOLVED|NOT solved)\S* .*?after (\d+) episodes, (\d+) steps',
                         out, re.M)
@@ -82,7 +89,8 @@ def main():
             sys.exit('seed %d: no verdict in the output:\n%s' % (seed, out))
         print('seed %d: %s' % (seed, said), file=sys.stderr, flush=True)
         return dict(seed=seed, passed=passed, episodes=int(end.group(2)),
-                    steps=int(end.group(3)), train_s=float(train_s.group(1)), cases=[(n, int(b)) for n, b, _ in cases])
+                    steps=int(end.group(3)), train_s=float(train_s.group(1)),
+                    cpu=usage.ru_utime + usage.ru_stime, cases=[(n, int(b)) for n, b, _ in cases])
 
     # A seed without a verdict stops the whole run at once (sys.exit in a worker thread would only
     # surface after every queued seed had trained): the seeds not started are cancelled.
@@ -95,17 +103,18 @@ def main():
                 future.cancel()
             raise
     names = [n for n, _ in rows[0]['cases']]
-    print('| seed | passes | episodes | steps | train_s | ' + ' | '.join(names) + ' |')
-    print('| --- ' * (5 + len(names)) + '|')
+    print('| seed | passes | episodes | steps | train_s | cpu s | ' + ' | '.join(names) + ' |')
+    print('| --- ' * (6 + len(names)) + '|')
     for r in rows:
-        print('| %d | %s | %d | %d | %.1f | %s |' % (r['seed'], 'yes' if r['passed'] else '**no**', r['episodes'],
-                                                    r['steps'], r['train_s'], ' | '.join(str(b) for _, b in r['cases'])))
+        print('| %d | %s | %d | %d | %.1f | %.1f | %s |' % (r['seed'], 'yes' if r['passed'] else '**no**', r['episodes'],
+                                                         r['steps'], r['train_s'], r['cpu'], ' | '.join(str(b) for _, b in r['cases'])))
     median = lambda key: statistics.median(r[key] for r in rows)
-    print('| median | %d of %d | %.10g | %.10g | %.1f | %s |' % (
-        sum(r['passed'] for r in rows), len(rows), median('episodes'), median('steps'), median('train_s'),
+    print('| median | %d of %d | %.10g | %.10g | %.1f | %.1f | %s |' % (
+        sum(r['passed'] for r in rows), len(rows), median('episodes'), median('steps'), median('train_s'), median('cpu'),
         ' | '.join('%.10g' % statistics.median(r['cases'][i][1] for r in rows) for i in range(len(names)))))
-    print('| worst | | %d | %d | %.1f | %s |' % (
+    print('| worst | | %d | %d | %.1f | %.1f | %s |' % (
         max(r['episodes'] for r in rows), max(r['steps'] for r in rows), max(r['train_s'] for r in rows),
+        max(r['cpu'] for r in rows),
         ' | '.join(str(min(r['cases'][i][1] for r in rows)) for i in range(len(names)))))
 
 
