@@ -17,7 +17,11 @@ llvm_toolchain() {
   fi
   CLANG=clang-$LLVM_VERSION
   CLANGXX=clang++-$LLVM_VERSION
-  LLVM_SYMBOLIZER=$(command -v "llvm-symbolizer-$LLVM_VERSION" || echo "/usr/lib/llvm-$LLVM_VERSION/bin/llvm-symbolizer")
+  # The one named llvm-symbolizer first: compiler-rt 11 (Debian 11) knows a symbolizer by its file
+  # name, refuses llvm-symbolizer-11 ("isn't a known symbolizer") and stops every sanitized process
+  # at its start; Debian's llvm-N links the versioned name in /usr/bin to this one.
+  LLVM_SYMBOLIZER=/usr/lib/llvm-$LLVM_VERSION/bin/llvm-symbolizer
+  [ -x "$LLVM_SYMBOLIZER" ] || LLVM_SYMBOLIZER=$(command -v "llvm-symbolizer-$LLVM_VERSION" || echo "$LLVM_SYMBOLIZER")
   [ -n "$LLVM_VERSION" ]
 }
 
