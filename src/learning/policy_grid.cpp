@@ -67,6 +67,7 @@ PolicyGrid policyGrid(const QTable& table, const PolicyGridParams& params)
   agent_params.discretiser = features.discretiser;
   agent_params.tilings = features.tilings;
   agent_params.tiles = features.tiles;
+  agent_params.second_tiles = features.second_tiles;
   agent_params.previous_action = features.previous_action;
   agent_params.actions = table.actions();
   QLearningAgent agent(agent_params, 0);
