@@ -20,7 +20,7 @@ namespace cartpole_qlearning
 // The longest decision period a config may ask for: a second of the Suite's 0.01 s steps.
 constexpr unsigned kMaxDecisionSteps = 100;
 // Experience replay's limits: a thousand replayed updates a decision, ten million transitions kept
-// (with 64 tilings about 5 GB: the limit of a machine, not of a sensible config).
+// (about 5 GB when a state activates 64 rows: the limit of a machine, not of a sensible config).
 constexpr unsigned kMaxReplayUpdates = 1000;
 constexpr unsigned kMaxReplayCapacity = 10000000;
 
