@@ -211,15 +211,46 @@ const ConfigSection<AgentParams>& learningSection()
       if (agent.initial_value != 0.0)
         writer.write("initial_value", agent.initial_value);
     };
+    ConfigKey<A> second_tiles =
+        dimensionsKey("second_tiles", "4 ints: a second tile coding's tiles per state value", field(&A::second_tiles));
+    second_tiles.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.featureParams().hasSecondTiles())
+        writer.write("second_tiles", agent.second_tiles);
+    };
+    ConfigKey<A> replay_updates =
+        wholeKey<A>("replay_updates", "int: replayed one-step updates after each decision's own, 0 for none",
+                    field(&A::replay_updates), 0, kMaxReplayUpdates);
+    replay_updates.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.replay_updates != 0)
+        writer.write("replay_updates", agent.replay_updates);
+    };
+    ConfigKey<A> replay_capacity =
+        wholeKey<A>("replay_capacity", "int, transitions: the last transitions replay draws from",
+                    field(&A::replay_capacity), 1, kMaxReplayCapacity);
+    replay_capacity.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.replay_updates != 0)
+        writer.write("replay_capacity", agent.replay_capacity);
+    };
+    ConfigKey<A> replay_alpha =
+        plainKey<A>("replay_alpha", "double: a replayed update's learning rate, 0 for the episode's alpha",
+                    field(&A::replay_alpha));
+    replay_alpha.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.replay_updates != 0)
+        writer.write("replay_alpha", agent.replay_alpha);
+    };
     ConfigKey<A> warp = dimensionsKey("warp", "4 doubles: finer bins and tiles near 0, 1 for uniform", field(&A::warp));
     warp.write = [](SectionWriter& writer, const AgentParams& agent) {
       if (agent.featureParams().warped())
         writer.write("warp", agent.warp);
     };
     s.keys.push_back(warp);
+    s.keys.push_back(second_tiles);
     s.keys.push_back(lambda);
     s.keys.push_back(initial);
     s.keys.push_back(decision);
+    s.keys.push_back(replay_updates);
+    s.keys.push_back(replay_capacity);
+    s.keys.push_back(replay_alpha);
     addSchedule(s.keys, "epsilon", &A::epsilon, "exploration rate");
     addSchedule(s.keys, "alpha", &A::alpha, "learning rate");
     ConfigKey<A> names = plainKey<A>("state_names", "list of strings: the table rows' names, then the fallen state's",

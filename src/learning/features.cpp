@@ -29,6 +29,13 @@ TileCoderParams FeatureParams::tileCoder() const
   return coder;
 }
 
+TileCoderParams FeatureParams::secondTileCoder() const
+{
+  TileCoderParams coder = tileCoder();
+  coder.tiles = second_tiles;
+  return coder;
+}
+
 std::string FeatureParams::validate() const
 {
   for (std::size_t d = 0; d < kStateDimensions; ++d)
@@ -42,11 +49,26 @@ std::string FeatureParams::validate() const
     if (!out.str().empty())
       return out.str();
   }
-  return kind == FeatureKind::Tiles ? tileCoder().validate() : discretiser.validate();
+  if (kind != FeatureKind::Tiles)
+  {
+    if (hasSecondTiles())
+      return "second_tiles is not allowed with features bins (it is a second tile coding)";
+    return discretiser.validate();
+  }
+  std::string error = tileCoder().validate();
+  if (!error.empty() || !hasSecondTiles())
+    return error;
+  if (2 * tilings > kMaxTilings)
+    return "second_tiles with tilings = " + std::to_string(tilings) + " is not allowed (a state then activates " +
+           std::to_string(2 * tilings) + " rows; tilings must be at most " + std::to_string(kMaxTilings / 2) + ")";
+  error = secondTileCoder().validate();
+  return error.empty() ? "" : "second_tiles: " + error;
 }
 
 std::size_t FeatureParams::stateRowCount() const
 {
+  if (kind == FeatureKind::Tiles && hasSecondTiles())
+    return TileCoder(tileCoder()).tileCount() + TileCoder(secondTileCoder()).tileCount();
   return kind == FeatureKind::Tiles ? TileCoder(tileCoder()).tileCount() : Discretiser(discretiser).stateCount();
 }
 
@@ -99,7 +121,9 @@ std::string FeatureParams::mismatch(const FeatureParams& other) const
     return "tilings " + std::to_string(other.tilings) + " differ from " + std::to_string(tilings);
   if (tiles != other.tiles)
     return "tiles " + fullPrecisionList(other.tiles) + " differ from " + fullPrecisionList(tiles);
-  if (!(tileCoder() == other.tileCoder()))
+  if (second_tiles != other.second_tiles)
+    return "second_tiles " + fullPrecisionList(other.second_tiles) + " differ from " + fullPrecisionList(second_tiles);
+  if (!(tileCoder() == other.tileCoder()) || (hasSecondTiles() && !(secondTileCoder() == other.secondTileCoder())))
     return "tile bounds " + boundsText(other.discretiser) + " differ from " + boundsText(discretiser);
   return "";
 }
@@ -125,6 +149,11 @@ FeatureMap::FeatureMap(const FeatureParams& params, std::size_t actions)
   {
     tile_coder_.emplace(params_.tileCoder());
     state_rows_ = tile_coder_->tileCount();
+    if (params_.hasSecondTiles())
+    {
+      second_coder_.emplace(params_.secondTileCoder());
+      state_rows_ += second_coder_->tileCount();
+    }
   }
   row_count_ = state_rows_ * params_.blocks(actions);
 }

@@ -67,6 +67,7 @@ PolicyGrid policyGrid(const QTable& table, const PolicyGridParams& params)
   agent_params.discretiser = features.discretiser;
   agent_params.tilings = features.tilings;
   agent_params.tiles = features.tiles;
+  agent_params.second_tiles = features.second_tiles;
   agent_params.previous_action = features.previous_action;
   agent_params.actions = table.actions();
   QLearningAgent agent(agent_params, 0);
@@ -119,8 +120,14 @@ std::string policyGridCsv(const PolicyGrid& grid, const QTable& table)
   out << "# policy: the greedy action and max_a Q of a cartpole_qlearning Q-table\n";
   out << "# features: " << toString(features.kind);
   if (features.kind == FeatureKind::Tiles)
+  {
     out << " (" << features.tilings << " tilings of " << features.tiles[0] << "x" << features.tiles[1] << "x"
-        << features.tiles[2] << "x" << features.tiles[3] << " tiles)";
+        << features.tiles[2] << "x" << features.tiles[3] << " tiles";
+    if (features.hasSecondTiles())
+      out << ", and " << features.tilings << " of " << features.second_tiles[0] << "x" << features.second_tiles[1]
+          << "x" << features.second_tiles[2] << "x" << features.second_tiles[3];
+    out << ")";
+  }
   else
     out << " (" << features.discretiser.bins[0] << "x" << features.discretiser.bins[1] << "x"
         << features.discretiser.bins[2] << "x" << features.discretiser.bins[3] << " bins)";

@@ -76,6 +76,7 @@ FeatureParams AgentParams::featureParams() const
   params.discretiser = discretiser;
   params.tilings = tilings;
   params.tiles = tiles;
+  params.second_tiles = second_tiles;
   params.previous_action = previous_action;
   params.warp = warp;
   return params;
@@ -117,6 +118,21 @@ std::string AgentParams::validate() const
   if (!std::isfinite(initial_value))
   {
     out << "initial_value = " << initial_value << " is not allowed (must be finite)";
+    return out.str();
+  }
+  if (replay_updates > kMaxReplayUpdates)
+  {
+    out << "replay_updates = " << replay_updates << " is not allowed (must be in [0, " << kMaxReplayUpdates << "])";
+    return out.str();
+  }
+  if (replay_capacity < 1 || replay_capacity > kMaxReplayCapacity)
+  {
+    out << "replay_capacity = " << replay_capacity << " is not allowed (must be in [1, " << kMaxReplayCapacity << "])";
+    return out.str();
+  }
+  if (!(replay_alpha >= 0.0 && replay_alpha <= 1.0))
+  {
+    out << "replay_alpha = " << replay_alpha << " is not allowed (must be in [0, 1])";
     return out.str();
   }
   if (decision_steps < 1 || decision_steps > kMaxDecisionSteps)
@@ -162,7 +178,7 @@ QLearningAgent::QLearningAgent(const AgentParams& params, std::uint64_t seed)
 {
   if (params_.initial_value != 0.0)
   {
-    const double weight = params_.initial_value / (params_.features == FeatureKind::Tiles ? params_.tilings : 1);
+    const double weight = params_.initial_value / params_.featureParams().activeRowCount();
     for (std::size_t row = 0; row < table_.stateCount(); ++row)
       for (std::size_t a = 0; a < table_.actionCount(); ++a)
         table_.at(row, a) = weight;

@@ -232,6 +232,9 @@ FeatureParams readFeatures(const YAML::Node& root, bool version1)
       refuse("tilings is not a whole number in [1, " + std::to_string(kMaxTilings) + "]");
     features.tilings = static_cast<unsigned>(tilings);
     features.tiles = readCounts(root, "tiles");
+    // Absent in older files and in tables of one tile coding.
+    if (root["second_tiles"])
+      features.second_tiles = readCounts(root, "second_tiles");
   }
   else
   {

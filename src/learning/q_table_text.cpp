@@ -69,6 +69,12 @@ std::string checksumOf(const QTable& table)
   // Summed only when on, so that every other table keeps its checksum.
   if (f.previous_action)
     sum.add(std::uint64_t{1});
+  if (tiles && f.hasSecondTiles())
+  {
+    sum.add(std::uint64_t{2});
+    for (const unsigned t : f.second_tiles)
+      sum.add(static_cast<std::uint64_t>(t));
+  }
   // Version 3's keys, summed only when present: a table without them keeps its checksum.
   if (table.tau > 0.0)
   {
@@ -187,7 +193,12 @@ std::string formatQTable(const QTable& table)
         << "dimensions: [x, x_dot, theta, theta_dot]\n"
         << "tilings: " << f.tilings << "\n"
         << "tiles: " << flowList(f.tiles) << "\n";
-  else
+  // Written only when present: a table without it is the file it always was.
+  if (tiles && f.hasSecondTiles())
+    out << "# A second tile coding, as many tilings again over the same bounds with these tiles; its rows\n"
+        << "# follow the first's, and Q(s, a) sums the active tile of every tiling of both.\n"
+        << "second_tiles: " << flowList(f.second_tiles) << "\n";
+  if (!tiles)
     out << "# Features: uniform bins per state dimension; values outside the bounds go to the end bins.\n"
         << "features: bins\n"
         << "dimensions: [x, x_dot, theta, theta_dot]\n"

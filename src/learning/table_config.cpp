@@ -52,6 +52,7 @@ TableConfig tableConfig(const QTable& table, const std::string& table_path)
   agent.discretiser = features.discretiser;
   agent.tilings = features.tilings;
   agent.tiles = features.tiles;
+  agent.second_tiles = features.second_tiles;
   agent.previous_action = features.previous_action;
   agent.actions = table.actions();
   if (table.tau > 0.0)
@@ -79,6 +80,8 @@ std::string tableContradiction(const TrainingConfig& config, const std::string& 
     {
       differ("learning/tilings", std::to_string(wanted.tilings), std::to_string(has.tilings));
       differ("learning/tiles", listText(wanted.tiles), listText(has.tiles));
+      if (wanted.hasSecondTiles() || has.hasSecondTiles())
+        differ("learning/second_tiles", listText(wanted.second_tiles), listText(has.second_tiles));
     }
     // Tiles use the bounds of the dimensions they split only: what tiles them alike counts.
     const bool same_bounds =

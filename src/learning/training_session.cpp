@@ -38,6 +38,20 @@ TrainingSession::TrainingSession(const TaskParams& task, const AgentParams& agen
   if (robots < 1)
     throw std::invalid_argument("TrainingSession: at least one robot");
   episodes_.assign(robots, Episode(task.solved_window));
+  if (learning_ && agent.replay_updates > 0)
+    replay_.emplace(agent.replay_capacity, seed);
+}
+
+void TrainingSession::replayExperience(const ActiveRows& state, std::size_t action, double reward,
+                                       const ActiveRows& next_state, bool next_is_terminal, double episode_alpha)
+{
+  replay_->add(state, action, reward, next_state, next_is_terminal);
+  const double alpha = agent_.params().replay_alpha > 0.0 ? agent_.params().replay_alpha : episode_alpha;
+  for (unsigned i = 0; i < agent_.params().replay_updates; ++i)
+  {
+    const ReplayedTransition& drawn = replay_->draw();
+    agent_.update(drawn.state, drawn.action, drawn.reward, drawn.next_state, drawn.next_is_terminal, alpha);
+  }
 }
 
 std::string TrainingSession::predictDelay(const CartPoleParams& model, unsigned steps)
@@ -128,6 +142,8 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
     const QUpdate update = agent_.update(e.state(), e.action, reward, e.next(), decision.outcome.terminated, e.alpha,
                                          agent_.params().lambda > 0.0 ? &e.traces : nullptr);
     agent_.table().steps += held;
+    if (replay_)
+      replayExperience(e.state(), e.action, reward, e.next(), decision.outcome.terminated, e.alpha);
     if (trace_)
     {
       TraceStep step;

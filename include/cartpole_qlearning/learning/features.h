@@ -45,6 +45,23 @@ struct FeatureParams
   // default); a warped dimension needs bounds symmetric about 0. Carried by the configuration a
   // table was trained with (its trained_with), not by the table's file.
   std::array<double, kStateDimensions> warp{{1.0, 1.0, 1.0, 1.0}};
+  // A second tile coding beside the first, summed into the same Q: as many tilings again over the
+  // same (warped) bounds, with these tiles per dimension (1 ignores a dimension). A group over theta
+  // and theta_dot alone, finer than the first, resolves the pole near upright without multiplying
+  // its tiles by the cart's; the first then needs only as fine a grid as the cart's part of the
+  // task. All 0 (the default): none. Tiles only.
+  std::array<unsigned, kStateDimensions> second_tiles{{0, 0, 0, 0}};
+
+  bool hasSecondTiles() const
+  {
+    return second_tiles != std::array<unsigned, kStateDimensions>{{0, 0, 0, 0}};
+  }
+  TileCoderParams secondTileCoder() const;
+  // The rows a state activates: 1 for bins, a row per tiling of each tile coding for tiles.
+  unsigned activeRowCount() const
+  {
+    return kind == FeatureKind::Tiles ? tilings * (hasSecondTiles() ? 2 : 1) : 1;
+  }
 
   bool warped() const
   {
@@ -150,6 +167,15 @@ private:
     }
     tile_coder_->activeTiles(state, active.rows.data());
     active.count = tile_coder_->tilings();
+    if (second_coder_)
+    {
+      // The second coding's rows follow the first's.
+      second_coder_->activeTiles(state, active.rows.data() + active.count);
+      const auto first_rows = static_cast<std::uint32_t>(tile_coder_->tileCount());
+      for (unsigned i = active.count; i < 2 * active.count; ++i)
+        active.rows[i] += first_rows;
+      active.count *= 2;
+    }
     for (unsigned i = 0; offset != 0 && i < active.count; ++i)
       active.rows[i] += offset;
   }
@@ -157,6 +183,7 @@ private:
   FeatureParams params_;
   Discretiser discretiser_;
   std::optional<TileCoder> tile_coder_;
+  std::optional<TileCoder> second_coder_;  // FeatureParams::second_tiles
   std::size_t state_rows_;
   std::size_t row_count_;
   bool warped_ = false;

@@ -19,6 +19,10 @@ namespace cartpole_qlearning
 {
 // The longest decision period a config may ask for: a second of the Suite's 0.01 s steps.
 constexpr unsigned kMaxDecisionSteps = 100;
+// Experience replay's limits: a thousand replayed updates a decision, ten million transitions kept
+// (about 5 GB when a state activates 64 rows: the limit of a machine, not of a sensible config).
+constexpr unsigned kMaxReplayUpdates = 1000;
+constexpr unsigned kMaxReplayCapacity = 10000000;
 
 struct AgentParams
 {
@@ -28,6 +32,7 @@ struct AgentParams
   DiscretiserParams discretiser;
   unsigned tilings = 8;
   std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
+  std::array<unsigned, kStateDimensions> second_tiles{{0, 0, 0, 0}};  // FeatureParams::second_tiles
   bool previous_action = false;  // the action taken last is part of what the learner sees
   std::array<double, kStateDimensions> warp{{1.0, 1.0, 1.0, 1.0}};  // FeatureParams::warp
   std::vector<double> actions{-10.0, 10.0};                         // [N] the effort of each action
@@ -41,6 +46,13 @@ struct AgentParams
   // 1/N of it). Above the returns a task can give, it is optimism: every untried action looks
   // better than what has been tried, and the table explores by itself. 0: today's empty table.
   double initial_value = 0.0;
+  // Experience replay (experience_replay.h): after each decision's own update, this many one-step
+  // updates from transitions drawn at random among the last replay_capacity ones; 0: none. They take
+  // no environment step, so the step counts are those without replay.
+  unsigned replay_updates = 0;
+  unsigned replay_capacity = 100000;
+  // The learning rate of a replayed update; 0: the episode's alpha (the schedule's).
+  double replay_alpha = 0.0;
   ScheduleParams epsilon = defaultEpsilon();  // exploration rate per episode
   ScheduleParams alpha = defaultAlpha();      // learning rate per episode
   // Names of the table's rows for the trace, then the name of the terminal state (which has no

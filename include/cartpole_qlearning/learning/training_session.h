@@ -13,6 +13,7 @@
 #include "cartpole_qlearning/learning/cartpole_task.h"
 #include "cartpole_qlearning/learning/learning_settings.h"
 #include "cartpole_qlearning/learning/delay_predictor.h"
+#include "cartpole_qlearning/learning/experience_replay.h"
 #include "cartpole_qlearning/learning/q_learning_agent.h"
 #include "cartpole_qlearning/learning/trace.h"
 
@@ -239,6 +240,11 @@ private:
 
   // While learning with traces, an exploring choice ends them (Watkins).
   std::size_t chooseAction(const ActiveRows& state, double epsilon, EligibilityTraces& traces);
+  // Stores the transition just learnt from and learns again from replay_updates drawn at random
+  // (AgentParams::replay_updates), one step each, without traces: a trace belongs to the episode
+  // under way, and a drawn transition to some episode before.
+  void replayExperience(const ActiveRows& state, std::size_t action, double reward, const ActiveRows& next_state,
+                        bool next_is_terminal, double episode_alpha);
   // The state a decision is made for: the observed one, or its prediction (predictDelay).
   CartPoleState decidedFor(const CartPoleState& observed, std::size_t robot) const
   {
@@ -247,6 +253,9 @@ private:
 
   CartPoleTask task_;
   QLearningAgent agent_;
+  // While learning with replay_updates > 0; shared by every robot, as the table is. Not part of a
+  // checkpoint: a resumed run starts it empty.
+  std::optional<ExperienceReplay> replay_;
   std::vector<DelayPredictor> predictors_;  // one per robot; empty: decide for what is observed
   double stamp_tau_ = 0.0;                  // stampTables' (0: none)
   std::string stamp_trained_with_;

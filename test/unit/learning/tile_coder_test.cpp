@@ -1,5 +1,6 @@
 #include "cartpole_qlearning/learning/q_learning_agent.h"
 #include "cartpole_qlearning/common/random.h"
+#include "cartpole_qlearning/learning/q_table_file.h"
 #include "cartpole_qlearning/learning/tile_coder.h"
 
 #include <gtest/gtest.h>
@@ -284,4 +285,81 @@ TEST(TileCoder, TheTilesAreThoseOfTheDefinitionForEveryTiling)
       }
     }
   }
+}
+
+namespace
+{
+// The two tilings above, and a second tile coding of four tiles of theta_dot over the same bounds.
+FeatureParams withSecondTiles()
+{
+  FeatureParams p = twoTilings().featureParams();
+  p.second_tiles = {{1, 1, 1, 4}};
+  return p;
+}
+}  // namespace
+
+TEST(SecondTileCoding, ItsRowsFollowTheFirstsAndEveryStateActivatesATileOfEachTiling)
+{
+  const FeatureParams params = withSecondTiles();
+  const FeatureMap map(params, 2);
+  const TileCoder first(params.tileCoder());
+  const TileCoder second(params.secondTileCoder());
+  EXPECT_EQ(6u, first.tileCount());    // 2 tilings of 3 tiles
+  EXPECT_EQ(10u, second.tileCount());  // 2 tilings of 5 tiles
+  EXPECT_EQ(16u, map.rowCount());
+  EXPECT_EQ(4u, params.activeRowCount());
+  for (const double theta_dot : {-0.9, -0.3, 0.1, 0.6})
+  {
+    const CartPoleState state(0.0, 0.0, 0.0, theta_dot);
+    ActiveRows rows;
+    map.activeRows(state, rows);
+    ASSERT_EQ(4u, rows.count);
+    const Tiles own_first = active(first, state);
+    const Tiles own_second = active(second, state);
+    EXPECT_EQ(own_first, (Tiles{rows.rows[0], rows.rows[1]}));
+    EXPECT_EQ((Tiles{own_second[0] + 6, own_second[1] + 6}), (Tiles{rows.rows[2], rows.rows[3]}));
+  }
+}
+
+TEST(SecondTileCoding, OptimismAndUpdatesSpreadOverBothCodings)
+{
+  AgentParams p = twoTilings();
+  p.second_tiles = {{1, 1, 1, 4}};
+  p.initial_value = 8.0;
+  QLearningAgent agent(p, 0);
+  ActiveRows s;
+  agent.activeRows(CartPoleState(0.0, 0.0, 0.0, 0.25), s);
+  EXPECT_DOUBLE_EQ(8.0, agent.value(s, 0));  // each of 4 rows holds a quarter
+  agent.update(s, 0, 1.0, s, true, 0.5);     // terminal: target 1, Q moves halfway
+  EXPECT_DOUBLE_EQ(4.5, agent.value(s, 0));
+}
+
+TEST(SecondTileCoding, ATableWithItRoundTripsThroughItsFileAndATableWithoutIsWrittenAsBefore)
+{
+  QTable table(withSecondTiles(), {-10.0, 10.0});
+  for (std::size_t row = 0; row < table.stateCount(); ++row)
+    table.at(row, row % 2) = 0.25 * static_cast<double>(row);
+  const std::string text = formatQTable(table);
+  EXPECT_NE(std::string::npos, text.find("second_tiles: [1, 1, 1, 4]"));
+  const QTable read = parseQTable(text);
+  EXPECT_EQ("", table.features().mismatch(read.features()));
+  EXPECT_EQ(table.values(), read.values());
+
+  QTable one_coding(twoTilings().featureParams(), {-10.0, 10.0});
+  EXPECT_EQ(std::string::npos, formatQTable(one_coding).find("second_tiles"));
+  EXPECT_NE("", one_coding.features().mismatch(table.features()));
+}
+
+TEST(SecondTileCoding, IsRefusedWithBinsAndWithMoreThanHalfTheTilings)
+{
+  AgentParams bins;
+  bins.second_tiles = {{1, 1, 2, 2}};
+  EXPECT_NE(std::string::npos, bins.validate().find("second_tiles is not allowed with features bins"))
+      << bins.validate();
+  AgentParams many = twoTilings();
+  many.second_tiles = {{1, 1, 1, 4}};
+  many.tilings = kMaxTilings / 2 + 1;
+  EXPECT_NE(std::string::npos, many.validate().find("second_tiles with tilings")) << many.validate();
+  many.tilings = kMaxTilings / 2;
+  EXPECT_EQ("", many.validate());
 }
