@@ -33,7 +33,7 @@
 # under roslaunch that dies may not); so every process writes its reports to files under
 # $WS/build_sanitize/sanitizer_logs (log_path) and each such file is a failed test case here.
 # Reports that are not the project's are suppressed in test/sanitizer/asan.supp (a nodelet
-# bug) and test/sanitizer/lsan.supp (leaks; none so far), each with its reason. The Python nodes (rostest's hztest) are not
+# bug) and test/sanitizer/lsan.supp (leaks: other libraries' own, each with its reason). The Python nodes (rostest's hztest) are not
 # instrumented. nodelet's own executable (the manager that loads the instrumented nodelet
 # library) is not instrumented either: the sanitized devel space gets a lib/nodelet/nodelet of
 # its own, found by roslaunch before Debian's, that starts Debian's with the ASan runtime
