@@ -673,8 +673,10 @@ TEST(RobustnessSuite, PredictingTheDelayTheGreedyPathAndASessionTakeTheSameSteps
 TEST(RobustnessSuite, OnARobotOneStepLateATableActingOnThePredictionBalancesMore)
 {
   // The trained table of the default config on the suite's one_step_late case, in 500-step
-  // episodes: what the prediction is for. The same table on the nominal model, predicting a delay
-  // that is not there, decides a step ahead of the robot and balances less than it does there.
+  // episodes: what the prediction is for. The same table on the nominal model, told a delay that
+  // is not there, would decide a step ahead of the robot; the predictor's fit of the robot's steps
+  // takes the commands' effect as it shows (a step sooner) and it balances nearly as often as
+  // deciding for the state seen (before the fit: 0 of 100).
   const TrainingConfig config;
   const RobustnessSuite suite = loadRobustnessSuite(kSuite, config);
   TrainingConfig judged = config;
@@ -696,7 +698,7 @@ TEST(RobustnessSuite, OnARobotOneStepLateATableActingOnThePredictionBalancesMore
   EXPECT_GT(predicted.balanced, seen.balanced);
   const CaseResult nominal_seen = evaluateCase(table, judged, *nominal, 100, suite.seed);
   const CaseResult nominal_predicted = evaluateCase(table, judged, *nominal, 100, suite.seed, false, 0, 1);
-  EXPECT_LT(nominal_predicted.balanced, nominal_seen.balanced);
+  EXPECT_GE(nominal_predicted.balanced + 5, nominal_seen.balanced);
   std::printf("one_step_late: %llu balanced predicting, %llu not; nominal: %llu predicting, %llu not\n",
               static_cast<unsigned long long>(predicted.balanced), static_cast<unsigned long long>(seen.balanced),
               static_cast<unsigned long long>(nominal_predicted.balanced),
