@@ -68,6 +68,8 @@ PolicyGrid policyGrid(const QTable& table, const PolicyGridParams& params)
   agent_params.tilings = features.tilings;
   agent_params.tiles = features.tiles;
   agent_params.second_tiles = features.second_tiles;
+  agent_params.energy_tiles = features.energy_tiles;
+  agent_params.pole_frequency = features.pole_frequency;
   agent_params.previous_action = features.previous_action;
   agent_params.actions = table.actions();
   QLearningAgent agent(agent_params, 0);
@@ -126,6 +128,9 @@ std::string policyGridCsv(const PolicyGrid& grid, const QTable& table)
     if (features.hasSecondTiles())
       out << ", and " << features.tilings << " of " << features.second_tiles[0] << "x" << features.second_tiles[1]
           << "x" << features.second_tiles[2] << "x" << features.second_tiles[3];
+    if (features.hasEnergyTiles())
+      out << ", and " << features.tilings << " of " << features.energy_tiles[0] << "x" << features.energy_tiles[1]
+          << "x" << features.energy_tiles[2] << "x" << features.energy_tiles[3] << " over the swing";
     out << ")";
   }
   else
