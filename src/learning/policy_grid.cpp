@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/learning/policy_grid.h"
 
 #include "cartpole_qlearning/learning/q_learning_agent.h"
+#include "cartpole_qlearning/learning/table_config.h"
 
 #include <cmath>
 #include <cstdio>
@@ -72,6 +73,14 @@ PolicyGrid policyGrid(const QTable& table, const PolicyGridParams& params)
   agent_params.pole_frequency = features.pole_frequency;
   agent_params.previous_action = features.previous_action;
   agent_params.actions = table.actions();
+  // What maps states onto rows beyond the file's header (warp, mirror) is in the configuration the
+  // table carries (the defaults when it carries none).
+  if (!table.trained_with.empty())
+  {
+    const AgentParams carried = tableConfig(table, "").config.agent;
+    agent_params.warp = carried.warp;
+    agent_params.mirror = carried.mirror;
+  }
   QLearningAgent agent(agent_params, 0);
   const std::string mismatch = agent.replaceTable(table);
   if (!mismatch.empty())  // cannot happen: the agent was made from the table's own shape
