@@ -217,6 +217,20 @@ const ConfigSection<AgentParams>& learningSection()
       if (agent.featureParams().hasSecondTiles())
         writer.write("second_tiles", agent.second_tiles);
     };
+    ConfigKey<A> energy_tiles = dimensionsKey(
+        "energy_tiles", "4 ints: a tile coding's tiles per x, x_dot, the pole's energy, theta_dot cos(theta)",
+        field(&A::energy_tiles));
+    energy_tiles.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.featureParams().hasEnergyTiles())
+        writer.write("energy_tiles", agent.energy_tiles);
+    };
+    ConfigKey<A> pole_frequency =
+        plainKey<A>("pole_frequency", "double, rad/s: sqrt(m g l / I) of the pole, for energy_tiles' energy",
+                    field(&A::pole_frequency));
+    pole_frequency.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.featureParams().hasEnergyTiles())
+        writer.write("pole_frequency", agent.pole_frequency);
+    };
     ConfigKey<A> replay_updates =
         wholeKey<A>("replay_updates", "int: replayed one-step updates after each decision's own, 0 for none",
                     field(&A::replay_updates), 0, kMaxReplayUpdates);
@@ -244,7 +258,16 @@ const ConfigSection<AgentParams>& learningSection()
         writer.write("warp", agent.warp);
     };
     s.keys.push_back(warp);
+    ConfigKey<A> mirror = plainKey<A>(
+        "mirror", "bool: a state with theta < 0 seen as its mirror image, its actions reversed", field(&A::mirror));
+    mirror.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.mirror)
+        writer.write("mirror", agent.mirror);
+    };
+    s.keys.push_back(mirror);
     s.keys.push_back(second_tiles);
+    s.keys.push_back(energy_tiles);
+    s.keys.push_back(pole_frequency);
     s.keys.push_back(lambda);
     s.keys.push_back(initial);
     s.keys.push_back(decision);

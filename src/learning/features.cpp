@@ -1,5 +1,6 @@
 #include "cartpole_qlearning/learning/features.h"
 
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -36,6 +37,17 @@ TileCoderParams FeatureParams::secondTileCoder() const
   return coder;
 }
 
+TileCoderParams FeatureParams::energyTileCoder() const
+{
+  TileCoderParams coder = tileCoder();
+  coder.tiles = energy_tiles;
+  coder.lower[2] = -2.0;
+  coder.upper[2] = 2.0;
+  coder.lower[3] = -discretiser.upper[3];
+  coder.upper[3] = discretiser.upper[3];
+  return coder;
+}
+
 std::string FeatureParams::validate() const
 {
   for (std::size_t d = 0; d < kStateDimensions; ++d)
@@ -49,27 +61,59 @@ std::string FeatureParams::validate() const
     if (!out.str().empty())
       return out.str();
   }
+  if (mirror && previous_action)
+    return "mirror is not allowed with previous_action (the previous action's rows would need mirroring too)";
   if (kind != FeatureKind::Tiles)
   {
     if (hasSecondTiles())
       return "second_tiles is not allowed with features bins (it is a second tile coding)";
+    if (hasEnergyTiles())
+      return "energy_tiles is not allowed with features bins (it is a tile coding)";
     return discretiser.validate();
   }
   std::string error = tileCoder().validate();
-  if (!error.empty() || !hasSecondTiles())
+  if (!error.empty() || (!hasSecondTiles() && !hasEnergyTiles()))
     return error;
-  if (2 * tilings > kMaxTilings)
-    return "second_tiles with tilings = " + std::to_string(tilings) + " is not allowed (a state then activates " +
-           std::to_string(2 * tilings) + " rows; tilings must be at most " + std::to_string(kMaxTilings / 2) + ")";
-  error = secondTileCoder().validate();
-  return error.empty() ? "" : "second_tiles: " + error;
+  const unsigned active = activeRowCount();
+  if (active > kMaxTilings)
+    return std::string(hasSecondTiles() ? "second_tiles" : "energy_tiles") +
+           " with tilings = " + std::to_string(tilings) + " is not allowed (a state then activates " +
+           std::to_string(active) + " rows; tilings must be at most " + std::to_string(kMaxTilings / codings()) + ")";
+  if (hasSecondTiles())
+  {
+    error = secondTileCoder().validate();
+    if (!error.empty())
+      return "second_tiles: " + error;
+  }
+  if (!hasEnergyTiles())
+    return "";
+  if (!(std::isfinite(pole_frequency) && pole_frequency > 0.0))
+  {
+    std::ostringstream out;
+    out << "pole_frequency = " << pole_frequency << " is not allowed (must be finite and > 0)";
+    return out.str();
+  }
+  if (!(discretiser.upper[3] > 0.0))
+  {
+    std::ostringstream out;
+    out << "energy_tiles is not allowed with upper_bounds[3] = " << discretiser.upper[3]
+        << " (theta_dot * cos(theta) is tiled over +-upper_bounds[3]: it must be > 0)";
+    return out.str();
+  }
+  error = energyTileCoder().validate();
+  return error.empty() ? "" : "energy_tiles: " + error;
 }
 
 std::size_t FeatureParams::stateRowCount() const
 {
-  if (kind == FeatureKind::Tiles && hasSecondTiles())
-    return TileCoder(tileCoder()).tileCount() + TileCoder(secondTileCoder()).tileCount();
-  return kind == FeatureKind::Tiles ? TileCoder(tileCoder()).tileCount() : Discretiser(discretiser).stateCount();
+  if (kind != FeatureKind::Tiles)
+    return Discretiser(discretiser).stateCount();
+  std::size_t rows = TileCoder(tileCoder()).tileCount();
+  if (hasSecondTiles())
+    rows += TileCoder(secondTileCoder()).tileCount();
+  if (hasEnergyTiles())
+    rows += TileCoder(energyTileCoder()).tileCount();
+  return rows;
 }
 
 std::size_t FeatureParams::rowCount(std::size_t actions) const
@@ -123,7 +167,13 @@ std::string FeatureParams::mismatch(const FeatureParams& other) const
     return "tiles " + fullPrecisionList(other.tiles) + " differ from " + fullPrecisionList(tiles);
   if (second_tiles != other.second_tiles)
     return "second_tiles " + fullPrecisionList(other.second_tiles) + " differ from " + fullPrecisionList(second_tiles);
-  if (!(tileCoder() == other.tileCoder()) || (hasSecondTiles() && !(secondTileCoder() == other.secondTileCoder())))
+  if (energy_tiles != other.energy_tiles)
+    return "energy_tiles " + fullPrecisionList(other.energy_tiles) + " differ from " + fullPrecisionList(energy_tiles);
+  if (hasEnergyTiles() && pole_frequency != other.pole_frequency)
+    return "pole_frequency " + fullPrecisionList(std::array<double, 1>{{other.pole_frequency}}) + " differs from " +
+           fullPrecisionList(std::array<double, 1>{{pole_frequency}});
+  if (!(tileCoder() == other.tileCoder()) || (hasSecondTiles() && !(secondTileCoder() == other.secondTileCoder())) ||
+      (hasEnergyTiles() && !(energyTileCoder() == other.energyTileCoder())))
     return "tile bounds " + boundsText(other.discretiser) + " differ from " + boundsText(discretiser);
   return "";
 }
@@ -153,6 +203,12 @@ FeatureMap::FeatureMap(const FeatureParams& params, std::size_t actions)
     {
       second_coder_.emplace(params_.secondTileCoder());
       state_rows_ += second_coder_->tileCount();
+    }
+    if (params_.hasEnergyTiles())
+    {
+      energy_coder_.emplace(params_.energyTileCoder());
+      energy_first_row_ = state_rows_;
+      state_rows_ += energy_coder_->tileCount();
     }
   }
   row_count_ = state_rows_ * params_.blocks(actions);

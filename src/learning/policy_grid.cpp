@@ -1,6 +1,7 @@
 #include "cartpole_qlearning/learning/policy_grid.h"
 
 #include "cartpole_qlearning/learning/q_learning_agent.h"
+#include "cartpole_qlearning/learning/table_config.h"
 
 #include <cmath>
 #include <cstdio>
@@ -68,8 +69,18 @@ PolicyGrid policyGrid(const QTable& table, const PolicyGridParams& params)
   agent_params.tilings = features.tilings;
   agent_params.tiles = features.tiles;
   agent_params.second_tiles = features.second_tiles;
+  agent_params.energy_tiles = features.energy_tiles;
+  agent_params.pole_frequency = features.pole_frequency;
   agent_params.previous_action = features.previous_action;
   agent_params.actions = table.actions();
+  // What maps states onto rows beyond the file's header (warp, mirror) is in the configuration the
+  // table carries (the defaults when it carries none).
+  if (!table.trained_with.empty())
+  {
+    const AgentParams carried = tableConfig(table, "").config.agent;
+    agent_params.warp = carried.warp;
+    agent_params.mirror = carried.mirror;
+  }
   QLearningAgent agent(agent_params, 0);
   const std::string mismatch = agent.replaceTable(table);
   if (!mismatch.empty())  // cannot happen: the agent was made from the table's own shape
@@ -126,6 +137,9 @@ std::string policyGridCsv(const PolicyGrid& grid, const QTable& table)
     if (features.hasSecondTiles())
       out << ", and " << features.tilings << " of " << features.second_tiles[0] << "x" << features.second_tiles[1]
           << "x" << features.second_tiles[2] << "x" << features.second_tiles[3];
+    if (features.hasEnergyTiles())
+      out << ", and " << features.tilings << " of " << features.energy_tiles[0] << "x" << features.energy_tiles[1]
+          << "x" << features.energy_tiles[2] << "x" << features.energy_tiles[3] << " over the swing";
     out << ")";
   }
   else

@@ -77,8 +77,11 @@ FeatureParams AgentParams::featureParams() const
   params.tilings = tilings;
   params.tiles = tiles;
   params.second_tiles = second_tiles;
+  params.energy_tiles = energy_tiles;
+  params.pole_frequency = pole_frequency;
   params.previous_action = previous_action;
   params.warp = warp;
+  params.mirror = mirror;
   return params;
 }
 
@@ -102,6 +105,14 @@ std::string AgentParams::validate() const
     if (!std::isfinite(actions[i]))
     {
       out << "actions[" << i << "] = " << actions[i] << " is not allowed (must be finite)";
+      return out.str();
+    }
+    if (mirror && actions[i] != -actions[actions.size() - 1 - i])
+    {
+      out << "mirror with actions[" << i << "] = " << actions[i] << " and actions[" << actions.size() - 1 - i
+          << "] = " << actions[actions.size() - 1 - i]
+          << " is not allowed (a mirrored state's actions are its own in reverse: they must be symmetric, "
+             "actions[i] = -actions[n - 1 - i])";
       return out.str();
     }
   }
@@ -187,6 +198,7 @@ QLearningAgent::QLearningAgent(const AgentParams& params, std::uint64_t seed)
 
 double QLearningAgent::value(const ActiveRows& state, std::size_t action) const
 {
+  action = state.column(action, table_.actionCount());
   double q = table_.at(state.rows[0], action);
   for (unsigned i = 1; i < state.count; ++i)
     q += table_.at(state.rows[i], action);
@@ -268,7 +280,7 @@ QUpdate QLearningAgent::update(const ActiveRows& state, std::size_t action, doub
   if (traces != nullptr && params_.lambda > 0.0)
   {
     done.old_value = value(state, action);
-    traces->visit(state, action, table_.actionCount(), table_.values().size());
+    traces->visit(state, state.column(action, table_.actionCount()), table_.actionCount(), table_.values().size());
     const double step = alpha / state.count * (done.target - done.old_value);
     const std::vector<std::uint32_t>& indices = traces->indices();
     const std::vector<double>& weights = traces->traces();
@@ -284,7 +296,7 @@ QUpdate QLearningAgent::update(const ActiveRows& state, std::size_t action, doub
   if (state.count == 1)
   {
     // Bins: one row, the arithmetic in the order it always had (a seed's table stays the same).
-    double& q = table_.at(state.rows[0], action);
+    double& q = table_.at(state.rows[0], state.column(action, table_.actionCount()));
     done.old_value = q;
     q += alpha * (done.target - q);
     done.new_value = q;
@@ -292,8 +304,9 @@ QUpdate QLearningAgent::update(const ActiveRows& state, std::size_t action, doub
   }
   done.old_value = value(state, action);
   const double step = alpha / state.count * (done.target - done.old_value);
+  const std::size_t column = state.column(action, table_.actionCount());
   for (unsigned i = 0; i < state.count; ++i)
-    table_.at(state.rows[i], action) += step;
+    table_.at(state.rows[i], column) += step;
   done.new_value = value(state, action);
   return done;
 }

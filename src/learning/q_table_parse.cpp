@@ -235,6 +235,11 @@ FeatureParams readFeatures(const YAML::Node& root, bool version1)
     // Absent in older files and in tables of one tile coding.
     if (root["second_tiles"])
       features.second_tiles = readCounts(root, "second_tiles");
+    if (root["energy_tiles"])
+    {
+      features.energy_tiles = readCounts(root, "energy_tiles");
+      features.pole_frequency = readNumber(required(root, "pole_frequency"), "pole_frequency");
+    }
   }
   else
   {

@@ -75,6 +75,13 @@ std::string checksumOf(const QTable& table)
     for (const unsigned t : f.second_tiles)
       sum.add(static_cast<std::uint64_t>(t));
   }
+  if (tiles && f.hasEnergyTiles())
+  {
+    sum.add(std::uint64_t{4});
+    for (const unsigned t : f.energy_tiles)
+      sum.add(static_cast<std::uint64_t>(t));
+    sum.add(f.pole_frequency);
+  }
   // Version 3's keys, summed only when present: a table without them keeps its checksum.
   if (table.tau > 0.0)
   {
@@ -198,6 +205,12 @@ std::string formatQTable(const QTable& table)
     out << "# A second tile coding, as many tilings again over the same bounds with these tiles; its rows\n"
         << "# follow the first's, and Q(s, a) sums the active tile of every tiling of both.\n"
         << "second_tiles: " << flowList(f.second_tiles) << "\n";
+  if (tiles && f.hasEnergyTiles())
+    out << "# A tile coding over the swing, as many tilings again over (x, x_dot, the pole's energy relative\n"
+        << "# to upright's per m g l: cos(theta) - 1 + (theta_dot / pole_frequency)^2 / 2, in [-2, 2],\n"
+        << "# theta_dot * cos(theta) within +-upper_bounds[3]) with these tiles; its rows follow the others'.\n"
+        << "energy_tiles: " << flowList(f.energy_tiles) << "\n"
+        << "pole_frequency: " << exact(f.pole_frequency) << "\n";
   if (!tiles)
     out << "# Features: uniform bins per state dimension; values outside the bounds go to the end bins.\n"
         << "features: bins\n"

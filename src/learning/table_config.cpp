@@ -53,6 +53,8 @@ TableConfig tableConfig(const QTable& table, const std::string& table_path)
   agent.tilings = features.tilings;
   agent.tiles = features.tiles;
   agent.second_tiles = features.second_tiles;
+  agent.energy_tiles = features.energy_tiles;
+  agent.pole_frequency = features.pole_frequency;
   agent.previous_action = features.previous_action;
   agent.actions = table.actions();
   if (table.tau > 0.0)
@@ -82,6 +84,10 @@ std::string tableContradiction(const TrainingConfig& config, const std::string& 
       differ("learning/tiles", listText(wanted.tiles), listText(has.tiles));
       if (wanted.hasSecondTiles() || has.hasSecondTiles())
         differ("learning/second_tiles", listText(wanted.second_tiles), listText(has.second_tiles));
+      if (wanted.hasEnergyTiles() || has.hasEnergyTiles())
+        differ("learning/energy_tiles", listText(wanted.energy_tiles), listText(has.energy_tiles));
+      if (wanted.hasEnergyTiles() && has.hasEnergyTiles())
+        differ("learning/pole_frequency", exactText(wanted.pole_frequency), exactText(has.pole_frequency));
     }
     // Tiles use the bounds of the dimensions they split only: what tiles them alike counts.
     const bool same_bounds =

@@ -45,22 +45,56 @@ struct FeatureParams
   // default); a warped dimension needs bounds symmetric about 0. Carried by the configuration a
   // table was trained with (its trained_with), not by the table's file.
   std::array<double, kStateDimensions> warp{{1.0, 1.0, 1.0, 1.0}};
+  // The cart-pole's mirror symmetry: a state with theta < 0 (wrapped) is seen as its mirror image
+  // (x, x_dot, theta, theta_dot all negated) and its actions' columns in reverse order (the learner's
+  // actions must then be symmetric, actions[i] = -actions[n - 1 - i]), so that what is learnt on one
+  // side of upright holds on the other: half the states, each visited twice as often. Carried, like
+  // warp, by the configuration a table was trained with. Not with previous_action.
+  bool mirror = false;
   // A second tile coding beside the first, summed into the same Q: as many tilings again over the
   // same (warped) bounds, with these tiles per dimension (1 ignores a dimension). A group over theta
   // and theta_dot alone, finer than the first, resolves the pole near upright without multiplying
   // its tiles by the cart's; the first then needs only as fine a grid as the cart's part of the
   // task. All 0 (the default): none. Tiles only.
   std::array<unsigned, kStateDimensions> second_tiles{{0, 0, 0, 0}};
+  // A third tile coding, as many tilings again, over what a swing is made of rather than where the
+  // pole is: (x, x_dot, the pole's energy, theta_dot * cos(theta)) with these tiles per dimension
+  // (1 ignores one). The energy is relative to upright's, per m g l: cos(theta) - 1 + (theta_dot /
+  // pole_frequency)^2 / 2, 0 for a swing that just reaches the top, -2 hanging at rest, tiled over
+  // [-2, 2]; theta_dot * cos(theta) is positive where a push towards -x adds energy, tiled over
+  // +-theta_dot's upper bound; x and x_dot over their bounds, none warped. What pumps the pole is
+  // then learnt once for every angle of the swing. All 0 (the default): none. Tiles only.
+  std::array<unsigned, kStateDimensions> energy_tiles{{0, 0, 0, 0}};
+  // [rad/s] sqrt(m g l / I) of the pole about its hinge (l: the hinge to the centre of mass, I the
+  // moment of inertia): a uniform pole of half-length 0.5 m under 9.81 m/s^2, sqrt(3 g / (4 l)).
+  double pole_frequency = 3.8340579025361627;
 
   bool hasSecondTiles() const
   {
     return second_tiles != std::array<unsigned, kStateDimensions>{{0, 0, 0, 0}};
   }
+  bool hasEnergyTiles() const
+  {
+    return energy_tiles != std::array<unsigned, kStateDimensions>{{0, 0, 0, 0}};
+  }
   TileCoderParams secondTileCoder() const;
+  TileCoderParams energyTileCoder() const;
+  // The tile codings in use (1 for bins).
+  unsigned codings() const
+  {
+    return kind == FeatureKind::Tiles ? 1 + (hasSecondTiles() ? 1 : 0) + (hasEnergyTiles() ? 1 : 0) : 1;
+  }
   // The rows a state activates: 1 for bins, a row per tiling of each tile coding for tiles.
   unsigned activeRowCount() const
   {
-    return kind == FeatureKind::Tiles ? tilings * (hasSecondTiles() ? 2 : 1) : 1;
+    return kind == FeatureKind::Tiles ? tilings * codings() : 1;
+  }
+  // What energy_tiles codes of a state (theta wrapped or not): x, x_dot, the energy, theta_dot * cos(theta).
+  CartPoleState swingState(const CartPoleState& state) const
+  {
+    const double cos_theta = std::cos(state[2]);
+    const double speed = state[3] / pole_frequency;
+    return CartPoleState(state[0], state[1], cos_theta - 1.0 + 0.5 * speed * speed, state[3] * cos_theta);
   }
 
   bool warped() const
@@ -91,6 +125,15 @@ struct ActiveRows
 {
   std::array<std::uint32_t, kMaxTilings> rows{};
   unsigned count = 0;
+  // FeatureParams::mirror: the state was seen as its mirror image, so action a's values are in
+  // column actions - 1 - a.
+  bool mirrored = false;
+
+  // The table's column of an action of this state's (and the action of a column: its own inverse).
+  std::size_t column(std::size_t action, std::size_t actions) const
+  {
+    return mirrored ? actions - 1 - action : action;
+  }
 
   // One row: a discretised state.
   static ActiveRows single(std::size_t row)
@@ -130,17 +173,25 @@ public:
   // are, so that CartPole-v1's tables stay as they were.
   void activeRows(const CartPoleState& state, ActiveRows& active, std::size_t previous = 0) const
   {
-    if (std::fabs(state[2]) > M_PI || warped_)
+    active.mirrored = false;
+    if (std::fabs(state[2]) > M_PI || warped_ || energy_coder_ || params_.mirror)
     {
       CartPoleState seen = state;
       if (std::fabs(state[2]) > M_PI)
         seen[2] = std::remainder(state[2], 2.0 * M_PI);
+      if (params_.mirror && seen[2] < 0.0)
+      {
+        for (std::size_t d = 0; d < kStateDimensions; ++d)
+          seen[d] = -seen[d];
+        active.mirrored = true;
+      }
+      const CartPoleState swing = energy_coder_ ? params_.swingState(seen) : seen;
       if (warped_)
         warp(seen);
-      codedRows(seen, active, previous);
+      codedRows(seen, active, previous, energy_coder_ ? &swing : nullptr);
       return;
     }
-    codedRows(state, active, previous);
+    codedRows(state, active, previous, nullptr);
   }
 
 private:
@@ -156,7 +207,8 @@ private:
       state[d] = std::copysign(bound * std::pow(ratio, 1.0 / params_.warp[d]), state[d]);
     }
   }
-  void codedRows(const CartPoleState& state, ActiveRows& active, std::size_t previous) const
+  // swing: what the energy coding codes (FeatureParams::swingState), or null without one.
+  void codedRows(const CartPoleState& state, ActiveRows& active, std::size_t previous, const CartPoleState* swing) const
   {
     const auto offset = static_cast<std::uint32_t>(params_.previous_action ? previous * state_rows_ : 0);
     if (!tile_coder_)
@@ -174,7 +226,16 @@ private:
       const auto first_rows = static_cast<std::uint32_t>(tile_coder_->tileCount());
       for (unsigned i = active.count; i < 2 * active.count; ++i)
         active.rows[i] += first_rows;
-      active.count *= 2;
+      active.count += tile_coder_->tilings();
+    }
+    if (swing)
+    {
+      // The energy coding's rows follow the others'.
+      energy_coder_->activeTiles(*swing, active.rows.data() + active.count);
+      const auto before = static_cast<std::uint32_t>(energy_first_row_);
+      for (unsigned i = active.count; i < active.count + tile_coder_->tilings(); ++i)
+        active.rows[i] += before;
+      active.count += tile_coder_->tilings();
     }
     for (unsigned i = 0; offset != 0 && i < active.count; ++i)
       active.rows[i] += offset;
@@ -184,6 +245,8 @@ private:
   Discretiser discretiser_;
   std::optional<TileCoder> tile_coder_;
   std::optional<TileCoder> second_coder_;  // FeatureParams::second_tiles
+  std::optional<TileCoder> energy_coder_;  // FeatureParams::energy_tiles
+  std::size_t energy_first_row_ = 0;       // the first row of the energy coding's
   std::size_t state_rows_;
   std::size_t row_count_;
   bool warped_ = false;

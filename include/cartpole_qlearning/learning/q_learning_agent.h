@@ -33,8 +33,11 @@ struct AgentParams
   unsigned tilings = 8;
   std::array<unsigned, kStateDimensions> tiles{{1, 1, 6, 12}};
   std::array<unsigned, kStateDimensions> second_tiles{{0, 0, 0, 0}};  // FeatureParams::second_tiles
+  std::array<unsigned, kStateDimensions> energy_tiles{{0, 0, 0, 0}};  // FeatureParams::energy_tiles
+  double pole_frequency = FeatureParams().pole_frequency;             // [rad/s] FeatureParams::pole_frequency
   bool previous_action = false;  // the action taken last is part of what the learner sees
   std::array<double, kStateDimensions> warp{{1.0, 1.0, 1.0, 1.0}};  // FeatureParams::warp
+  bool mirror = false;                                              // FeatureParams::mirror
   std::vector<double> actions{-10.0, 10.0};                         // [N] the effort of each action
   double gamma = 0.99;                                              // discount per decision, in [0, 1]
   // Watkins's Q(lambda) (eligibility_traces.h): in [0, 1]; 0 is one-step Q-learning, no traces.
@@ -147,7 +150,8 @@ public:
   // agent, runs (greedy_episodes.cpp).
   static std::size_t greedyAction(const QTable& table, const ActiveRows& state)
   {
-    return state.count == 1 ? table.argmax(state.rows[0]) : bestAction(table, state, nullptr);
+    const std::size_t best = state.count == 1 ? table.argmax(state.rows[0]) : bestAction(table, state, nullptr);
+    return state.column(best, table.actionCount());
   }
   // The same for a bins state given as its row.
   std::size_t selectAction(std::size_t state, double epsilon)

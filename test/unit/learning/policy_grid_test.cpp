@@ -3,6 +3,7 @@
 #include "cartpole_qlearning/learning/policy_grid.h"
 #include "cartpole_qlearning/learning/q_learning_agent.h"
 #include "cartpole_qlearning/learning/q_table_file.h"
+#include "cartpole_qlearning/learning/training_config.h"
 
 #include <gtest/gtest.h>
 
@@ -139,4 +140,30 @@ TEST(PolicyGridTest, TheCsvSaysWhatItIsThenOneRowPerPoint)
   EXPECT_EQ("# slice: x=0 x_dot=0", lines[4]);
   EXPECT_EQ("theta,theta_dot,action,effort,value,tie", lines[6]);
   EXPECT_EQ("0,0,0,-10,0,1", lines[11]) << "the middle point";
+}
+
+// A table's warp and mirror are in the configuration it carries, not in its header: the grid is
+// what the agent that trained it chooses, on both sides of upright.
+TEST(PolicyGridTest, AWarpedMirroredTableIsPlottedAsItsConfigurationSeesIt)
+{
+  TrainingConfig config;
+  config.agent = tiles();
+  config.agent.actions = {-10.0, 0.0, 10.0};
+  config.agent.warp = {{1.0, 1.0, 2.0, 2.0}};
+  config.agent.mirror = true;
+  QLearningAgent agent = trainedLike(config.agent);
+  agent.table().trained_with = trainingConfigText(config);
+  PolicyGridParams grid_params;
+  grid_params.points = 15;
+  const PolicyGrid grid = policyGrid(agent.table(), grid_params);
+  std::size_t mirrored = 0;
+  for (const PolicyPoint& point : grid.points)
+  {
+    ActiveRows active;
+    agent.activeRows(CartPoleState(0.0, 0.0, point.x, point.y), active);
+    mirrored += active.mirrored ? 1 : 0;
+    ASSERT_EQ(agent.greedyAction(active), point.action) << point.x << " " << point.y;
+    ASSERT_EQ(agent.value(active, point.action), point.value);
+  }
+  EXPECT_GT(mirrored, 0u);
 }

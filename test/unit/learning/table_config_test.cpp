@@ -197,3 +197,29 @@ TEST(TableConfig, AContradictionNamesTheConfigsValueAndTheTablesWithBothSources)
   gamma.task.max_episode_steps = 3000;
   EXPECT_EQ("", tableContradiction(gamma, "my.yaml", table, "/t/q.yaml"));
 }
+
+TEST(TableConfig, ATableCarriesItsEnergyCodingAndMirrorAndAConfigWithoutThemIsNamed)
+{
+  const std::string path = scratchFile("energy_mirror_table.yaml");
+  const TrainingConfig trained = readText(
+      "{learning: {features: tiles, tiles: [1, 1, 4, 4], energy_tiles: [1, 1, 2, 2], pole_frequency: 3.5, "
+      "mirror: true, actions: [-10.0, 0.0, 10.0]}}");
+  const std::string text = trainingConfigText(trained);
+  EXPECT_NE(std::string::npos, text.find("energy_tiles: [1, 1, 2, 2]")) << text;
+  EXPECT_NE(std::string::npos, text.find("mirror: true")) << text;
+  saveQTableFile(stampedTable(trained), path);
+  const TableConfig own = tableConfig(loadQTableFile(path), path);
+  EXPECT_TRUE(own.config.agent.mirror);
+  EXPECT_EQ(trained.agent.energy_tiles, own.config.agent.energy_tiles);
+  EXPECT_EQ(3.5, own.config.agent.pole_frequency);
+  EXPECT_EQ("", tableContradiction(own.config, "its own", loadQTableFile(path), path));
+  const TrainingConfig without =
+      readText("{learning: {features: tiles, tiles: [1, 1, 4, 4], actions: [-10.0, 0.0, 10.0]}}");
+  EXPECT_NE(std::string::npos,
+            tableContradiction(without, "c.yaml", loadQTableFile(path), path).find("learning/energy_tiles"));
+  // Off (the defaults): not in the text, so that every other table is the file it was.
+  const std::string plain = trainingConfigText(without);
+  EXPECT_EQ(std::string::npos, plain.find("energy_tiles")) << plain;
+  EXPECT_EQ(std::string::npos, plain.find("pole_frequency")) << plain;
+  EXPECT_EQ(std::string::npos, plain.find("mirror")) << plain;
+}

@@ -363,3 +363,199 @@ TEST(SecondTileCoding, IsRefusedWithBinsAndWithMoreThanHalfTheTilings)
   many.tilings = kMaxTilings / 2;
   EXPECT_EQ("", many.validate());
 }
+
+namespace
+{
+// The two tilings above, the second coding, and an energy coding of two tiles of the energy and two
+// of theta_dot * cos(theta).
+FeatureParams withEnergyTiles()
+{
+  FeatureParams p = withSecondTiles();
+  p.energy_tiles = {{1, 1, 2, 2}};
+  return p;
+}
+}  // namespace
+
+TEST(EnergyTileCoding, CodesThePolesEnergyRelativeToUprightsAndThePumpingPhase)
+{
+  const FeatureParams params = withEnergyTiles();
+  // Upright at rest, and a swing through the bottom that just reaches the top: the same energy.
+  EXPECT_DOUBLE_EQ(0.0, params.swingState(CartPoleState(0.3, -0.2, 0.0, 0.0))[2]);
+  const double reaching = 2.0 * params.pole_frequency;  // (theta_dot / w)^2 / 2 = 2
+  EXPECT_NEAR(0.0, params.swingState(CartPoleState(0.0, 0.0, M_PI, reaching))[2], 1e-12);
+  EXPECT_NEAR(-2.0, params.swingState(CartPoleState(0.0, 0.0, -M_PI, 0.0))[2], 1e-12);
+  // The cart's part as it is, theta_dot * cos(theta) the phase: its sign flips past horizontal.
+  const CartPoleState below = params.swingState(CartPoleState(0.3, -0.2, 2.5, 1.0));
+  EXPECT_EQ(0.3, below[0]);
+  EXPECT_EQ(-0.2, below[1]);
+  EXPECT_DOUBLE_EQ(std::cos(2.5), below[3]);
+  EXPECT_GT(0.0, below[3]);
+  EXPECT_LT(0.0, params.swingState(CartPoleState(0.0, 0.0, 0.5, 1.0))[3]);
+  // A turn further on is the same pole.
+  EXPECT_NEAR(below[2], params.swingState(CartPoleState(0.3, -0.2, 2.5 + 2.0 * M_PI, 1.0))[2], 1e-12);
+  // Tiled over [-2, 2] and +-theta_dot's bound, x and x_dot over theirs.
+  const TileCoderParams coder = params.energyTileCoder();
+  EXPECT_EQ(-2.0, coder.lower[2]);
+  EXPECT_EQ(2.0, coder.upper[2]);
+  EXPECT_EQ(-1.0, coder.lower[3]);
+  EXPECT_EQ(1.0, coder.upper[3]);
+  EXPECT_EQ(params.discretiser.lower[0], coder.lower[0]);
+  EXPECT_EQ(params.discretiser.upper[1], coder.upper[1]);
+}
+
+TEST(EnergyTileCoding, ItsRowsFollowTheOthersAndStatesOfOneEnergyAndPhaseShareThem)
+{
+  const FeatureParams params = withEnergyTiles();
+  const FeatureMap map(params, 2);
+  const TileCoder energy(params.energyTileCoder());
+  EXPECT_EQ(18u, energy.tileCount());  // 2 tilings of 3 x 3 tiles
+  EXPECT_EQ(6u + 10u + 18u, map.rowCount());
+  EXPECT_EQ(6u, params.activeRowCount());
+  const CartPoleState state(0.0, 0.0, 2.0, 0.9);
+  ActiveRows rows;
+  map.activeRows(state, rows);
+  ASSERT_EQ(6u, rows.count);
+  const Tiles own = active(energy, params.swingState(state));
+  EXPECT_EQ((Tiles{own[0] + 16, own[1] + 16}), (Tiles{rows.rows[4], rows.rows[5]}));
+  // The same energy and phase at the mirror angle, swinging the other way: the same energy rows.
+  ActiveRows mirror;
+  map.activeRows(CartPoleState(0.0, 0.0, -2.0, 0.9), mirror);
+  EXPECT_EQ((Tiles{rows.rows[4], rows.rows[5]}), (Tiles{mirror.rows[4], mirror.rows[5]}));
+  // Without it, the first two codings' rows are what they were.
+  ActiveRows two;
+  FeatureMap(withSecondTiles(), 2).activeRows(state, two);
+  ASSERT_EQ(4u, two.count);
+  for (unsigned i = 0; i < 4; ++i)
+    EXPECT_EQ(two.rows[i], rows.rows[i]);
+}
+
+TEST(EnergyTileCoding, OptimismAndUpdatesSpreadOverAllThreeCodings)
+{
+  AgentParams p = twoTilings();
+  p.second_tiles = {{1, 1, 1, 4}};
+  p.energy_tiles = {{1, 1, 2, 2}};
+  p.initial_value = 6.0;
+  QLearningAgent agent(p, 0);
+  ActiveRows s;
+  agent.activeRows(CartPoleState(0.0, 0.0, 3.0, 0.25), s);
+  ASSERT_EQ(6u, s.count);
+  EXPECT_DOUBLE_EQ(6.0, agent.value(s, 0));  // each of 6 rows holds a sixth
+  agent.update(s, 0, 1.0, s, true, 0.5);     // terminal: target 1, Q moves halfway
+  EXPECT_DOUBLE_EQ(3.5, agent.value(s, 0));
+}
+
+TEST(EnergyTileCoding, ATableWithItRoundTripsThroughItsFileAndATableWithoutIsWrittenAsBefore)
+{
+  FeatureParams params = withEnergyTiles();
+  params.pole_frequency = 3.5;
+  QTable table(params, {-10.0, 10.0});
+  for (std::size_t row = 0; row < table.stateCount(); ++row)
+    table.at(row, row % 2) = 0.25 * static_cast<double>(row);
+  const std::string text = formatQTable(table);
+  EXPECT_NE(std::string::npos, text.find("energy_tiles: [1, 1, 2, 2]"));
+  EXPECT_NE(std::string::npos, text.find("pole_frequency: 3.5"));
+  const QTable read = parseQTable(text);
+  EXPECT_EQ("", table.features().mismatch(read.features()));
+  EXPECT_EQ(3.5, read.features().pole_frequency);
+  EXPECT_EQ(table.values(), read.values());
+
+  QTable two_codings(withSecondTiles(), {-10.0, 10.0});
+  EXPECT_EQ(std::string::npos, formatQTable(two_codings).find("energy_tiles"));
+  EXPECT_EQ(std::string::npos, formatQTable(two_codings).find("pole_frequency"));
+  EXPECT_NE("", two_codings.features().mismatch(table.features()));
+  FeatureParams other_frequency = params;
+  other_frequency.pole_frequency = 4.0;
+  EXPECT_NE(std::string::npos, params.mismatch(other_frequency).find("pole_frequency"))
+      << params.mismatch(other_frequency);
+}
+
+TEST(EnergyTileCoding, IsRefusedWithBinsWithTooManyTilingsAndWithABadFrequency)
+{
+  AgentParams bins;
+  bins.energy_tiles = {{1, 1, 2, 2}};
+  EXPECT_NE(std::string::npos, bins.validate().find("energy_tiles is not allowed with features bins"))
+      << bins.validate();
+  AgentParams many = twoTilings();
+  many.second_tiles = {{1, 1, 1, 4}};
+  many.energy_tiles = {{1, 1, 2, 2}};
+  many.tilings = kMaxTilings / 3 + 1;
+  EXPECT_NE(std::string::npos, many.validate().find("tilings must be at most 21")) << many.validate();
+  many.tilings = kMaxTilings / 3;
+  EXPECT_EQ("", many.validate());
+  many.pole_frequency = 0.0;
+  EXPECT_NE(std::string::npos, many.validate().find("pole_frequency = 0 is not allowed")) << many.validate();
+}
+
+namespace
+{
+// Two tilings over theta and theta_dot, three symmetric actions, the mirror on.
+AgentParams mirrored()
+{
+  AgentParams p = twoTilings();
+  p.tiles = {{1, 1, 2, 2}};
+  p.discretiser.lower[2] = -1.0;
+  p.discretiser.upper[2] = 1.0;
+  p.actions = {-10.0, 0.0, 10.0};
+  p.mirror = true;
+  return p;
+}
+}  // namespace
+
+TEST(Mirror, AStateWithThetaBelowZeroIsSeenAsItsMirrorImageWithItsActionsReversed)
+{
+  const FeatureMap map(mirrored().featureParams(), 3);
+  ActiveRows right;
+  ActiveRows left;
+  map.activeRows(CartPoleState(0.1, 0.2, 0.3, -0.4), right);
+  map.activeRows(CartPoleState(-0.1, -0.2, -0.3, 0.4), left);
+  EXPECT_FALSE(right.mirrored);
+  EXPECT_TRUE(left.mirrored);
+  ASSERT_EQ(right.count, left.count);
+  for (unsigned i = 0; i < right.count; ++i)
+    EXPECT_EQ(right.rows[i], left.rows[i]);
+  EXPECT_EQ(0u, left.column(2, 3));
+  EXPECT_EQ(1u, left.column(1, 3));
+  EXPECT_EQ(2u, right.column(2, 3));
+  // A turn further on is the same pole, the mirror decided on the wrapped angle.
+  ActiveRows turned;
+  map.activeRows(CartPoleState(-0.1, -0.2, -0.3 + 2.0 * M_PI, 0.4), turned);
+  EXPECT_TRUE(turned.mirrored);
+  // A row reused for an unmirrored state forgets it was mirrored.
+  map.activeRows(CartPoleState(0.1, 0.2, 0.3, -0.4), left);
+  EXPECT_FALSE(left.mirrored);
+}
+
+TEST(Mirror, WhatIsLearntOnOneSideIsTheMirroredActionsOnTheOther)
+{
+  QLearningAgent agent(mirrored(), 0);
+  ActiveRows right;
+  ActiveRows left;
+  agent.activeRows(CartPoleState(0.0, 0.0, 0.3, -0.4), right);
+  agent.activeRows(CartPoleState(0.0, 0.0, -0.3, 0.4), left);
+  agent.update(right, 2, 1.0, right, true, 0.5);  // pushing +x from the right: target 1, halfway
+  EXPECT_DOUBLE_EQ(0.5, agent.value(right, 2));
+  EXPECT_DOUBLE_EQ(0.5, agent.value(left, 0));  // pushing -x from the mirror image
+  EXPECT_DOUBLE_EQ(0.0, agent.value(left, 2));
+  EXPECT_EQ(2u, agent.greedyAction(right));
+  EXPECT_EQ(0u, agent.greedyAction(left));
+  // Through the traces too.
+  AgentParams traced = mirrored();
+  traced.lambda = 0.9;
+  QLearningAgent with_traces(traced, 0);
+  EligibilityTraces traces;
+  with_traces.update(left, 0, 1.0, left, true, 0.5, &traces);
+  EXPECT_DOUBLE_EQ(0.5, with_traces.value(right, 2));
+  EXPECT_EQ(0u, with_traces.greedyAction(left));
+}
+
+TEST(Mirror, NeedsSymmetricActionsAndNoPreviousAction)
+{
+  AgentParams p = mirrored();
+  EXPECT_EQ("", p.validate());
+  p.actions = {-10.0, 0.0, 4.0};
+  EXPECT_NE(std::string::npos, p.validate().find("must be symmetric")) << p.validate();
+  p.actions = {-10.0, 10.0};
+  EXPECT_EQ("", p.validate());
+  p.previous_action = true;
+  EXPECT_NE(std::string::npos, p.validate().find("mirror is not allowed with previous_action")) << p.validate();
+}
