@@ -7,7 +7,8 @@
 #
 # One fresh root per release, where the two commands run one after the other, as a user types them.
 # usage (as root, from a clone with the change committed: the roots get `git archive HEAD`):
-#   bash tools/check_releases.sh [RELEASE...]          default: bullseye trixie
+#   bash tools/check_releases.sh [RELEASE...]          default: bullseye trixie (bookworm: a fresh
+#                                                      Debian 12 root, beside CI's own machine)
 #   CHECK=train|test|both (default both); LOGS=DIR (default a new folder under /tmp)
 #   FRESH_MACHINE=PATH: the fresh_machine.sh to use (default ../shared/tools/fresh_machine.sh
 #   beside the clone; without it the check is skipped with a note)
