@@ -17,6 +17,9 @@
 # of them is missing. About 10 min per train.sh and 25-45 per test.sh on 2 cores, one root at a
 # time (the first root of a release takes a few minutes more to make).
 set -uo pipefail
+# The whole script is one compound command, read before it runs: bash reads a script as it goes,
+# and an edit of this file during an hour-long run would otherwise change what the run does next.
+{
 SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 FRESH=${FRESH_MACHINE:-$SRC/../shared/tools/fresh_machine.sh}
 CHECK=${CHECK:-both}
@@ -29,7 +32,7 @@ if [ ! -f "$FRESH" ]; then
   exit 0
 fi
 [ "$(id -u)" -eq 0 ] || { echo "[releases] fresh_machine.sh needs root (debootstrap, chroot, mounts)" >&2; exit 2; }
-cd "$SRC"
+cd "$SRC" || exit 2
 if ! git diff --quiet HEAD 2>/dev/null; then
   echo "[releases] note: uncommitted changes are not checked (the roots get git archive HEAD: $(git rev-parse --short HEAD))"
 fi
@@ -86,3 +89,4 @@ done
 echo "[releases] summary (commit $commit):"
 printf '  %s\n' "${summary[@]}"
 exit "$status"
+}
