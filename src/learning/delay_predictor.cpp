@@ -124,12 +124,8 @@ CartPoleState DelayPredictor::fittedStep(const CartPoleState& state, double forc
   std::array<CartPoleState, 2> model{};
   model_.stepEach(state, forces.data(), forces.size(), model.data());
   CartPoleState next = model[1];
-  // How far a velocity's change shows in its position within the same step: not at all with
-  // Gymnasium's Euler (positions advance with the old velocity), wholly with the semi-implicit
-  // one, about half under RK4.
-  const Integrator integrator = model_.params().integrator;
-  const double carried =
-      integrator == Integrator::Euler ? 0.0 : (integrator == Integrator::SemiImplicitEuler ? 1.0 : 0.5);
+  // The fitted velocity's difference from the model's moves the position as the integrator would.
+  const double carried = model_.velocityChangeInPosition();
   for (std::size_t v = 0; v < 2; ++v)
   {
     const std::size_t d = 2 * v + 1;

@@ -80,6 +80,24 @@ public:
   // cart within the rail): DelayEstimator steps every delay it weighs from the same state.
   void stepEach(const CartPoleState& state, const double* forces, std::size_t n, CartPoleState* out) const;
 
+  // How much of a step's change of a velocity shows in the same step's change of its position, as
+  // a share of tau x that change: none under Gymnasium's Euler (positions advance with the old
+  // velocity), all of it under the semi-implicit one, about half under RK4. A model whose velocity
+  // change is corrected afterwards (DelayPredictor's fit) moves the position by this much of it.
+  double velocityChangeInPosition() const
+  {
+    switch (params_.integrator)
+    {
+      case Integrator::Euler:
+        return 0.0;
+      case Integrator::SemiImplicitEuler:
+        return 1.0;
+      case Integrator::Rk4:
+        break;
+    }
+    return 0.5;
+  }
+
   // The force clamped to +-force_mag.
   double clampForce(double force) const
   {

@@ -183,6 +183,28 @@ TEST(CartPoleDynamics, SteppingSeveralForcesAtOnceGivesEachStepsBits)
   }
 }
 
+TEST(CartPoleDynamics, AVelocityChangeShowsInThePositionByTheIntegratorsShare)
+{
+  // DelayPredictor corrects the model's velocity change and moves the position by this share of
+  // the correction: it must be what the integrator's own step does with a change of force.
+  for (Integrator integrator : {Integrator::Euler, Integrator::SemiImplicitEuler, Integrator::Rk4})
+  {
+    const CartPoleDynamics dynamics = dynamicsWith(integrator);
+    const CartPoleState state(0.3, -0.7, 0.05, 0.4);
+    const CartPoleState pushed = dynamics.step(state, 10.0);
+    const CartPoleState free = dynamics.step(state, 0.0);
+    for (int velocity : {1, 3})
+    {
+      const double change = pushed[velocity] - free[velocity];
+      ASSERT_GT(std::fabs(change), 1e-3);
+      const double share = (pushed[velocity - 1] - free[velocity - 1]) / (dynamics.params().tau * change);
+      // RK4's force acts over the whole step, so the position sees about half the velocity's change.
+      EXPECT_NEAR(dynamics.velocityChangeInPosition(), share, integrator == Integrator::Rk4 ? 0.02 : 1e-9)
+          << "integrator " << static_cast<int>(integrator) << ", velocity " << velocity;
+    }
+  }
+}
+
 TEST(CartPoleDynamics, ForceIsClampedToForceMag)
 {
   const CartPoleDynamics dynamics = dynamicsWith(Integrator::Euler);
