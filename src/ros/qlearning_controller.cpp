@@ -362,7 +362,14 @@ void QLearningControllerNode::startLiveTuning()
   // the parameter server, where a new run first puts the values in use: no client sees others.
   if (running)
     setLearningConfigParams(*running, pnh_);
-  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<LearningConfig>>(reconfigure_mutex_, pnh_);
+  // On the services' own queue, as save and load, not the node's: nodelet 1.10.0 (Debian 11)
+  // disables a nodelet's queues while its onInit runs and drops what arrives meanwhile
+  // (ros/nodelet_core#106, fixed in 1.10.1), so a set_parameters call made during a slow start
+  // was never answered and its client waited for ever (live_tuning_nodelet in a Debian 11 root
+  // at load 5-9: training had begun on the lockstep thread while the server was still starting).
+  ros::NodeHandle reconfigure_nh(pnh_);
+  reconfigure_nh.setCallbackQueue(&services_queue_);
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<LearningConfig>>(reconfigure_mutex_, reconfigure_nh);
   reconfigure_->setCallback([this](LearningConfig& config, std::uint32_t level) { onReconfigure(config, level); });
 }
 

@@ -17,7 +17,6 @@
 
 #include <csignal>
 #include <functional>
-#include <iostream>
 #include <string>
 #include <vector>
 
@@ -73,30 +72,6 @@ double serverParam(const std::string& name)
   ros::param::get(kController + "/" + name, value);
   return value;
 }
-
-// The client's set_parameters call, tried again when the call itself fails: on a loaded machine
-// (Debian 11's roscpp 1.15.9, two fresh roots testing at once, load 5-9) the first call of a run
-// once returned false. A client (dynparam, a GUI) tries again; each try sends the same values, so
-// a repeat changes nothing the test checks. The server's answer replaces `config`, as the
-// client's own call does.
-bool setConfiguration(dynamic_reconfigure::Client<LearningConfig>& client, LearningConfig& config)
-{
-  constexpr int kTries = 5;
-  for (int attempt = 1; attempt <= kTries; ++attempt)
-  {
-    LearningConfig answer = config;
-    if (client.setConfiguration(answer))
-    {
-      config = answer;
-      return true;
-    }
-    std::cerr << "set_parameters call " << attempt << " of " << kTries << " failed (the service "
-              << (ros::service::exists(kController + "/set_parameters", false) ? "is" : "is not")
-              << " advertised); trying again" << std::endl;
-    ros::Duration(1.0).sleep();
-  }
-  return false;
-}
 }  // namespace
 
 TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume)
@@ -136,7 +111,7 @@ TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume
   change.epsilon_override = 0.0;
   change.alpha_override = 0.2;
   change.gamma = 0.95;
-  ASSERT_TRUE(setConfiguration(client, change));
+  ASSERT_TRUE(client.setConfiguration(change));
   EXPECT_EQ(0.0, change.epsilon_override);  // the server's answer: what it now holds
   EXPECT_EQ(0.95, change.gamma);
   const std::size_t changed = firstStats(0, [](const EpisodeStats& s) { return s.gamma == 0.95; });
@@ -158,7 +133,7 @@ TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume
   bad.epsilon_start = 0.5;
   bad.epsilon_min = 0.9;
   bad.gamma = 0.9;
-  ASSERT_TRUE(setConfiguration(client, bad));
+  ASSERT_TRUE(client.setConfiguration(bad));
   EXPECT_EQ(1.0, bad.epsilon_start);
   EXPECT_EQ(0.02, bad.epsilon_min);
   EXPECT_EQ(0.95, bad.gamma);
@@ -184,7 +159,7 @@ TEST(LiveTuning, ChangesShowInEpisodeStatsBadOnesAreRefusedAndTheSchedulesResume
   back.epsilon_override = -1.0;
   back.alpha_override = -1.0;
   back.gamma = 0.96;
-  ASSERT_TRUE(setConfiguration(client, back));
+  ASSERT_TRUE(client.setConfiguration(back));
   EXPECT_EQ(-1.0, back.epsilon_override);
   const std::size_t resumed = firstStats(changed, [](const EpisodeStats& s) { return s.gamma == 0.96; });
   ASSERT_LT(resumed, stats.size()) << "no episode with gamma 0.96";
