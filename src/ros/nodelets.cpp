@@ -6,8 +6,9 @@
 // two callbacks in a row on that thread: a published message waits in the queue until the
 // callback that published it returns, and no thread is ever woken for it. Through the
 // manager's own queues each message would cross threads (its dispatcher, then a worker), which
-// costs about ten times more than the step itself (bench/run_benchmarks.sh). Timers and
-// services stay on the manager's threads; the node classes lock their state for that.
+// costs about ten times more than the step itself (bench/run_benchmarks.sh). Timers and the
+// sim's services stay on the manager's threads (the controller serves save, load and live tuning
+// on a thread of its own); the node classes lock their state for that.
 #include "cartpole_qlearning/ros/cartpole_sim.h"
 #include "cartpole_qlearning/ros/command_watchdog.h"
 #include "cartpole_qlearning/ros/qlearning_controller.h"
