@@ -245,6 +245,13 @@ const ConfigSection<AgentParams>& learningSection()
       if (agent.replay_updates != 0)
         writer.write("replay_capacity", agent.replay_capacity);
     };
+    ConfigKey<A> ensemble =
+        wholeKey<A>("ensemble", "int: tables learnt side by side, each from its own episodes, the table their mean",
+                    field(&A::ensemble), 1, kMaxEnsemble);
+    ensemble.write = [](SectionWriter& writer, const AgentParams& agent) {
+      if (agent.ensemble != 1)
+        writer.write("ensemble", agent.ensemble);
+    };
     ConfigKey<A> replay_alpha =
         plainKey<A>("replay_alpha", "double: a replayed update's learning rate, 0 for the episode's alpha",
                     field(&A::replay_alpha));
@@ -274,6 +281,7 @@ const ConfigSection<AgentParams>& learningSection()
     s.keys.push_back(replay_updates);
     s.keys.push_back(replay_capacity);
     s.keys.push_back(replay_alpha);
+    s.keys.push_back(ensemble);
     addSchedule(s.keys, "epsilon", &A::epsilon, "exploration rate");
     addSchedule(s.keys, "alpha", &A::alpha, "learning rate");
     ConfigKey<A> names = plainKey<A>("state_names", "list of strings: the table rows' names, then the fallen state's",

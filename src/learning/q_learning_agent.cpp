@@ -146,6 +146,11 @@ std::string AgentParams::validate() const
     out << "replay_alpha = " << replay_alpha << " is not allowed (must be in [0, 1])";
     return out.str();
   }
+  if (ensemble < 1 || ensemble > kMaxEnsemble)
+  {
+    out << "ensemble = " << ensemble << " is not allowed (must be in [1, " << kMaxEnsemble << "])";
+    return out.str();
+  }
   if (decision_steps < 1 || decision_steps > kMaxDecisionSteps)
   {
     out << "decision_steps = " << decision_steps << " is not allowed (must be in [1, " << kMaxDecisionSteps << "])";
@@ -194,15 +199,28 @@ QLearningAgent::QLearningAgent(const AgentParams& params, std::uint64_t seed)
       for (std::size_t a = 0; a < table_.actionCount(); ++a)
         table_.at(row, a) = weight;
   }
+  if (params_.ensemble > 1)
+    members_.assign(params_.ensemble, table_);
 }
 
-double QLearningAgent::value(const ActiveRows& state, std::size_t action) const
+double QLearningAgent::value(const QTable& table, const ActiveRows& state, std::size_t action)
 {
-  action = state.column(action, table_.actionCount());
-  double q = table_.at(state.rows[0], action);
+  action = state.column(action, table.actionCount());
+  double q = table.at(state.rows[0], action);
   for (unsigned i = 1; i < state.count; ++i)
-    q += table_.at(state.rows[i], action);
+    q += table.at(state.rows[i], action);
   return q;
+}
+
+void QLearningAgent::addToWeight(std::size_t row, std::size_t column, double delta)
+{
+  if (members_.empty())
+  {
+    table_.at(row, column) += delta;
+    return;
+  }
+  members_[learner_].at(row, column) += delta;
+  table_.at(row, column) += delta / static_cast<double>(members_.size());
 }
 
 std::size_t QLearningAgent::bestAction(const QTable& table, const ActiveRows& state, double* best_q)
@@ -248,12 +266,12 @@ std::size_t QLearningAgent::bestAction(const QTable& table, const ActiveRows& st
   return best;
 }
 
-double QLearningAgent::maxValue(const ActiveRows& state) const
+double QLearningAgent::maxValue(const QTable& table, const ActiveRows& state)
 {
   if (state.count == 1)
-    return table_.max(state.rows[0]);
+    return table.max(state.rows[0]);
   double best_q = 0.0;
-  bestAction(table_, state, &best_q);
+  bestAction(table, state, &best_q);
   return best_q;
 }
 
@@ -261,32 +279,36 @@ std::size_t QLearningAgent::selectAction(const ActiveRows& state, double epsilon
 {
   if (explored != nullptr)
     *explored = false;
+  const QTable& values = learner();
   if (rng_.uniform01() < epsilon)
   {
-    const auto action = static_cast<std::size_t>(rng_.uniformIndex(table_.actionCount()));
+    const auto action = static_cast<std::size_t>(rng_.uniformIndex(values.actionCount()));
     if (explored != nullptr)
-      *explored = action != greedyAction(state);
+      *explored = action != greedyAction(values, state);
     return action;
   }
-  return greedyAction(state);
+  return greedyAction(values, state);
 }
 
 QUpdate QLearningAgent::update(const ActiveRows& state, std::size_t action, double reward, const ActiveRows& next_state,
                                bool next_is_terminal, double alpha, EligibilityTraces* traces)
 {
+  // With an ensemble, each of its tables learns on its own values (the target too); the mean
+  // follows each change by its share.
+  QTable& table = learner();
   QUpdate done;
-  done.next_max = next_is_terminal ? 0.0 : maxValue(next_state);
+  done.next_max = next_is_terminal ? 0.0 : maxValue(table, next_state);
   done.target = next_is_terminal ? reward : reward + params_.gamma * done.next_max;
   if (traces != nullptr && params_.lambda > 0.0)
   {
-    done.old_value = value(state, action);
-    traces->visit(state, state.column(action, table_.actionCount()), table_.actionCount(), table_.values().size());
+    done.old_value = value(table, state, action);
+    traces->visit(state, state.column(action, table.actionCount()), table.actionCount(), table.values().size());
     const double step = alpha / state.count * (done.target - done.old_value);
     const std::vector<std::uint32_t>& indices = traces->indices();
     const std::vector<double>& weights = traces->traces();
     for (std::size_t i = 0; i < indices.size(); ++i)
-      table_.at(indices[i] / table_.actionCount(), indices[i] % table_.actionCount()) += step * weights[i];
-    done.new_value = value(state, action);
+      addToWeight(indices[i] / table.actionCount(), indices[i] % table.actionCount(), step * weights[i]);
+    done.new_value = value(table, state, action);
     if (next_is_terminal)
       traces->clear();
     else
@@ -296,18 +318,22 @@ QUpdate QLearningAgent::update(const ActiveRows& state, std::size_t action, doub
   if (state.count == 1)
   {
     // Bins: one row, the arithmetic in the order it always had (a seed's table stays the same).
-    double& q = table_.at(state.rows[0], state.column(action, table_.actionCount()));
+    const std::size_t column = state.column(action, table.actionCount());
+    double& q = table.at(state.rows[0], column);
     done.old_value = q;
-    q += alpha * (done.target - q);
+    if (members_.empty())
+      q += alpha * (done.target - q);
+    else
+      addToWeight(state.rows[0], column, alpha * (done.target - q));
     done.new_value = q;
     return done;
   }
-  done.old_value = value(state, action);
+  done.old_value = value(table, state, action);
   const double step = alpha / state.count * (done.target - done.old_value);
-  const std::size_t column = state.column(action, table_.actionCount());
+  const std::size_t column = state.column(action, table.actionCount());
   for (unsigned i = 0; i < state.count; ++i)
-    table_.at(state.rows[i], column) += step;
-  done.new_value = value(state, action);
+    addToWeight(state.rows[i], column, step);
+  done.new_value = value(table, state, action);
   return done;
 }
 
@@ -330,7 +356,11 @@ std::string QLearningAgent::replaceTable(QTable table)
 {
   const std::string mismatch = table_.shapeMismatch(table);
   if (mismatch.empty())
+  {
     table_ = std::move(table);
+    for (QTable& member : members_)
+      member = table_;
+  }
   return mismatch;
 }
 

@@ -99,6 +99,9 @@ double TrainingSession::beginEpisode(const CartPoleState& start_state, std::size
   e.held = 0;
   e.held_reward = 0.0;
   e.traces.clear();
+  // With an ensemble (AgentParams::ensemble), episode n of the session is table n mod ensemble's.
+  e.begun = begun_++;
+  agent_.learnWith(e.begun);
   if (!predictors_.empty())
     predictors_[robot].begin(start_state);
   agent_.activeRows(decidedFor(start_state, robot), e.rows[e.current]);
@@ -137,6 +140,7 @@ Decision TrainingSession::observe(const CartPoleState& state, std::size_t robot)
   // The action just taken: with previous_action, part of what the learner sees of this state.
   // (A predicting session does not learn: its rows are only what the next action is chosen on.)
   agent_.activeRows(decidedFor(state, robot), e.next(), e.action + 1);
+  agent_.learnWith(e.begun);  // robots' episodes interleave: this one's table learns and chooses
   if (learning_)
   {
     const QUpdate update = agent_.update(e.state(), e.action, reward, e.next(), decision.outcome.terminated, e.alpha,

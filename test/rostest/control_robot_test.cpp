@@ -58,9 +58,11 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
   ros::param::get("~predict_delay", predict_delay);
   int found_delay = 1;
   ros::param::get("~found_delay", found_delay);
-  const auto trained =
-      runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + CARTPOLE_CONFIG_DIR +
-                 "/robust.yaml --seed " + std::to_string(seed) + " --quiet --no-run-folder --save robust.yaml");
+  // The config that trains the table (robust.yaml, or robust_five_minutes.yaml: config:=).
+  std::string config = std::string(CARTPOLE_CONFIG_DIR) + "/robust.yaml";
+  ros::param::get("~config", config);
+  const auto trained = runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + config + " --seed " +
+                                  std::to_string(seed) + " --quiet --no-run-folder --save robust.yaml");
   ASSERT_EQ(0, trained.status) << trained.output;
 
   ros::NodeHandle nh;

@@ -19,6 +19,8 @@ namespace cartpole_qlearning
 {
 // The longest decision period a config may ask for: a second of the Suite's 0.01 s steps.
 constexpr unsigned kMaxDecisionSteps = 100;
+// The most tables an ensemble may learn side by side (AgentParams::ensemble).
+constexpr unsigned kMaxEnsemble = 16;
 // Experience replay's limits: a thousand replayed updates a decision, ten million transitions kept
 // (about 5 GB when a state activates 64 rows: the limit of a machine, not of a sensible config).
 constexpr unsigned kMaxReplayUpdates = 1000;
@@ -56,6 +58,13 @@ struct AgentParams
   unsigned replay_capacity = 100000;
   // The learning rate of a replayed update; 0: the episode's alpha (the schedule's).
   double replay_alpha = 0.0;
+  // Tables learnt side by side (1: one table, as always). Each learns from its own share of the
+  // episodes (episode n trains table n mod ensemble) and explores on its own values; the table
+  // the agent gives (table(): judged, saved, run greedily) is their mean, kept as they learn. Two
+  // tables trained apart err in different states, and their mean holds where either alone fails:
+  // robust.yaml's tables, two averaged, held five-minute all_at_once 96-100 of 100 where each
+  // alone held 86-98 (docs/notes/tuning.md, "Two tables averaged").
+  unsigned ensemble = 1;
   ScheduleParams epsilon = defaultEpsilon();  // exploration rate per episode
   ScheduleParams alpha = defaultAlpha();      // learning rate per episode
   // Names of the table's rows for the trace, then the name of the terminal state (which has no
@@ -109,6 +118,9 @@ public:
   {
     features_.activeRows(state, active, previous);
   }
+  // The table: with an ensemble, the mean of its tables. Its counters (episodes, steps) and
+  // stamps are the run's; its values must not be written here while an ensemble learns (the
+  // mean is kept from the tables' updates: replaceTable() sets them all).
   const QTable& table() const
   {
     return table_;
@@ -116,6 +128,17 @@ public:
   QTable& table()
   {
     return table_;
+  }
+  // The tables an ensemble learns (ensemble > 1; empty otherwise), their mean table().
+  const std::vector<QTable>& ensembleTables() const
+  {
+    return members_;
+  }
+  // Which of the ensemble's tables explores and learns from now on (taken mod ensemble; the one
+  // table without an ensemble). TrainingSession gives each episode's number.
+  void learnWith(std::uint64_t episode)
+  {
+    learner_ = members_.empty() ? 0 : static_cast<std::size_t>(episode % members_.size());
   }
 
   double epsilon(unsigned long episode) const
@@ -133,10 +156,15 @@ public:
   // from the start.
   std::string setLearning(double gamma, const ScheduleParams& epsilon, const ScheduleParams& alpha);
 
-  // Q(s, a): the sum of the active rows' weights for the action.
-  double value(const ActiveRows& state, std::size_t action) const;
+  // Q(s, a): the sum of the active rows' weights for the action, in table() (the mean of an
+  // ensemble's tables).
+  double value(const ActiveRows& state, std::size_t action) const
+  {
+    return value(table_, state, action);
+  }
 
-  // With probability epsilon a uniformly drawn action, else the greedy one. Always takes one
+  // With probability epsilon a uniformly drawn action, else the greedy one (with an ensemble, on
+  // the values of the table learnWith() chose: each explores on its own). Always takes one
   // draw for the coin and, when exploring, one for the action.
   // explored, when given: whether the action taken is not the greedy one (what ends Watkins's
   // traces); a draw that lands on the greedy action is greedy.
@@ -182,19 +210,30 @@ public:
   }
 
   // Replaces the table after checking it has this agent's features and actions; on a
-  // mismatch returns what differs and leaves the table in use as it was.
+  // mismatch returns what differs and leaves the table in use as it was. An ensemble's tables
+  // all start again from it (a table file holds the mean only).
   std::string replaceTable(QTable table);
 
 private:
   // Over several rows: the greedy action, and its Q in best_q when given.
   static std::size_t bestAction(const QTable& table, const ActiveRows& state, double* best_q);
-  double maxValue(const ActiveRows& state) const;
+  static double value(const QTable& table, const ActiveRows& state, std::size_t action);
+  static double maxValue(const QTable& table, const ActiveRows& state);
+  // The table that explores and learns: the ensemble's table learnWith() chose, else table_.
+  QTable& learner()
+  {
+    return members_.empty() ? table_ : members_[learner_];
+  }
+  // Adds `delta` to a weight of the learning table and its share to the mean (an ensemble's).
+  void addToWeight(std::size_t row, std::size_t column, double delta);
 
   AgentParams params_;
   FeatureMap features_;
   Schedule epsilon_;
   Schedule alpha_;
   QTable table_;
+  std::vector<QTable> members_;  // an ensemble's tables (ensemble > 1), table_ their mean
+  std::size_t learner_ = 0;
   RandomStream rng_;
 };
 

@@ -158,6 +158,11 @@ public:
   {
     return agent_.table();
   }
+  // An ensemble's tables (AgentParams::ensemble > 1; empty otherwise): table() is their mean.
+  const std::vector<QTable>& ensembleTables() const
+  {
+    return agent_.ensembleTables();
+  }
   // What a table this session trains says of how to run it (q_table.h): the step it learns and
   // the configuration (training_config.h's trainingConfigText). Put on the table in use now and,
   // while learning, on every table installed later (a table trained further is this
@@ -218,6 +223,7 @@ private:
     }
     bool running = false;
     std::uint64_t number = 0;  // as the trace numbers it (TraceStep::episode)
+    std::uint64_t begun = 0;   // the session's count of episodes begun before it (an ensemble's turn)
     std::array<ActiveRows, 2> rows{};
     unsigned current = 0;
     std::size_t action = 0;
@@ -257,6 +263,7 @@ private:
   // checkpoint: a resumed run starts it empty.
   std::optional<ExperienceReplay> replay_;
   std::vector<DelayPredictor> predictors_;  // one per robot; empty: decide for what is observed
+  std::uint64_t begun_ = 0;                 // episodes begun, every robot's
   double stamp_tau_ = 0.0;                  // stampTables' (0: none)
   std::string stamp_trained_with_;
   LearningSettings learning_settings_;

@@ -40,6 +40,29 @@ QTable trainedTable(std::uint64_t seed)
 }
 }  // namespace
 
+TEST(RobustnessSuite, TheStrictSuiteIsTheSuiteWithAllAtOnceHeldToEveryEpisode)
+{
+  // robust_five_minutes.yaml trains until it passes: the same robots, judged as harshly or more.
+  const TrainingConfig config;
+  const RobustnessSuite suite = loadRobustnessSuite(kSuite, config);
+  const RobustnessSuite strict =
+      loadRobustnessSuite(std::string(CARTPOLE_CONFIG_DIR) + "/robust_suite_strict.yaml", config);
+  EXPECT_EQ(suite.episodes, strict.episodes);
+  EXPECT_EQ(suite.seed, strict.seed);
+  EXPECT_EQ(suite.max_episode_steps, strict.max_episode_steps);
+  EXPECT_EQ(suite.start_state_bound, strict.start_state_bound);
+  ASSERT_EQ(suite.cases.size(), strict.cases.size());
+  for (std::size_t i = 0; i < suite.cases.size(); ++i)
+  {
+    const SuiteCase& a = suite.cases[i];
+    const SuiteCase& b = strict.cases[i];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.start_state_bound, b.start_state_bound) << a.name;
+    EXPECT_EQ(describePerturbations(a.perturbations, 0.02), describePerturbations(b.perturbations, 0.02)) << a.name;
+    EXPECT_EQ(a.name == "all_at_once" ? suite.episodes : a.pass, b.pass) << a.name;
+  }
+}
+
 TEST(RobustnessSuite, TheShippedSuiteHoldsTheCasesOfARealCartPole)
 {
   const RobustnessSuite suite = loadRobustnessSuite(kSuite, TrainingConfig());

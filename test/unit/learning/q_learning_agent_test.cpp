@@ -257,3 +257,107 @@ TEST(QLearningAgent, LambdaAndDecisionStepsOutOfRangeAreRefused)
   p.decision_steps = 0;
   EXPECT_NE(std::string::npos, p.validate().find("decision_steps = 0")) << p.validate();
 }
+
+TEST(QLearningAgent, AnEnsembleTeachesTheTableWhoseTurnItIsAndGivesTheirMean)
+{
+  AgentParams p = tutorialParams();
+  p.ensemble = 2;
+  QLearningAgent agent(p, 0);
+  ASSERT_EQ(2u, agent.ensembleTables().size());
+  // Episode 0 is the first table's: Q(S0, A1) = 0 + 0.5 (1 - 0) there, half of it in the mean.
+  agent.learnWith(0);
+  agent.update(0, 1, 1.0, 3, true, 0.5);
+  EXPECT_EQ(0.5, agent.ensembleTables()[0].at(0, 1));
+  EXPECT_EQ(0.0, agent.ensembleTables()[1].at(0, 1));
+  EXPECT_EQ(0.25, agent.table().at(0, 1));
+  // Episode 1 is the second's, which bootstraps from its own values (none yet), not the mean's.
+  agent.learnWith(1);
+  const auto update = agent.update(1, 0, 0.0, 0, false, 1.0);
+  EXPECT_EQ(0.0, update.next_max);
+  EXPECT_EQ(0.0, agent.table().at(1, 0));
+  agent.update(0, 0, 2.0, 3, true, 0.5);
+  EXPECT_EQ(1.0, agent.ensembleTables()[1].at(0, 0));
+  EXPECT_EQ(0.5, agent.table().at(0, 0));
+  // Episode 2 is the first table's again: its own max at S0 is 0.5 (A1), the mean's 0.5 too, but
+  // the second table's 1.0 (A0) is not its.
+  agent.learnWith(2);
+  EXPECT_EQ(0.9 * 0.5, agent.update(1, 0, 0.0, 0, false, 1.0).target);
+  EXPECT_EQ(0.45, agent.ensembleTables()[0].at(1, 0));
+  EXPECT_EQ(0.225, agent.table().at(1, 0));
+  // Each explores on its own values; the mean (what runs greedily) on both.
+  agent.learnWith(0);
+  EXPECT_EQ(1u, agent.selectAction(0, 0.0));
+  agent.learnWith(1);
+  EXPECT_EQ(0u, agent.selectAction(0, 0.0));
+  EXPECT_EQ(0u, agent.greedyAction(0));  // mean: A0 0.5 > A1 0.25
+}
+
+TEST(QLearningAgent, AnEnsemblesMeanFollowsEveryUpdateOfTilesAndTraces)
+{
+  AgentParams p;
+  p.features = cartpole_qlearning::FeatureKind::Tiles;
+  p.tilings = 4;
+  p.tiles = {{2, 2, 4, 4}};
+  p.lambda = 0.8;
+  p.ensemble = 3;
+  QLearningAgent agent(p, 5);
+  cartpole_qlearning::RandomStream draws(11, 0);
+  cartpole_qlearning::EligibilityTraces traces;
+  cartpole_qlearning::ActiveRows state;
+  cartpole_qlearning::ActiveRows next;
+  for (int episode = 0; episode < 30; ++episode)
+  {
+    agent.learnWith(static_cast<std::uint64_t>(episode));
+    traces.clear();
+    for (int step = 0; step < 20; ++step)
+    {
+      const auto random_state = [&] {
+        cartpole_qlearning::CartPoleState s;
+        for (int d = 0; d < 4; ++d)
+          s[d] = draws.uniform(-1.0, 1.0);
+        return s;
+      };
+      agent.activeRows(random_state(), state);
+      agent.activeRows(random_state(), next);
+      agent.update(state, agent.selectAction(state, 0.3), draws.uniform(-1.0, 1.0), next, step == 19, 0.3, &traces);
+    }
+  }
+  const std::vector<QTable>& tables = agent.ensembleTables();
+  double largest = 0.0;
+  for (std::size_t row = 0; row < agent.table().stateCount(); ++row)
+    for (std::size_t a = 0; a < 2; ++a)
+    {
+      const double mean = (tables[0].at(row, a) + tables[1].at(row, a) + tables[2].at(row, a)) / 3.0;
+      EXPECT_NEAR(mean, agent.table().at(row, a), 1e-12) << "row " << row << ", action " << a;
+      largest = std::max(largest, std::abs(tables[0].at(row, a) - tables[1].at(row, a)));
+    }
+  EXPECT_GT(largest, 0.01);  // the tables learnt apart
+}
+
+TEST(QLearningAgent, ALoadedTableIsEveryEnsembleTablesStart)
+{
+  AgentParams p = tutorialParams();
+  p.ensemble = 2;
+  QLearningAgent agent(p, 0);
+  agent.learnWith(0);
+  agent.update(0, 1, 1.0, 3, true, 0.5);
+  QTable loaded(p.discretiser, p.actions);
+  loaded.at(2, 0) = 3.0;
+  EXPECT_EQ("", agent.replaceTable(loaded));
+  for (const QTable& table : agent.ensembleTables())
+  {
+    EXPECT_EQ(3.0, table.at(2, 0));
+    EXPECT_EQ(0.0, table.at(0, 1));
+  }
+  EXPECT_EQ(3.0, agent.table().at(2, 0));
+}
+
+TEST(QLearningAgent, AnEnsembleOutOfRangeIsRefusedAndOneTableHasNone)
+{
+  AgentParams p = tutorialParams();
+  EXPECT_TRUE(QLearningAgent(p, 0).ensembleTables().empty());
+  p.ensemble = 0;
+  EXPECT_NE(std::string::npos, p.validate().find("ensemble = 0 is not allowed (must be in [1, 16])")) << p.validate();
+  p.ensemble = 17;
+  EXPECT_NE(std::string::npos, p.validate().find("ensemble = 17")) << p.validate();
+}

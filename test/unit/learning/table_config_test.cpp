@@ -47,8 +47,8 @@ std::string scratchFile(const std::string& name)
 TEST(TrainingConfigText, EveryShippedConfigReadsBackAsItself)
 {
   // (inverted_pendulum_v5.yaml names its model by an environment variable: mujoco_cartpole.yaml stands for it.)
-  for (const char* name : {"cartpole.yaml", "robust.yaml", "tiles.yaml", "tutorial.yaml", "tutorial_4_states.yaml",
-                           "mujoco_cartpole.yaml"})
+  for (const char* name : {"cartpole.yaml", "robust.yaml", "robust_five_minutes.yaml", "tiles.yaml", "tutorial.yaml",
+                           "tutorial_4_states.yaml", "mujoco_cartpole.yaml"})
   {
     const TrainingConfig config = shipped(name);
     const std::string text = trainingConfigText(config);

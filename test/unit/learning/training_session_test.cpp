@@ -69,6 +69,33 @@ TEST(HeadlessTrainer, SameSeedGivesTheSameTableBitForBit)
   EXPECT_FALSE(bitIdentical(a.session().table().values(), c.session().table().values()));
 }
 
+TEST(HeadlessTrainer, AnEnsembleTrainsEachTableOnItsOwnEpisodesAndTheTableIsTheirMean)
+{
+  TrainingConfig config = readTrainingConfig(*loadYamlParameters(CARTPOLE_CONFIG_DIR "/tiles.yaml"));
+  config.agent.ensemble = 2;
+  config.limits.stop_when_solved = false;
+  config.limits.max_episodes = 1;
+  HeadlessTrainer one(config, 3);
+  one.run();
+  const auto nonzero = [](const QTable& table) {
+    return std::count_if(table.values().begin(), table.values().end(), [](double v) { return v != 0.0; });
+  };
+  ASSERT_EQ(2u, one.session().ensembleTables().size());
+  EXPECT_GT(nonzero(one.session().ensembleTables()[0]), 0);
+  EXPECT_EQ(0, nonzero(one.session().ensembleTables()[1]));  // its turn has not come
+
+  config.limits.max_episodes = 60;
+  HeadlessTrainer sixty(config, 3);
+  sixty.run();
+  const std::vector<QTable>& tables = sixty.session().ensembleTables();
+  EXPECT_GT(nonzero(tables[1]), 0);
+  EXPECT_FALSE(bitIdentical(tables[0].values(), tables[1].values()));
+  const QTable& mean = sixty.session().table();
+  EXPECT_EQ(60u, mean.episodes);
+  for (std::size_t i = 0; i < mean.values().size(); ++i)
+    ASSERT_NEAR((tables[0].values()[i] + tables[1].values()[i]) / 2.0, mean.values()[i], 1e-12) << "weight " << i;
+}
+
 TEST(HeadlessTrainer, EpisodeStatisticsAddUp)
 {
   TrainingConfig config = shippedConfig();
