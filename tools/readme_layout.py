@@ -42,14 +42,14 @@ def table():
          + quoted(stems("include/cartpole_qlearning/config", "src/config"))),
         ("`include/cartpole_qlearning/io/`, `src/io/`",
          "core layer 3: files (atomic saves, confined paths, size-checked reads, files that grow a line at a time), "
-         "YAML documents as parameter sources and sinks: "
+         "YAML documents as parameter sources and sinks, YAML read alike on every yaml-cpp: "
          + quoted(stems("include/cartpole_qlearning/io", "src/io"))),
         ("`include/cartpole_qlearning/simulation/`, `src/simulation/`",
          "core layer 4: the cart-pole's physics (the equations; a MuJoCo model, its own library) and what a real one does: "
          + quoted(stems("include/cartpole_qlearning/simulation", "src/simulation"))),
         ("`include/cartpole_qlearning/learning/`, `src/learning/`",
-         "core layer 5: the task, features, the Q-table and its file, the learner, a training session, the "
-         "configuration's sections (their key tables): " + quoted(stems("include/cartpole_qlearning/learning", "src/learning"))),
+         "core layer 5: the task, features, the Q-table and its file, the learner, its eligibility traces and "
+         "experience replay, a training session, the configuration's sections (their key tables): " + quoted(stems("include/cartpole_qlearning/learning", "src/learning"))),
         ("`include/cartpole_qlearning/protocol/`, `src/protocol/`",
          "core layer 6: the lockstep and controller message protocols, several robots, reset calls: "
          + quoted(stems("include/cartpole_qlearning/protocol", "src/protocol"))),
@@ -85,7 +85,8 @@ def table():
          "clients); `support/`: what the tests share; `data/`: their configs; `fuzz/`: fuzzers; "
          "`sanitizer/`: suppressions"),
         ("`bench/`", "benchmarks (Google Benchmark for the core; the lockstep loops against raw TCPROS and "
-         "intra-process round trips; the Python anchor)"),
+         "intra-process round trips; the Python anchor; the Suite's swing-up scores beside a hand-written "
+         "energy-based reference, `swingup_reference.cpp`, not part of the product)"),
         ("`scripts/`", "what users run: " + quoted(files("scripts"))),
         ("`tools/`", "what developers run (CI, fuzzing, sanitizers, pictures, figures, reference trajectories, the pages' output "
          "blocks checked): "
