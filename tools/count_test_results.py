@@ -16,6 +16,11 @@ import sys
 import xml.etree.ElementTree as ElementTree
 
 
+# Of a failure's message, the lines printed under its FAILED line, and their width.
+MESSAGE_LINES = 8
+MESSAGE_WIDTH = 300
+
+
 def main():
     folder = sys.argv[1] if len(sys.argv) > 1 else "."
     passed = failed = skipped = 0
@@ -39,6 +44,10 @@ def main():
                 failed += 1
                 message = (problems[0].get("message") or problems[0].text or "").strip().splitlines()
                 print("FAILED %s (%s): %s" % (name, os.path.basename(path), message[0] if message else ""))
+                # What the check said, not only where: a fresh root or a CI machine is gone by the
+                # time anyone reads its log (the first lines, each cut to a screen's width).
+                for line in message[1:MESSAGE_LINES]:
+                    print("    " + line[:MESSAGE_WIDTH])
             elif case.find("skipped") is not None or case.get("status") == "notrun":
                 skipped += 1
             else:
