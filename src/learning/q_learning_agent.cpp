@@ -151,6 +151,16 @@ std::string AgentParams::validate() const
     out << "ensemble = " << ensemble << " is not allowed (must be in [1, " << kMaxEnsemble << "])";
     return out.str();
   }
+  // Learning side by side, the agent holds the ensemble's tables and their mean: together no more
+  // than the values one table may hold (kMaxTableValues, 160 MB of doubles).
+  const std::uint64_t tables_held = ensemble > 1 ? ensemble + 1u : 1u;
+  if (tables_held > 1 && tables_held * rows * actions.size() > kMaxTableValues)
+  {
+    out << "ensemble = " << ensemble << " with a table of " << rows << " rows of " << actions.size()
+        << " actions is not allowed (its " << tables_held << " tables, each and their mean, would hold more than the "
+        << kMaxTableValues << " values a table may hold: fewer tables or fewer bins)";
+    return out.str();
+  }
   if (decision_steps < 1 || decision_steps > kMaxDecisionSteps)
   {
     out << "decision_steps = " << decision_steps << " is not allowed (must be in [1, " << kMaxDecisionSteps << "])";

@@ -360,4 +360,18 @@ TEST(QLearningAgent, AnEnsembleOutOfRangeIsRefusedAndOneTableHasNone)
   EXPECT_NE(std::string::npos, p.validate().find("ensemble = 0 is not allowed (must be in [1, 16])")) << p.validate();
   p.ensemble = 17;
   EXPECT_NE(std::string::npos, p.validate().find("ensemble = 17")) << p.validate();
+  // The tables and their mean together hold no more than one table may: 4,000,000 values each, 5
+  // of them with their mean; not 6.
+  p.discretiser.bins = {1, 100, 100, 100};
+  p.actions = {-10.0, -5.0, 5.0, 10.0};
+  p.mirror = false;
+  p.ensemble = 1;
+  EXPECT_EQ("", p.validate());
+  p.ensemble = 4;
+  EXPECT_EQ("", p.validate());
+  p.ensemble = 5;
+  EXPECT_NE(std::string::npos,
+            p.validate().find("ensemble = 5 with a table of 1000000 rows of 4 actions is not allowed (its 6 tables, "
+                              "each and their mean, would hold more than the 20000000 values"))
+      << p.validate();
 }
