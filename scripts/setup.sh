@@ -172,7 +172,7 @@ build() {
   # a user's compiler may warn about what ours did not, and must still build it.
   local args=(-DCMAKE_BUILD_TYPE=Release "-DCARTPOLE_WARNINGS_AS_ERRORS=${CARTPOLE_WARNINGS_AS_ERRORS:-OFF}")
   [ -x /usr/bin/python3 ] && args+=(-DPYTHON_EXECUTABLE=/usr/bin/python3)
-  say "building (catkin_make, Release; about 1 to 3 minutes from scratch on 2 cores); log in $CARTPOLE_WS/build.log"
+  say "building (catkin_make, Release; about 3 minutes from scratch on 2 cores); log in $CARTPOLE_WS/build.log"
   if ! catkin_make "${args[@]}" "$@" >"$CARTPOLE_WS/build.log" 2>&1; then
     tail -n 40 "$CARTPOLE_WS/build.log" >&2
     echo "[setup] the build failed (full log: $CARTPOLE_WS/build.log)" >&2

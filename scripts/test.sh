@@ -21,7 +21,7 @@ failed_case() {
     "$2" "$2" "$3" "$4" >"$1"
 }
 rm -rf build/test_results/cartpole_qlearning
-echo "[test] catkin_make tests (about 2 minutes on 2 cores), then run_tests (about 3 minutes); log in $CARTPOLE_WS/test.log"
+echo "[test] catkin_make tests (about 3 minutes on 2 cores), then run_tests (about 8 minutes, three tests at a time); log in $CARTPOLE_WS/test.log"
 # A test that does not compile is a failure, not a test fewer.
 if ! catkin_make tests -DCMAKE_BUILD_TYPE=Release "-DCARTPOLE_WARNINGS_AS_ERRORS=$CARTPOLE_WARNINGS_AS_ERRORS" >"$CARTPOLE_WS/test.log" 2>&1; then
   grep -E "error|Error" "$CARTPOLE_WS/test.log" | head -n 20
