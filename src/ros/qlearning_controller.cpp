@@ -129,6 +129,7 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
 
 QLearningControllerNode::~QLearningControllerNode()
 {
+  end_timer_.stop();
   // First, with mutex_ free: a reconfigure call or a save under way ends (they take mutex_), no
   // other starts.
   reconfigure_.reset();
@@ -256,10 +257,20 @@ void QLearningControllerNode::endEpisode(Robot& robot, const ros::Time& stamp, b
 
 void QLearningControllerNode::endWhenFinished()
 {
-  if (settings_.shutdown_when_finished && endParentLaunch())
-    say({{LogLine::Level::Info, "done; ending the launch"}});
-  else if (settings_.shutdown_when_finished && shutdown_)
-    shutdown_();
+  if (!settings_.shutdown_when_finished)
+    return;
+  // Half a second later: the last episode_stats (the solved episode) is still in the publisher's
+  // queue, and ending ROS now closes the connections it would leave on (a rostest client saw
+  // every episode but the last). States are no longer served meanwhile (app_->finished()).
+  end_timer_ = nh_.createSteadyTimer(
+      ros::WallDuration(kLingerSeconds),
+      [this](const ros::SteadyTimerEvent&) {
+        if (endParentLaunch())
+          say({{LogLine::Level::Info, "done; ending the launch"}});
+        else if (shutdown_)
+          shutdown_();
+      },
+      true);
 }
 
 void QLearningControllerNode::startRun()

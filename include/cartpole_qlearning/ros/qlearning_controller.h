@@ -85,7 +85,8 @@ private:
   // Starts the run (fresh, or going on with the run of a controller this process respawns) and
   // stores what a respawn of it needs to find it (~run/id, ~run/launcher, ~run/folder).
   void startRun();
-  // Training or evaluation is over: ends the launch (or the node) when ~shutdown_when_finished.
+  // Training or evaluation is over: ends the launch (or the node) when ~shutdown_when_finished, half a
+  // second later (what was published last must leave first).
   void endWhenFinished();
   void setUpRobots(ros::CallbackQueue* state_queue);
   using StateEvent = ros::MessageEvent<sensor_msgs::JointState const>;
@@ -145,6 +146,9 @@ private:
   ros::ServiceServer save_srv_;
   ros::ServiceServer load_srv_;
   ros::SteadyTimer watchdog_;
+  // Ends the launch (or the node) a moment after training finished (endWhenFinished).
+  ros::SteadyTimer end_timer_;
+  static constexpr double kLingerSeconds = 0.5;
   // Given to the server so that its updates and its callback never run at the same time.
   boost::recursive_mutex reconfigure_mutex_;
   std::unique_ptr<dynamic_reconfigure::Server<LearningConfig>> reconfigure_;
