@@ -40,7 +40,7 @@ QTable trainedTable(std::uint64_t seed)
 }
 }  // namespace
 
-TEST(RobustnessSuite, TheStrictSuiteIsTheSuiteWithAllAtOnceHeldToEveryEpisode)
+TEST(RobustnessSuite, TheStrictSuiteIsTheSuiteWithEveryCaseHeldToEveryEpisode)
 {
   // robust_five_minutes.yaml trains until it passes: the same robots, judged as harshly or more.
   const TrainingConfig config;
@@ -59,7 +59,8 @@ TEST(RobustnessSuite, TheStrictSuiteIsTheSuiteWithAllAtOnceHeldToEveryEpisode)
     EXPECT_EQ(a.name, b.name);
     EXPECT_EQ(a.start_state_bound, b.start_state_bound) << a.name;
     EXPECT_EQ(describePerturbations(a.perturbations, 0.02), describePerturbations(b.perturbations, 0.02)) << a.name;
-    EXPECT_EQ(a.name == "all_at_once" ? suite.episodes : a.pass, b.pass) << a.name;
+    EXPECT_EQ(suite.episodes, b.pass) << a.name;
+    EXPECT_GE(b.pass, a.pass) << a.name;
   }
 }
 
