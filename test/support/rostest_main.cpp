@@ -1,4 +1,4 @@
-// The main of every rostest client (add_rostest_client in CMakeLists.txt links it): the gtests run
+// The main of every rostest client (cartpole_add_rostest_client in CMakeLists.txt links it): the gtests run
 // as one ROS node, then the scratch folders the client declared (rostest_main.h) are removed.
 #include "rostest_main.h"
 
