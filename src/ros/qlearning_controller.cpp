@@ -68,15 +68,16 @@ QLearningControllerNode::QLearningControllerNode(const ros::NodeHandle& nh, cons
   services_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &services_queue_);
   services_spinner_->start();
   setUpRobots(state_queue);
-  // The watchdog on the states' queue (a nodelet's: the lockstep thread's, not the manager's), as
-  // the executable serves both on one: nodelet 1.10.0 (Debian 11) pauses a nodelet's own queues
-  // while it loads and drops what a timer adds meanwhile, after which that timer never fires again
-  // (ros/nodelet_core#106, fixed in 1.10.1); the guard would never stop a robot it cannot see.
-  ros::NodeHandle watchdog_nh(nh_);
+  // The watchdog (and the end, endWhenFinished) on the states' queue (a nodelet's: the lockstep
+  // thread's, not the manager's), as the executable serves both on one: nodelet 1.10.0 (Debian 11)
+  // pauses a nodelet's own queues while it loads and drops what a timer adds meanwhile, after which
+  // that timer never fires again (ros/nodelet_core#106, fixed in 1.10.1); the guard would never
+  // stop a robot it cannot see.
+  timers_nh_ = nh_;
   if (state_queue != nullptr)
-    watchdog_nh.setCallbackQueue(state_queue);
-  watchdog_ = watchdog_nh.createSteadyTimer(ros::WallDuration(dispatch_->tickSeconds()),
-                                            &QLearningControllerNode::onWatchdog, this);
+    timers_nh_.setCallbackQueue(state_queue);
+  watchdog_ = timers_nh_.createSteadyTimer(ros::WallDuration(dispatch_->tickSeconds()),
+                                           &QLearningControllerNode::onWatchdog, this);
   std::string served;
   for (const Robot& robot : robots_)
     served += (served.empty() ? "" : ", ") + describe(robot);
@@ -129,7 +130,12 @@ void QLearningControllerNode::setUpRobots(ros::CallbackQueue* state_queue)
 
 QLearningControllerNode::~QLearningControllerNode()
 {
-  end_timer_.stop();
+  {
+    // Set under mutex_ by the callback that ends the run (a nodelet's lockstep thread); its own
+    // callback takes no lock.
+    const std::lock_guard<std::mutex> lock(mutex_);
+    end_timer_.stop();
+  }
   // First, with mutex_ free: a reconfigure call or a save under way ends (they take mutex_), no
   // other starts.
   reconfigure_.reset();
@@ -262,7 +268,7 @@ void QLearningControllerNode::endWhenFinished()
   // Half a second later: the last episode_stats (the solved episode) is still in the publisher's
   // queue, and ending ROS now closes the connections it would leave on (a rostest client saw
   // every episode but the last). States are no longer served meanwhile (app_->finished()).
-  end_timer_ = nh_.createSteadyTimer(
+  end_timer_ = timers_nh_.createSteadyTimer(
       ros::WallDuration(kLingerSeconds),
       [this](const ros::SteadyTimerEvent&) {
         if (endParentLaunch())

@@ -25,9 +25,9 @@ TEST(SimToSim, ARobustTableTrainedOnTheEquationsBalancesTheMujocoCartPole)
   const fs::path dir = fs::temp_directory_path() / ("sim_to_sim_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string table_file = (dir / "robust.yaml").string();
-  // Seed 6 passes robust_suite.yaml in 2,356 episodes (283,205 steps, docs/robust_tables.md), one
-  // of the quicker seeds; on the model it balanced 100 and 97 of 100 in one-minute episodes when
-  // this was written (docs/mujoco.md).
+  // Seed 6 passes robust_suite.yaml in 2,368 episodes (285,406 steps, docs/robust_tables.md), one
+  // of the quicker seeds; on the model it balanced 100 and 98 of 100 in one-minute episodes
+  // (2026-12-07; docs/mujoco.md).
   const CommandRun training =
       runCommand("ROS_HOME=" + dir.string() + " " + TRAIN_HEADLESS + " --config " +
                  CARTPOLE_CONFIG_DIR "/robust.yaml --seed 6 --quiet --no-run-folder --save " + table_file);

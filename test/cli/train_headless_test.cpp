@@ -270,9 +270,16 @@ TEST_F(TrainHeadlessTest, TheRobustConfigTrainsOnUntilItsTablePassesTheSuite)
                                        "--no-run-folder --save " +
                                        table);
   EXPECT_EQ(0, run.status) << run.output;
-  // A line in every stretch of progress lines (100 episodes: at the first verdict past 100, every
-  // 8th episode), at least; not one per verdict.
-  EXPECT_TRUE(text_match::contains(run.output, "\nrobustness at episode 10[0-9] \\(")) << run.output;
+  const cartpole_qlearning::TrainingConfig robust = cartpole_qlearning::readTrainingConfig(
+      *cartpole_qlearning::loadYamlParameters(CARTPOLE_CONFIG_DIR "/robust.yaml"));
+  // A line in every stretch of progress lines (robust.yaml: 100 episodes), at least: at the first
+  // verdict of the second stretch (a verdict every suite_every episodes); not one per verdict.
+  const std::uint64_t every = robust.limits.suite_every;
+  const std::uint64_t second_stretch = robust.limits.progress_every;
+  ASSERT_GT(every, 0u);
+  const std::uint64_t first_verdict = (second_stretch + every - 1) / every * every;
+  EXPECT_NE(std::string::npos, run.output.find("\nrobustness at episode " + std::to_string(first_verdict) + " ("))
+      << run.output;
   text_match::Groups episodes;
   ASSERT_TRUE(text_match::contains(run.lastLine(), " episodes=([0-9]+) ", &episodes)) << run.lastLine();
   std::size_t said = 0;
@@ -282,8 +289,6 @@ TEST_F(TrainHeadlessTest, TheRobustConfigTrainsOnUntilItsTablePassesTheSuite)
   EXPECT_LT(said, std::stoull(episodes[1]) / 4) << "of " << episodes[1] << " verdicts";
   EXPECT_NE(std::string::npos, run.output.find("SUITE PASSED after ")) << run.output;
   // The table saved passes: judged again, apart from the run.
-  const cartpole_qlearning::TrainingConfig robust = cartpole_qlearning::readTrainingConfig(
-      *cartpole_qlearning::loadYamlParameters(CARTPOLE_CONFIG_DIR "/robust.yaml"));
   const cartpole_qlearning::SuiteResult verdict = cartpole_qlearning::evaluateSuite(
       cartpole_qlearning::loadQTableFile(table), robust,
       cartpole_qlearning::loadRobustnessSuite(CARTPOLE_CONFIG_DIR "/robust_suite.yaml", robust));

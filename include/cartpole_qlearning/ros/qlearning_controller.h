@@ -145,6 +145,7 @@ private:
   std::unique_ptr<ros::AsyncSpinner> services_spinner_;
   ros::ServiceServer save_srv_;
   ros::ServiceServer load_srv_;
+  ros::NodeHandle timers_nh_;  // nh_ on the states' queue: the watchdog's and end_timer_'s
   ros::SteadyTimer watchdog_;
   // Ends the launch (or the node) a moment after training finished (endWhenFinished).
   ros::SteadyTimer end_timer_;

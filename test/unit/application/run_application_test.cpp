@@ -1063,7 +1063,7 @@ TEST_F(RunApplicationTest, AtMaxEpisodesTheBestTableSeenIsSavedAndTheDefaultTabl
 
 TEST_F(RunApplicationTest, JudgedEveryEpisodeTheTablesNotKeptAreSaidOnceEachProgressStretchAndCounted)
 {
-  // Judged after every episode, a run has thousands of verdicts (robust.yaml's every 8th: hundreds). A table that can
+  // Judged after every episode, a run has thousands of verdicts (robust.yaml's every 16th: hundreds). A table that can
   // beat the best has a line of its own; of those that cannot (or, between best_every's evaluations, do not pass) one
   // line in each stretch of progress_every episodes and one at the end, and every line says how many others there were
   // since the last: every verdict is accounted for.
