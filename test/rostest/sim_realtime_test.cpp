@@ -81,6 +81,11 @@ TEST_F(SimRealtimeTest, BroadcastsWorldToPole)
 
 TEST_F(SimRealtimeTest, TfAtAJointStateStampMatchesThatState)
 {
+  // A state taken once the listener has TF: one taken before its /tf connection was up (CI, under
+  // load) has a transform this listener never received.
+  std::string connected;
+  ASSERT_TRUE(buffer_.canTransform("world", "pole", ros::Time(0), ros::Duration(kWaitSeconds), &connected))
+      << "no TF world -> pole: " << connected;
   const sensor_msgs::JointStateConstPtr msg = nextJointState();
   ASSERT_TRUE(msg) << "no joint_states on /cartpole/joint_states";
   const int cart = jointIndex(*msg, "cart_joint");
