@@ -62,7 +62,7 @@ for release in "${releases[@]}"; do
   inner+="; for f in \$(ls ~/cartpole_ws/build_sanitize/sanitizer_logs/* 2>/dev/null | head -n 3); do"
   inner+=" echo \"[releases] --- \$f\"; head -n 60 \"\$f\"; done"
   inner+="; for f in /tmp/cartpole_fuzz.*/*.log ~/cartpole_ws/test.log ~/cartpole_ws/sanitize.log; do"
-  inner+=" [ -f \"\$f\" ] && { echo \"[releases] --- the end of \$f\"; tail -n 40 \"\$f\"; }; done"
+  inner+=" if [ -f \"\$f\" ]; then echo \"[releases] --- the end of \$f\"; tail -n 40 \"\$f\"; fi; done"
   log="$LOGS/$release.log"
   echo "[releases] $release: ${commands[*]/%/.sh} in a fresh root (log: $log)"
   DEBIAN_RELEASE=$release bash "$FRESH" "$inner" >"$log" 2>&1
