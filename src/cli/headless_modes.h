@@ -1,5 +1,6 @@
 // train_headless's modes, one file each: training (from scratch, from a table, or on from a run
-// folder), a greedy evaluation, a robustness suite, a replay of transitions, a table's policy.
+// folder), a greedy evaluation, a robustness suite, a replay of transitions, a table's policy, the
+// mean of tables.
 // Each prints what it says and returns the exit status; the main only dispatches.
 #pragma once
 
@@ -47,5 +48,6 @@ int evaluateMode(const HeadlessOptions& options, const HeadlessSetup& setup);  /
 int suiteMode(const HeadlessOptions& options, const HeadlessSetup& setup);     // suite_mode.cpp
 int replayMode(const HeadlessOptions& options, const HeadlessSetup& setup);    // replay_mode.cpp
 int policyMode(const HeadlessOptions& options);                                // policy_mode.cpp
+int averageMode(const HeadlessOptions& options);                               // average_mode.cpp
 
 }  // namespace cartpole_qlearning

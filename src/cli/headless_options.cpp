@@ -54,6 +54,8 @@ const RuleOption kPredictDelay{"--predict-delay", [](const HeadlessOptions& o) {
 const RuleOption kSuite{"--suite", [](const HeadlessOptions& o) { return !o.suite_path.empty(); }};
 const RuleOption kReplay{"--replay", [](const HeadlessOptions& o) { return !o.replay_path.empty(); }};
 const RuleOption kPolicy{"--policy", [](const HeadlessOptions& o) { return !o.policy_path.empty(); }};
+const RuleOption kAverage{"--average", [](const HeadlessOptions& o) { return !o.average_paths.empty(); }};
+const RuleOption kQuiet{"--quiet", [](const HeadlessOptions& o) { return o.quiet; }};
 const RuleOption kGrid{"--grid", [](const HeadlessOptions& o) { return isTyped(o, "--grid"); }};
 const RuleOption kAxes{"--axes", [](const HeadlessOptions& o) { return isTyped(o, "--axes"); }};
 const RuleOption kAt{"--at", [](const HeadlessOptions& o) { return isTyped(o, "--at"); }};
@@ -112,6 +114,9 @@ const std::vector<OptionRule>& headlessOptionRules()
        kPolicy,
        {kGrid, kAxes, kAt, kPrevious, kNameSpace},
        "a policy is drawn from the table alone (its file says its features)"},
+      // The tables' files say everything the mean needs: nothing to train, evaluate or configure.
+      {Kind::Alone, kAverage, {kSave, kNameSpace, kQuiet}, "--average writes the mean of tables, nothing else"},
+      {Kind::Requires, kSave, {kAverage}, "give --save PATH, where the mean of the tables goes"},
       {Kind::OneOf, kLoad, {kResume}, "give one: --resume goes on from a run's own checkpoint"},
       {Kind::Requires, kEvaluate, {kEpisodes}, "counts --evaluate's episodes (training: --max-episodes)"},
       {Kind::Requires,
@@ -186,6 +191,8 @@ HeadlessCommandLine parseHeadlessOptions(const std::vector<std::string>& args)
       o.no_run_folder = true;
     else if (text != std::end(texts) && has_value)
       o.*(text->second) = args[++i];
+    else if (arg == "--average" && has_value)
+      o.average_paths.push_back(args[++i]);
     else if (arg == "--grid" && has_value)
     {
       if (!parseCount(args[++i], o.grid_points) || o.grid_points < 2 || o.grid_points > kMaxPolicyGridPoints)
@@ -257,6 +264,8 @@ HeadlessCommandLine parseHeadlessOptions(const std::vector<std::string>& args)
     }
   }
   line.error = brokenRule(o);
+  if (line.error.empty() && o.average_paths.size() == 1)
+    line.error = "--average " + o.average_paths.front() + ": give two tables or more, --average before each";
   return line;
 }
 

@@ -49,6 +49,9 @@ struct HeadlessOptions
 
   std::string replay_path;
 
+  // --average TABLE, once per table: their mean is written to --save.
+  std::vector<std::string> average_paths;
+
   std::string policy_path;
   std::uint64_t grid_points = PolicyGridParams().points;
   std::string axes = "theta,theta_dot";

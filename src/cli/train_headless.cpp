@@ -6,7 +6,8 @@
 // with "evaluated=N balanced=M mean_return=R", a robustness suite (--evaluate TABLE --suite FILE)
 // with "suite=PASSED|FAILED cases=N passed=K worst=M/E". With --replay it learns from the transitions of a
 // file instead (the tutorial's worked example), tracing each update. --policy TABLE prints the
-// table's greedy policy over a grid of states as CSV (scripts/plot_policy draws it).
+// table's greedy policy over a grid of states as CSV (scripts/plot_policy draws it); --average
+// writes the mean of tables.
 #include "headless_modes.h"
 
 #include <cstdio>
@@ -37,6 +38,8 @@ int run(const std::vector<std::string>& args)
   }
   if (!options.policy_path.empty())
     return policyMode(options);
+  if (!options.average_paths.empty())
+    return averageMode(options);
   const std::optional<HeadlessSetup> setup = readHeadlessSetup(options);
   if (!setup)
     return 2;

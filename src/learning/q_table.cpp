@@ -82,4 +82,43 @@ std::string tableShapeMismatch(const FeatureParams& features, const std::vector<
   return "";
 }
 
+QTable meanTable(const std::vector<QTable>& tables)
+{
+  if (tables.size() < 2)
+    throw std::invalid_argument("a mean needs at least two tables, got " + std::to_string(tables.size()));
+  const QTable& first = tables.front();
+  std::vector<double> sum(first.values().size(), 0.0);
+  std::uint64_t episodes = 0;
+  std::uint64_t steps = 0;
+  for (std::size_t i = 0; i < tables.size(); ++i)
+  {
+    const QTable& table = tables[i];
+    const std::string which = "table " + std::to_string(i + 1) + " of " + std::to_string(tables.size());
+    std::string differs = first.shapeMismatch(table);
+    if (differs.empty() && table.tau != first.tau)
+    {
+      std::ostringstream out;
+      out.precision(17);
+      out << "its step (tau) " << table.tau << " s differs from table 1's " << first.tau << " s";
+      differs = out.str();
+    }
+    if (differs.empty() && table.trained_with != first.trained_with)
+      differs = "the configuration that trained it (trained_with) differs from table 1's";
+    if (!differs.empty())
+      throw std::invalid_argument(which + ": " + differs);
+    for (std::size_t k = 0; k < sum.size(); ++k)
+      sum[k] += table.values()[k];
+    episodes += table.episodes;
+    steps += table.steps;
+  }
+  const double count = static_cast<double>(tables.size());
+  for (double& value : sum)
+    value /= count;
+  QTable mean = first;
+  mean.setValues(std::move(sum));
+  mean.episodes = episodes;
+  mean.steps = steps;
+  return mean;
+}
+
 }  // namespace cartpole_qlearning

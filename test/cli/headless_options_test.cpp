@@ -193,6 +193,18 @@ TEST(HeadlessOptions, EachRuleRefusesWhatDoesNotGoTogether)
   EXPECT_EQ("--checkpoint-every with --no-run-folder: checkpoints go into the run's folder",
             refusal("--no-run-folder --checkpoint-every 5"));
   EXPECT_EQ("", parse("--no-run-folder --checkpoint-every 0").error);  // no checkpoints: nothing to put there
+  const std::string average = " with --average: --average writes the mean of tables, nothing else";
+  for (const std::string option : {"--config c.yaml", "--seed 1", "--evaluate t.yaml", "--no-run-folder",
+                                   "--load l.yaml", "--robots 1", "--suite s.yaml"})
+    EXPECT_EQ(words(option)[0] + average, refusal("--average a.yaml --average b.yaml --save m.yaml " + option));
+  EXPECT_EQ("--average: give --save PATH, where the mean of the tables goes",
+            refusal("--average a.yaml --average b.yaml"));
+  EXPECT_EQ("--average a.yaml: give two tables or more, --average before each",
+            refusal("--average a.yaml --save m.yaml"));
+  const HeadlessCommandLine averaged =
+      parse("--average a.yaml --ns n --average /t/b.yaml --quiet --average c.yaml --save m.yaml");
+  EXPECT_EQ("", averaged.error);
+  EXPECT_EQ((std::vector<std::string>{"a.yaml", "/t/b.yaml", "c.yaml"}), averaged.options.average_paths);
 }
 
 TEST(HeadlessOptions, TheRulesAreCheckedInTheTablesOrder)
@@ -203,7 +215,7 @@ TEST(HeadlessOptions, TheRulesAreCheckedInTheTablesOrder)
   // Within a rule, its list's order: --load before --save.
   EXPECT_EQ("--load with --evaluate: an evaluation learns nothing and writes nothing",
             refusal("--evaluate t.yaml --save s --load l"));
-  EXPECT_EQ(11u, headlessOptionRules().size());
+  EXPECT_EQ(13u, headlessOptionRules().size());
   for (const OptionRule& rule : headlessOptionRules())
   {
     EXPECT_FALSE(rule.others.empty()) << rule.option.name;

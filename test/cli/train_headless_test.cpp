@@ -1028,6 +1028,61 @@ TEST_F(TrainHeadlessTest, ReplayWritesItsTableWhenAskedTo)
   EXPECT_EQ(10u, table.steps);
 }
 
+// Two seeds trained apart, their mean written as one table that runs as any other (the recipe of
+// docs/robust_tables.md, on the default config so that it takes a second).
+TEST_F(TrainHeadlessTest, AverageWritesTheMeanOfTablesTrainedApartAsATableThatRuns)
+{
+  for (const char* seed : {"0", "1"})
+  {
+    const CommandRun run = trainHeadless(config() + " --seed " + seed + " --no-run-folder --quiet --save " +
+                                         file(std::string("seed") + seed + ".yaml"));
+    ASSERT_EQ(0, run.status) << run.output;
+  }
+  const CommandRun averaged =
+      trainHeadless("--average " + file("seed0.yaml") + " --average " + file("seed1.yaml") + " --save mean.yaml");
+  ASSERT_EQ(0, averaged.status) << averaged.output;
+  const std::string saved = (tables() / "mean.yaml").string();  // relative: under the table folder
+  EXPECT_TRUE(text_match::contains(averaged.output,
+                                   "saved the mean of 2 tables \\([0-9]+ episodes, [0-9]+ steps "
+                                   "between them\\) to " +
+                                       saved))
+      << averaged.output;
+  const cartpole_qlearning::QTable a = cartpole_qlearning::loadQTableFile(file("seed0.yaml"));
+  const cartpole_qlearning::QTable b = cartpole_qlearning::loadQTableFile(file("seed1.yaml"));
+  const cartpole_qlearning::QTable mean = cartpole_qlearning::loadQTableFile(saved);
+  ASSERT_EQ(a.values().size(), mean.values().size());
+  EXPECT_NE(a.values(), b.values());
+  for (std::size_t i = 0; i < mean.values().size(); ++i)
+    ASSERT_EQ((a.values()[i] + b.values()[i]) / 2.0, mean.values()[i]) << "value " << i;
+  EXPECT_EQ(a.episodes + b.episodes, mean.episodes);
+  EXPECT_EQ(a.steps + b.steps, mean.steps);
+  EXPECT_EQ(a.trained_with, mean.trained_with);
+  // It runs with the configuration it carries, as each of the two would.
+  const CommandRun evaluated = trainHeadless("--evaluate mean.yaml --episodes 3");
+  EXPECT_EQ(0, evaluated.status) << evaluated.output;
+  EXPECT_TRUE(text_match::contains(evaluated.output, "evaluated=3 balanced=[0-3] mean_return=")) << evaluated.output;
+}
+
+// A table that learnt something else, or is not a table, is refused before anything is written.
+TEST_F(TrainHeadlessTest, AverageRefusesTablesThatDoNotGoTogetherAndWritesNothing)
+{
+  ASSERT_EQ(0, trainHeadless(config() + " --no-run-folder --quiet --save " + file("cartpole.yaml")).status);
+  ASSERT_EQ(0, trainHeadless(tutorialConfig() + " --replay " + CARTPOLE_CONFIG_DIR + "/tutorial_10_steps.yaml --save " +
+                             file("tutorial.yaml"))
+                   .status);
+  CommandRun run = trainHeadless("--average " + file("cartpole.yaml") + " --average " + file("cartpole.yaml") +
+                                 " --average " + file("tutorial.yaml") + " --save " + file("mean.yaml"));
+  EXPECT_EQ(2, run.status);
+  EXPECT_TRUE(text_match::contains(run.output, "train_headless: --average: table 3 of 3: ")) << run.output;
+  EXPECT_FALSE(fs::exists(dir_ / "mean.yaml"));
+  run = trainHeadless("--average " + file("cartpole.yaml") + " --average " + file("missing.yaml") + " --save " +
+                      file("mean.yaml"));
+  EXPECT_EQ(2, run.status);
+  EXPECT_TRUE(text_match::contains(run.output, "train_headless: --average " + file("missing.yaml") + ": "))
+      << run.output;
+  EXPECT_FALSE(fs::exists(dir_ / "mean.yaml"));
+}
+
 // A replay file with a mistake is refused with the line it is on, before any update.
 TEST_F(TrainHeadlessTest, BadReplayFileNamesTheLineAndRunsNothing)
 {

@@ -114,4 +114,14 @@ private:
 // table may hold 160 MB of zeros).
 std::string tableShapeMismatch(const FeatureParams& features, const std::vector<double>& actions, const QTable& other);
 
+// The mean of tables trained apart (train_headless --average): each value the mean of theirs, so
+// each Q the mean of their Qs (a tile's weights sum linearly). Tables trained apart err in
+// different states, and where one would drop the pole the others outvote it (docs/robust_tables.md).
+// Its counters are their sums (it learnt from all their episodes and steps) and it says how to
+// run it as each of them says. Throws std::invalid_argument, naming the table by its place in
+// the list (1-based), unless there are at least two and all have the first one's features,
+// actions, step (tau) and training configuration (trained_with): a mean of tables that learnt
+// different things would not be any configuration's table.
+QTable meanTable(const std::vector<QTable>& tables);
+
 }  // namespace cartpole_qlearning

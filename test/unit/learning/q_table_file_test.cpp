@@ -716,3 +716,79 @@ TEST_F(QTableFileTest, TheConfigurationThatTrainedATableReadsAsTheConfigFileItIs
   saveQTableFile(table, path("odd.yaml"));
   EXPECT_EQ(table.trained_with, loadQTableFile(path("odd.yaml")).trained_with);
 }
+
+// train_headless --average: the mean of tables trained apart is one ordinary table.
+namespace
+{
+QTable tableWith(double scale, std::uint64_t episodes)
+{
+  FeatureParams features;
+  features.kind = FeatureKind::Tiles;
+  features.tilings = 2;
+  features.tiles = {2, 2, 3, 3};
+  QTable table(features, {-10.0, 0.0, 10.0});
+  std::vector<double> values(table.values().size());
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = scale * (static_cast<double>(i % 11) - 5.0) / 7.0;
+  table.setValues(values);
+  table.episodes = episodes;
+  table.steps = 100 * episodes;
+  table.tau = 0.02;
+  table.trained_with = "learning:\n  features: tiles\n";
+  return table;
+}
+}  // namespace
+
+TEST(QTableMeanTest, EachValueIsTheMeanOfTheTablesAndTheCountersAreSummed)
+{
+  const std::vector<QTable> tables{tableWith(1.0, 3), tableWith(-0.5, 4), tableWith(0.3, 5)};
+  const QTable mean = meanTable(tables);
+  EXPECT_EQ("", tables[0].shapeMismatch(mean));
+  ASSERT_EQ(tables[0].values().size(), mean.values().size());
+  for (std::size_t i = 0; i < mean.values().size(); ++i)
+    EXPECT_DOUBLE_EQ((tables[0].values()[i] + tables[1].values()[i] + tables[2].values()[i]) / 3.0, mean.values()[i])
+        << "value " << i;
+  EXPECT_EQ(12u, mean.episodes);
+  EXPECT_EQ(1200u, mean.steps);
+  EXPECT_EQ(0.02, mean.tau);
+  EXPECT_EQ(tables[0].trained_with, mean.trained_with);
+  // Its file is an ordinary table's: it loads as the same table.
+  const std::string path =
+      (fs::temp_directory_path() / ("q_table_mean_" + std::to_string(::getpid()) + ".yaml")).string();
+  saveQTableFile(mean, path);
+  const QTable loaded = loadQTableFile(path);
+  fs::remove(path);
+  EXPECT_TRUE(bitIdentical(mean.values(), loaded.values()));
+  EXPECT_EQ(12u, loaded.episodes);
+}
+
+TEST(QTableMeanTest, TablesThatLearntDifferentThingsAreRefusedNamingWhichAndWhatDiffers)
+{
+  const auto refusal = [](const std::vector<QTable>& tables) {
+    try
+    {
+      meanTable(tables);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      return std::string(e.what());
+    }
+    return std::string("no refusal");
+  };
+  EXPECT_EQ("a mean needs at least two tables, got 1", refusal({tableWith(1.0, 1)}));
+  EXPECT_EQ("a mean needs at least two tables, got 0", refusal({}));
+  QTable other_actions(tableWith(1.0, 1).features(), {-10.0, 10.0});
+  EXPECT_EQ(
+      0u,
+      refusal({tableWith(1.0, 1), tableWith(1.0, 1), other_actions}).find("table 3 of 3: actions [-10, 10] differ"));
+  FeatureParams bins;
+  EXPECT_EQ(0u, refusal({tableWith(1.0, 1), QTable(bins, {-10.0, 0.0, 10.0})}).find("table 2 of 2: "));
+  QTable other_tau = tableWith(1.0, 1);
+  other_tau.tau = 0.01;
+  EXPECT_EQ("table 2 of 2: its step (tau) 0.01 s differs from table 1's 0.02 s",
+            refusal({tableWith(1.0, 1), other_tau}));
+  QTable other_config = tableWith(1.0, 1);
+  other_config.trained_with += "  ensemble: 2\n";
+  EXPECT_EQ("table 2 of 2: the configuration that trained it (trained_with) differs from table 1's",
+            refusal({tableWith(1.0, 1), other_config}));
+}
