@@ -61,9 +61,23 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
   // The config that trains the table (robust.yaml, or robust_five_minutes.yaml: config:=).
   std::string config = std::string(CARTPOLE_CONFIG_DIR) + "/robust.yaml";
   ros::param::get("~config", config);
-  const auto trained = runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + config + " --seed " +
-                                  std::to_string(seed) + " --quiet --no-run-folder --save robust.yaml");
+  // average_with:=K: the table run is the mean of seed's and seed K's (train_headless --average).
+  int average_with = -1;
+  ros::param::get("~average_with", average_with);
+  const auto train = [&](int table_seed, const std::string& path) {
+    return runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS + " --config " + config + " --seed " +
+                      std::to_string(table_seed) + " --quiet --no-run-folder --save " + path);
+  };
+  const auto trained = train(seed, average_with < 0 ? "robust.yaml" : "first.yaml");
   ASSERT_EQ(0, trained.status) << trained.output;
+  if (average_with >= 0)
+  {
+    const auto second = train(average_with, "second.yaml");
+    ASSERT_EQ(0, second.status) << second.output;
+    const auto mean = runCommand("ROS_HOME=" + home + " " + TRAIN_HEADLESS +
+                                 " --average first.yaml --average second.yaml --save robust.yaml");
+    ASSERT_EQ(0, mean.status) << mean.output;
+  }
 
   ros::NodeHandle nh;
   ControlStats last;
