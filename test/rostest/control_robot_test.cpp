@@ -156,9 +156,12 @@ TEST(ControlRobot, ATableDrivesAPosedRobotForFiveMinutesOfItsTimeAndCtrlCLeavesZ
     EXPECT_EQ(1u, occurrences(output, "carries out each command")) << "another delay was said:\n" << output;
     EXPECT_EQ(found_delay, published_delay);
   }
+  const std::string table = average_with < 0 ? "seed " + std::to_string(seed) + "'s table"
+                                             : "the mean of seeds " + std::to_string(seed) + " and " +
+                                                   std::to_string(average_with) + "'s tables";
   std::printf(
-      "five minutes of control on %s, seed %d's table, predict_delay %d: %.1f s balanced, the longest "
+      "five minutes of control on %s, %s, predict_delay %d: %.1f s balanced, the longest "
       "stretch %.1f s, %llu falls\n",
-      suite_case.c_str(), seed, predict_delay, at_five_minutes.balanced_seconds, at_five_minutes.longest_seconds,
-      static_cast<unsigned long long>(at_five_minutes.falls));
+      suite_case.c_str(), table.c_str(), predict_delay, at_five_minutes.balanced_seconds,
+      at_five_minutes.longest_seconds, static_cast<unsigned long long>(at_five_minutes.falls));
 }
