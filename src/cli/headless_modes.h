@@ -42,6 +42,9 @@ QTable loadTable(const std::string& table_dir, const std::string& path);
 void saveTable(const QTable& table, const std::string& table_dir, const std::string& path);
 // Where loadTable and saveTable find `path`: made absolute.
 std::string tablePath(const std::string& table_dir, const std::string& path);
+// Whether a relative --save stays in the table folder (an absolute one is the user's): false after
+// saying why.
+bool saveStaysInTableFolder(const std::string& table_dir, const std::string& save_path);
 
 int trainMode(const HeadlessOptions& options, const HeadlessSetup& setup);     // train_mode.cpp
 int evaluateMode(const HeadlessOptions& options, const HeadlessSetup& setup);  // evaluate_mode.cpp

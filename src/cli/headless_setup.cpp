@@ -149,20 +149,26 @@ std::optional<HeadlessSetup> readHeadlessSetup(const HeadlessOptions& options)
               << " has tiles)\n";
     return std::nullopt;
   }
-  // A relative --save must stay in the table folder, as over a service: said before training.
-  if (!options.save_path.empty() && options.save_path.front() != '/')
-  {
-    try
-    {
-      relativePathUnder(setup.table_dir, options.save_path);
-    }
-    catch (const FileError& e)
-    {
-      std::cerr << "train_headless: --save " << options.save_path << " is not allowed (" << e.what() << ")\n";
-      return std::nullopt;
-    }
-  }
+  if (!saveStaysInTableFolder(setup.table_dir, options.save_path))
+    return std::nullopt;
   return setup;
+}
+
+bool saveStaysInTableFolder(const std::string& table_dir, const std::string& save_path)
+{
+  // A relative --save must stay in the table folder, as over a service: said before any work.
+  if (save_path.empty() || save_path.front() == '/')
+    return true;
+  try
+  {
+    relativePathUnder(table_dir, save_path);
+  }
+  catch (const FileError& e)
+  {
+    std::cerr << "train_headless: --save " << save_path << " is not allowed (" << e.what() << ")\n";
+    return false;
+  }
+  return true;
 }
 
 bool printLog(const LogLines& log, bool quiet)

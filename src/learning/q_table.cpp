@@ -1,5 +1,6 @@
 #include "cartpole_qlearning/learning/q_table.h"
 
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -82,42 +83,70 @@ std::string tableShapeMismatch(const FeatureParams& features, const std::vector<
   return "";
 }
 
-QTable meanTable(const std::vector<QTable>& tables)
+TableMean::TableMean(QTable first) : sum_(std::move(first)) {}
+
+namespace
 {
-  if (tables.size() < 2)
-    throw std::invalid_argument("a mean needs at least two tables, got " + std::to_string(tables.size()));
-  const QTable& first = tables.front();
-  std::vector<double> sum(first.values().size(), 0.0);
-  std::uint64_t episodes = 0;
-  std::uint64_t steps = 0;
-  for (std::size_t i = 0; i < tables.size(); ++i)
+// The first line where two texts differ, as "LINE (the first: OTHER)".
+std::string firstDifferingLine(const std::string& text, const std::string& first)
+{
+  std::istringstream a(text);
+  std::istringstream b(first);
+  std::string line_a;
+  std::string line_b;
+  for (int number = 1;; ++number)
   {
-    const QTable& table = tables[i];
-    const std::string which = "table " + std::to_string(i + 1) + " of " + std::to_string(tables.size());
-    std::string differs = first.shapeMismatch(table);
-    if (differs.empty() && table.tau != first.tau)
-    {
-      std::ostringstream out;
-      out.precision(17);
-      out << "its step (tau) " << table.tau << " s differs from table 1's " << first.tau << " s";
-      differs = out.str();
-    }
-    if (differs.empty() && table.trained_with != first.trained_with)
-      differs = "the configuration that trained it (trained_with) differs from table 1's";
-    if (!differs.empty())
-      throw std::invalid_argument(which + ": " + differs);
-    for (std::size_t k = 0; k < sum.size(); ++k)
-      sum[k] += table.values()[k];
-    episodes += table.episodes;
-    steps += table.steps;
+    const bool more_a = static_cast<bool>(std::getline(a, line_a));
+    const bool more_b = static_cast<bool>(std::getline(b, line_b));
+    if (!more_a && !more_b)
+      return "";
+    if (!more_a || !more_b || line_a != line_b)
+      return "line " + std::to_string(number) + " '" + (more_a ? line_a : "(none)") + "' where the first's is '" +
+             (more_b ? line_b : "(none)") + "'";
   }
-  const double count = static_cast<double>(tables.size());
-  for (double& value : sum)
-    value /= count;
-  QTable mean = first;
-  mean.setValues(std::move(sum));
-  mean.episodes = episodes;
-  mean.steps = steps;
+}
+}  // namespace
+
+void TableMean::add(const QTable& table)
+{
+  std::string differs = sum_.shapeMismatch(table);
+  if (differs.empty() && table.tau != sum_.tau)
+  {
+    std::ostringstream out;
+    out.precision(17);
+    out << "its step (tau) " << table.tau << " s differs from the first table's " << sum_.tau << " s";
+    differs = out.str();
+  }
+  if (differs.empty() && table.trained_with != sum_.trained_with)
+    differs = "the configuration that trained it (trained_with) differs from the first table's at " +
+              firstDifferingLine(table.trained_with, sum_.trained_with);
+  if (!differs.empty())
+    throw std::invalid_argument(differs);
+  // In place: a table may hold 160 MB.
+  for (std::size_t state = 0; state < sum_.stateCount(); ++state)
+    for (std::size_t action = 0; action < sum_.actionCount(); ++action)
+      sum_.at(state, action) += table.at(state, action);
+  counters_overflow_ =
+      counters_overflow_ || sum_.episodes + table.episodes < sum_.episodes || sum_.steps + table.steps < sum_.steps;
+  sum_.episodes += table.episodes;
+  sum_.steps += table.steps;
+  ++count_;
+}
+
+QTable TableMean::mean() const
+{
+  if (counters_overflow_)
+    throw std::invalid_argument("the tables' episode or step counts sum past the largest count a table holds");
+  const double count = static_cast<double>(count_);
+  QTable mean = sum_;
+  for (std::size_t state = 0; state < mean.stateCount(); ++state)
+    for (std::size_t action = 0; action < mean.actionCount(); ++action)
+    {
+      double& value = mean.at(state, action);
+      if (!std::isfinite(value))
+        throw std::invalid_argument("a value's sum over the tables is not finite (values near the largest double)");
+      value /= count;
+    }
   return mean;
 }
 

@@ -1063,24 +1063,39 @@ TEST_F(TrainHeadlessTest, AverageWritesTheMeanOfTablesTrainedApartAsATableThatRu
   EXPECT_TRUE(text_match::contains(evaluated.output, "evaluated=3 balanced=[0-3] mean_return=")) << evaluated.output;
 }
 
-// A table that learnt something else, or is not a table, is refused before anything is written.
-TEST_F(TrainHeadlessTest, AverageRefusesTablesThatDoNotGoTogetherAndWritesNothing)
+// A table that learnt something else, is not a table, or is given twice is refused, naming it, and
+// --save's file stays as it was; a --save that cannot be written exits 1.
+TEST_F(TrainHeadlessTest, AverageRefusesTablesThatDoNotGoTogetherAndLeavesSaveAsItWas)
 {
-  ASSERT_EQ(0, trainHeadless(config() + " --no-run-folder --quiet --save " + file("cartpole.yaml")).status);
+  for (const char* seed : {"0", "1"})
+    ASSERT_EQ(0, trainHeadless(config() + " --seed " + seed + " --no-run-folder --quiet --save " +
+                               file(std::string("seed") + seed + ".yaml"))
+                     .status);
   ASSERT_EQ(0, trainHeadless(tutorialConfig() + " --replay " + CARTPOLE_CONFIG_DIR + "/tutorial_10_steps.yaml --save " +
                              file("tutorial.yaml"))
                    .status);
-  CommandRun run = trainHeadless("--average " + file("cartpole.yaml") + " --average " + file("cartpole.yaml") +
-                                 " --average " + file("tutorial.yaml") + " --save " + file("mean.yaml"));
-  EXPECT_EQ(2, run.status);
-  EXPECT_TRUE(text_match::contains(run.output, "train_headless: --average: table 3 of 3: ")) << run.output;
-  EXPECT_FALSE(fs::exists(dir_ / "mean.yaml"));
-  run = trainHeadless("--average " + file("cartpole.yaml") + " --average " + file("missing.yaml") + " --save " +
-                      file("mean.yaml"));
-  EXPECT_EQ(2, run.status);
-  EXPECT_TRUE(text_match::contains(run.output, "train_headless: --average " + file("missing.yaml") + ": "))
-      << run.output;
-  EXPECT_FALSE(fs::exists(dir_ / "mean.yaml"));
+  const std::string mean = file("mean.yaml", "an earlier file\n");
+  const std::string seeds = " --average " + file("seed0.yaml") + " --average " + file("seed1.yaml");
+  const auto refused = [&](const std::string& args, const std::string& message) {
+    const CommandRun run = trainHeadless(args);
+    EXPECT_EQ(2, run.status) << args << "\n" << run.output;
+    EXPECT_TRUE(text_match::contains(run.output, message)) << args << "\n" << run.output;
+    EXPECT_EQ("an earlier file\n", fileText(mean)) << args;
+  };
+  refused(seeds + " --average " + file("tutorial.yaml") + " --save " + mean,
+          "train_headless: --average " + file("tutorial.yaml") + ": .+ \\(the first: " + file("seed0.yaml") + "\\)");
+  refused(seeds + " --average " + file("missing.yaml") + " --save " + mean,
+          "train_headless: --average " + file("missing.yaml") + ": ");
+  refused(seeds + " --average " + file("not_a_table.txt", "hello\n") + " --save " + mean,
+          "train_headless: --average " + file("not_a_table.txt") + ": ");
+  refused(seeds + " --average " + (dir_ / "." / "seed0.yaml").string() + " --save " + mean,
+          "is the file --average " + file("seed0.yaml") + " gave already");
+  refused(seeds + " --save ../../../mean.yaml", "train_headless: --save ../../../mean.yaml is not allowed");
+  // A folder where --save's file should go: it cannot be written.
+  fs::create_directories(dir_ / "a_folder.yaml");
+  const CommandRun unwritable = trainHeadless(seeds + " --save " + (dir_ / "a_folder.yaml").string());
+  EXPECT_EQ(1, unwritable.status) << unwritable.output;
+  EXPECT_TRUE(text_match::contains(unwritable.output, "train_headless: --save: ")) << unwritable.output;
 }
 
 // A replay file with a mistake is refused with the line it is on, before any update.

@@ -114,14 +114,31 @@ private:
 // table may hold 160 MB of zeros).
 std::string tableShapeMismatch(const FeatureParams& features, const std::vector<double>& actions, const QTable& other);
 
-// The mean of tables trained apart (train_headless --average): each value the mean of theirs, so
-// each Q the mean of their Qs (a tile's weights sum linearly). Tables trained apart err in
-// different states, and where one would drop the pole the others outvote it (docs/robust_tables.md).
-// Its counters are their sums (it learnt from all their episodes and steps) and it says how to
-// run it as each of them says. Throws std::invalid_argument, naming the table by its place in
-// the list (1-based), unless there are at least two and all have the first one's features,
-// actions, step (tau) and training configuration (trained_with): a mean of tables that learnt
-// different things would not be any configuration's table.
-QTable meanTable(const std::vector<QTable>& tables);
+// The mean of tables trained apart (train_headless --average), added one at a time so that only
+// one table besides the sum is held: each value the mean of theirs, so each Q the mean of their Qs
+// (a tile's weights sum linearly). Tables trained apart err in different states, and where one
+// would drop the pole the others outvote it (docs/robust_tables.md). Its counters are their sums
+// (it learnt from all their episodes and steps) and it says how to run it as each of them says.
+class TableMean
+{
+public:
+  explicit TableMean(QTable first);
+  // Throws std::invalid_argument saying what differs, and adds nothing, unless the table has the
+  // first one's features, actions, step (tau) and training configuration (trained_with): a mean
+  // of tables that learnt different things would not be any configuration's table.
+  void add(const QTable& table);
+  std::size_t count() const
+  {
+    return count_;
+  }
+  // The mean of the tables added (the first alone: itself). Throws std::invalid_argument when a
+  // value's sum is not finite (values near the largest double) or a counter would overflow.
+  QTable mean() const;
+
+private:
+  QTable sum_;  // the first table, its values and counters summed over the tables added
+  std::size_t count_ = 1;
+  bool counters_overflow_ = false;
+};
 
 }  // namespace cartpole_qlearning

@@ -737,12 +737,21 @@ QTable tableWith(double scale, std::uint64_t episodes)
   table.trained_with = "learning:\n  features: tiles\n";
   return table;
 }
+
+// The mean of tables, added one at a time as train_headless --average reads them.
+QTable meanOf(const std::vector<QTable>& tables)
+{
+  TableMean sum(tables.front());
+  for (std::size_t i = 1; i < tables.size(); ++i)
+    sum.add(tables[i]);
+  return sum.mean();
+}
 }  // namespace
 
 TEST(QTableMeanTest, EachValueIsTheMeanOfTheTablesAndTheCountersAreSummed)
 {
   const std::vector<QTable> tables{tableWith(1.0, 3), tableWith(-0.5, 4), tableWith(0.3, 5)};
-  const QTable mean = meanTable(tables);
+  const QTable mean = meanOf(tables);
   EXPECT_EQ("", tables[0].shapeMismatch(mean));
   ASSERT_EQ(tables[0].values().size(), mean.values().size());
   for (std::size_t i = 0; i < mean.values().size(); ++i)
@@ -762,12 +771,43 @@ TEST(QTableMeanTest, EachValueIsTheMeanOfTheTablesAndTheCountersAreSummed)
   EXPECT_EQ(12u, loaded.episodes);
 }
 
-TEST(QTableMeanTest, TablesThatLearntDifferentThingsAreRefusedNamingWhichAndWhatDiffers)
+TEST(QTableMeanTest, SignsOfZeroSurviveAndASumPastTheLargestDoubleIsRefused)
 {
-  const auto refusal = [](const std::vector<QTable>& tables) {
+  QTable a = tableWith(1.0, 1);
+  QTable b = tableWith(1.0, 1);
+  std::vector<double> values = a.values();
+  values[0] = -0.0;
+  values[1] = std::numeric_limits<double>::max();
+  a.setValues(values);
+  b.setValues(values);
+  TableMean sum(a);
+  EXPECT_EQ(1u, sum.count());
+  EXPECT_TRUE(bitIdentical(a.values(), sum.mean().values()));  // one table: itself
+  sum.add(b);
+  EXPECT_EQ(2u, sum.count());
+  try
+  {
+    sum.mean();
+    ADD_FAILURE() << "a sum past the largest double was averaged";
+  }
+  catch (const std::invalid_argument& e)
+  {
+    EXPECT_STREQ("a value's sum over the tables is not finite (values near the largest double)", e.what());
+  }
+  values[1] = 1.0;
+  a.setValues(values);
+  TableMean zeros(a);
+  zeros.add(a);
+  EXPECT_TRUE(std::signbit(zeros.mean().values()[0]));
+}
+
+TEST(QTableMeanTest, TablesThatLearntDifferentThingsAreRefusedSayingWhatDiffersAndAddNothing)
+{
+  TableMean sum(tableWith(1.0, 1));
+  const auto refusal = [&sum](const QTable& table) {
     try
     {
-      meanTable(tables);
+      sum.add(table);
     }
     catch (const std::invalid_argument& e)
     {
@@ -775,20 +815,28 @@ TEST(QTableMeanTest, TablesThatLearntDifferentThingsAreRefusedNamingWhichAndWhat
     }
     return std::string("no refusal");
   };
-  EXPECT_EQ("a mean needs at least two tables, got 1", refusal({tableWith(1.0, 1)}));
-  EXPECT_EQ("a mean needs at least two tables, got 0", refusal({}));
   QTable other_actions(tableWith(1.0, 1).features(), {-10.0, 10.0});
-  EXPECT_EQ(
-      0u,
-      refusal({tableWith(1.0, 1), tableWith(1.0, 1), other_actions}).find("table 3 of 3: actions [-10, 10] differ"));
+  EXPECT_EQ("actions [-10, 10] differ from [-10, 0, 10]", refusal(other_actions));
   FeatureParams bins;
-  EXPECT_EQ(0u, refusal({tableWith(1.0, 1), QTable(bins, {-10.0, 0.0, 10.0})}).find("table 2 of 2: "));
+  EXPECT_EQ(tableWith(1.0, 1).shapeMismatch(QTable(bins, {-10.0, 0.0, 10.0})),
+            refusal(QTable(bins, {-10.0, 0.0, 10.0})));
+  EXPECT_NE("", refusal(QTable(bins, {-10.0, 0.0, 10.0})));
   QTable other_tau = tableWith(1.0, 1);
   other_tau.tau = 0.01;
-  EXPECT_EQ("table 2 of 2: its step (tau) 0.01 s differs from table 1's 0.02 s",
-            refusal({tableWith(1.0, 1), other_tau}));
+  EXPECT_EQ("its step (tau) 0.01 s differs from the first table's 0.02 s", refusal(other_tau));
   QTable other_config = tableWith(1.0, 1);
-  other_config.trained_with += "  ensemble: 2\n";
-  EXPECT_EQ("table 2 of 2: the configuration that trained it (trained_with) differs from table 1's",
-            refusal({tableWith(1.0, 1), other_config}));
+  other_config.trained_with = "learning:\n  features: bins\n";
+  EXPECT_EQ(
+      "the configuration that trained it (trained_with) differs from the first table's at line 2 '  features: bins' "
+      "where the first's is '  features: tiles'",
+      refusal(other_config));
+  other_config.trained_with = tableWith(1.0, 1).trained_with + "  ensemble: 2\n";
+  EXPECT_EQ(
+      "the configuration that trained it (trained_with) differs from the first table's at line 3 '  ensemble: 2' "
+      "where the first's is '(none)'",
+      refusal(other_config));
+  // Nothing refused was added: the mean is still the first table.
+  EXPECT_EQ(1u, sum.count());
+  EXPECT_TRUE(bitIdentical(tableWith(1.0, 1).values(), sum.mean().values()));
+  EXPECT_EQ(1u, sum.mean().episodes);
 }
